@@ -1,0 +1,99 @@
+//! Acceleration structures behind one trait: Intel Embree (feature `embree`) and the
+//! pure-Rust BVH. Both report hits in the same terms (geometry id = [`Kind`], primitive
+//! index within the kind), so the renderer cannot tell them apart.
+
+pub mod bvh;
+#[cfg(feature = "embree")]
+pub mod embree;
+
+use crate::geometry::Kind;
+use crate::math::{Ray, Vec3};
+
+/// The nearest hit along a ray.
+#[derive(Clone, Copy, Debug, PartialEq)]
+pub struct Hit {
+    /// Ray parameter.
+    pub t: f32,
+    /// Geometry id: a [`Kind`] discriminant.
+    pub geom_id: u32,
+    /// Index of the primitive within its kind.
+    pub prim_id: u32,
+    /// First surface parameter (triangles: barycentric weight of vertex 1).
+    pub u: f32,
+    /// Second surface parameter (triangles: barycentric weight of vertex 2).
+    pub v: f32,
+    /// Geometric normal, not normalised; for triangles `(p1 − p0) × (p2 − p0)`.
+    pub ng: Vec3,
+}
+
+impl Hit {
+    /// The primitive kind hit.
+    pub fn kind(&self) -> Kind {
+        Kind::from_id(self.geom_id).expect("invalid geometry id")
+    }
+}
+
+/// What a backend reports about itself.
+#[derive(Clone, Debug, Default, PartialEq)]
+pub struct AccelStats {
+    /// Backend name (`embree` or `bvh`).
+    pub backend: &'static str,
+    /// Primitives in the structure.
+    pub prims: usize,
+    /// Nodes (BVH only; 0 when the backend does not say).
+    pub nodes: usize,
+    /// Bytes used by the structure (approximate for Embree: 0 when unknown).
+    pub bytes: usize,
+    /// Free-form details (Embree version, ISA, ...).
+    pub detail: String,
+}
+
+/// A ray-query structure built over a [`Scene`].
+pub trait Accel: Sync {
+    /// The nearest hit with `t` in `(ray.tmin, ray.tmax)`.
+    fn intersect(&self, ray: &Ray) -> Option<Hit>;
+    /// Whether anything lies in `(ray.tmin, ray.tmax)` (any-hit, for shadow rays).
+    fn occluded(&self, ray: &Ray) -> bool;
+    /// Statistics about the built structure.
+    fn stats(&self) -> AccelStats;
+}
+
+/// Which backend to build.
+#[derive(Clone, Copy, Debug, PartialEq, Eq, Hash)]
+pub enum Backend {
+    /// Intel Embree.
+    Embree,
+    /// The pure-Rust BVH.
+    Bvh,
+}
+
+impl Backend {
+    /// The name used on the command line and in statistics.
+    pub fn name(self) -> &'static str {
+        match self {
+            Backend::Embree => "embree",
+            Backend::Bvh => "bvh",
+        }
+    }
+
+    /// The default: Embree when compiled in, else the BVH.
+    pub fn default_available() -> Backend {
+        if cfg!(feature = "embree") {
+            Backend::Embree
+        } else {
+            Backend::Bvh
+        }
+    }
+}
+
+/// Errors from building a backend.
+#[derive(Debug, thiserror::Error)]
+pub enum AccelError {
+    /// The Embree backend failed.
+    #[cfg(feature = "embree")]
+    #[error(transparent)]
+    Embree(#[from] embree::EmbreeError),
+    /// The requested backend is not compiled in.
+    #[error("backend `{0}` is not available in this build (it was built without the `embree` feature)")]
+    Unavailable(&'static str),
+}

@@ -1,0 +1,160 @@
+//! Command-line arguments and their conversion into library settings.
+
+use clap::{Args, Parser, Subcommand, ValueEnum};
+use emray::accel::Backend;
+use emray::output::Encoding;
+use std::path::PathBuf;
+
+/// emray: a Whitted ray tracer for NFF scenes on Intel Embree or a pure-Rust BVH.
+#[derive(Parser, Debug)]
+#[command(name = "emray", version, about, long_about = None)]
+pub struct Cli {
+    /// What to do; with none, renders the built-in default scene to emray.png.
+    #[command(subcommand)]
+    pub command: Option<Command>,
+}
+
+/// Subcommands.
+#[derive(Subcommand, Debug)]
+pub enum Command {
+    /// Render one or more scene files.
+    Render(RenderArgs),
+}
+
+/// The backends as named on the command line.
+#[derive(Clone, Copy, Debug, ValueEnum, PartialEq, Eq)]
+pub enum BackendArg {
+    /// Intel Embree (default when built with the `embree` feature).
+    Embree,
+    /// The pure-Rust BVH.
+    Bvh,
+}
+
+impl From<BackendArg> for Backend {
+    fn from(b: BackendArg) -> Self {
+        match b {
+            BackendArg::Embree => Backend::Embree,
+            BackendArg::Bvh => Backend::Bvh,
+        }
+    }
+}
+
+/// PNG value encodings.
+#[derive(Clone, Copy, Debug, ValueEnum, PartialEq, Eq)]
+pub enum EncodingArg {
+    /// sRGB transfer curve (default).
+    Srgb,
+    /// Values written as they are.
+    Linear,
+}
+
+impl From<EncodingArg> for Encoding {
+    fn from(e: EncodingArg) -> Self {
+        match e {
+            EncodingArg::Srgb => Encoding::Srgb,
+            EncodingArg::Linear => Encoding::Linear,
+        }
+    }
+}
+
+/// `emray render`.
+#[derive(Args, Debug, Clone)]
+pub struct RenderArgs {
+    /// Scene files (NFF).
+    #[arg(required = true, value_name = "SCENE")]
+    pub scenes: Vec<PathBuf>,
+    /// Output file (.png or .exr), or a template with `{stem}` for several scenes.
+    /// Default: `{stem}.png` in the current directory.
+    #[arg(short, long, value_name = "OUT")]
+    pub output: Option<String>,
+    /// Ray-query backend.
+    #[arg(long, value_enum)]
+    pub backend: Option<BackendArg>,
+    /// Image size, overriding the scene's resolution.
+    #[arg(long, value_name = "WxH", value_parser = parse_res)]
+    pub res: Option<(u32, u32)>,
+    /// Samples per pixel (stratified; 1 = pixel centre).
+    #[arg(long, default_value_t = 1, value_parser = clap::value_parser!(u32).range(1..=65536))]
+    pub spp: u32,
+    /// Maximum ray-tree depth, the eye ray being depth 1.
+    #[arg(long, default_value_t = 5, value_parser = clap::value_parser!(u32).range(1..=64))]
+    pub max_depth: u32,
+    /// Worker threads (default: all cores).
+    #[arg(short, long, value_name = "N", value_parser = clap::value_parser!(u32).range(1..=4096))]
+    pub threads: Option<u32>,
+    /// SPD testing mode: 513x513 corner rays for 512x512, depth 5, ray statistics.
+    #[arg(long)]
+    pub spd: bool,
+    /// Print primitives, timings, ray counts and Mrays/s.
+    #[arg(long)]
+    pub stats: bool,
+    /// Append one JSON object per render to FILE.
+    #[arg(long, value_name = "FILE")]
+    pub stats_json: Option<PathBuf>,
+    /// PNG value encoding.
+    #[arg(long, value_enum, default_value_t = EncodingArg::Srgb)]
+    pub encoding: EncodingArg,
+    /// No progress bar and no messages but errors.
+    #[arg(short, long)]
+    pub quiet: bool,
+    /// More log output (repeat for more).
+    #[arg(short, long, action = clap::ArgAction::Count)]
+    pub verbose: u8,
+}
+
+impl RenderArgs {
+    /// The arguments for a bare `emray`: the default scene to `emray.png`.
+    pub fn default_scene() -> Self {
+        RenderArgs {
+            scenes: Vec::new(),
+            output: Some("emray.png".into()),
+            backend: None,
+            res: None,
+            spp: 1,
+            max_depth: 5,
+            threads: None,
+            spd: false,
+            stats: false,
+            stats_json: None,
+            encoding: EncodingArg::Srgb,
+            quiet: false,
+            verbose: 0,
+        }
+    }
+}
+
+/// Largest accepted image side; larger sizes are refused before any allocation.
+pub const MAX_SIDE: u32 = 65536;
+/// Largest accepted pixel count (2^28, 268 megapixels).
+pub const MAX_PIXELS: u64 = 1 << 28;
+
+fn parse_res(s: &str) -> Result<(u32, u32), String> {
+    let (w, h) = s
+        .split_once(['x', 'X'])
+        .ok_or_else(|| format!("'{s}' is not WxH (e.g. 640x480)"))?;
+    let w: u32 = w.trim().parse().map_err(|_| format!("bad width in '{s}'"))?;
+    let h: u32 = h.trim().parse().map_err(|_| format!("bad height in '{s}'"))?;
+    if w == 0 || h == 0 {
+        return Err(format!("'{s}': width and height must be at least 1"));
+    }
+    if w > MAX_SIDE || h > MAX_SIDE || w as u64 * h as u64 > MAX_PIXELS {
+        return Err(format!(
+            "'{s}' is too large (at most {MAX_SIDE} per side and {MAX_PIXELS} pixels)"
+        ));
+    }
+    Ok((w, h))
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+
+    #[test]
+    fn res_parses_and_refuses() {
+        assert_eq!(parse_res("640x480"), Ok((640, 480)));
+        assert!(parse_res("0x10").is_err());
+        assert!(parse_res("abc").is_err());
+        assert!(parse_res("100000x10").is_err());
+        assert!(parse_res("60000x60000").is_err());
+    }
+}

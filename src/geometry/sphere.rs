@@ -1,0 +1,104 @@
+use super::{diff_of_products, quadratic_roots, ShapeHit, SurfacePoint};
+use crate::math::{gamma, Aabb, Ray, Vec3};
+
+/// A sphere. With `inside_only` (NFF's negative radius) only hits where the ray leaves
+/// the sphere count, so the inside is visible and the outside is not.
+#[derive(Clone, Copy, Debug, PartialEq)]
+pub struct Sphere {
+    /// Centre.
+    pub center: Vec3,
+    /// Radius, positive.
+    pub radius: f32,
+    /// Only the inside is visible.
+    pub inside_only: bool,
+}
+
+impl Sphere {
+    /// A sphere from NFF's signed radius.
+    pub fn new(center: Vec3, signed_radius: f32) -> Self {
+        Sphere {
+            center,
+            radius: signed_radius.abs(),
+            inside_only: signed_radius < 0.0,
+        }
+    }
+
+    /// Bounds, widened by a few ulps.
+    pub fn bounds(&self) -> Aabb {
+        let r = Vec3::splat(self.radius * (1.0 + gamma(2)));
+        let slack = self.center.abs() * gamma(2);
+        Aabb {
+            min: self.center - r - slack,
+            max: self.center + r + slack,
+        }
+    }
+
+    /// The (entry, exit) roots of the ray's quadratic, or `None` on a miss
+    /// (Haines et al., Ray Tracing Gems ch. 7: the discriminant from the distance between
+    /// the centre and the line, which does not cancel).
+    #[inline]
+    fn roots(&self, ray: &Ray) -> Option<(f32, f32)> {
+        let f = ray.org - self.center;
+        let a = ray.dir.dot(ray.dir);
+        let b = f.dot(ray.dir);
+        let c = f.dot(f) - self.radius * self.radius;
+        // Perpendicular vector from the centre to the line.
+        let l = f - ray.dir * (b / a);
+        let ll = l.length();
+        let disc = a * diff_of_products(self.radius, self.radius, ll, ll);
+        if disc < 0.0 || !disc.is_finite() {
+            return None;
+        }
+        // a > 0, so the entry root is the smaller one.
+        Some(quadratic_roots(a, b, c, disc))
+    }
+
+    /// The nearest hit in `(ray.tmin, ray.tmax)`.
+    #[inline]
+    pub fn intersect(&self, ray: &Ray) -> Option<ShapeHit> {
+        let (t0, t1) = self.roots(ray)?;
+        let t = if !self.inside_only && t0 > ray.tmin && t0 < ray.tmax {
+            t0
+        } else if t1 > ray.tmin && t1 < ray.tmax {
+            t1
+        } else {
+            return None;
+        };
+        let ng = ray.at(t) - self.center;
+        Some(ShapeHit {
+            t,
+            u: 0.0,
+            v: 0.0,
+            ng,
+        })
+    }
+
+    /// Whether a hit lies in `(ray.tmin, ray.tmax)`.
+    #[inline]
+    pub fn occluded(&self, ray: &Ray) -> bool {
+        match self.roots(ray) {
+            Some((t0, t1)) => {
+                (!self.inside_only && t0 > ray.tmin && t0 < ray.tmax)
+                    || (t1 > ray.tmin && t1 < ray.tmax)
+            }
+            None => false,
+        }
+    }
+
+    /// The hit point reprojected onto the sphere, with its error bound (pbrt §6.8.5).
+    pub fn surface(&self, ray: &Ray, t: f32) -> SurfacePoint {
+        let mut local = ray.at(t) - self.center;
+        let len = local.length();
+        if len > 0.0 {
+            local *= self.radius / len;
+        }
+        let p = self.center + local;
+        let err = (local.abs() * gamma(5) + p.abs() * gamma(1)) * 2.0;
+        let ng = if len > 0.0 {
+            local / self.radius
+        } else {
+            -ray.dir.normalize()
+        };
+        SurfacePoint { p, err, ng }
+    }
+}

@@ -1,0 +1,138 @@
+use super::{ShapeHit, SurfacePoint};
+use crate::math::{gamma, Aabb, Ray, Vec3};
+
+/// A triangle. Its front side is the one from which the vertices appear
+/// counterclockwise; the geometric normal `(p1 − p0) × (p2 − p0)` points to it.
+/// Intersection is two-sided.
+#[derive(Clone, Copy, Debug, PartialEq)]
+pub struct Triangle {
+    /// The three vertices.
+    pub p: [Vec3; 3],
+}
+
+/// A ray prepared for the watertight test (Woop, Benthin and Wald, JCGT 2013): the axis
+/// of largest direction component becomes z and the other two are sheared away.
+#[derive(Clone, Copy, Debug)]
+pub struct WatertightRay {
+    org: Vec3,
+    k: [usize; 3],
+    shear: Vec3,
+    tmin: f32,
+    tmax: f32,
+}
+
+impl WatertightRay {
+    /// Precompute the permutation and shear for `ray`.
+    #[inline]
+    pub fn new(ray: &Ray) -> Self {
+        let d = ray.dir;
+        let kz = d.abs().max_position();
+        let mut kx = (kz + 1) % 3;
+        let mut ky = (kx + 1) % 3;
+        if d[kz] < 0.0 {
+            std::mem::swap(&mut kx, &mut ky);
+        }
+        let dz = d[kz];
+        WatertightRay {
+            org: ray.org,
+            k: [kx, ky, kz],
+            shear: Vec3::new(d[kx] / dz, d[ky] / dz, 1.0 / dz),
+            tmin: ray.tmin,
+            tmax: ray.tmax,
+        }
+    }
+
+    /// Narrow the far end of the interval (after a closer hit).
+    #[inline]
+    pub fn set_tmax(&mut self, tmax: f32) {
+        self.tmax = tmax;
+    }
+}
+
+impl Triangle {
+    /// Geometric normal `(p1 − p0) × (p2 − p0)`, not normalised.
+    #[inline]
+    pub fn normal(&self) -> Vec3 {
+        (self.p[1] - self.p[0]).cross(self.p[2] - self.p[0])
+    }
+
+    /// Bounds.
+    pub fn bounds(&self) -> Aabb {
+        Aabb::from_points(self.p[0], self.p[1]).grow(self.p[2])
+    }
+
+    /// Area.
+    pub fn area(&self) -> f32 {
+        0.5 * self.normal().length()
+    }
+
+    /// Watertight intersection: no ray passes between two triangles sharing an edge.
+    #[inline]
+    pub fn intersect_wt(&self, r: &WatertightRay) -> Option<ShapeHit> {
+        let [kx, ky, kz] = r.k;
+        let a = self.p[0] - r.org;
+        let b = self.p[1] - r.org;
+        let c = self.p[2] - r.org;
+        let s = r.shear;
+        let ax = a[kx] - s.x * a[kz];
+        let ay = a[ky] - s.y * a[kz];
+        let bx = b[kx] - s.x * b[kz];
+        let by = b[ky] - s.y * b[kz];
+        let cx = c[kx] - s.x * c[kz];
+        let cy = c[ky] - s.y * c[kz];
+        let mut u = cx * by - cy * bx;
+        let mut v = ax * cy - ay * cx;
+        let mut w = bx * ay - by * ax;
+        if u == 0.0 || v == 0.0 || w == 0.0 {
+            // Exactly on an edge in f32: decide it in f64, as the paper prescribes.
+            let (ax, ay, bx, by, cx, cy) = (
+                ax as f64, ay as f64, bx as f64, by as f64, cx as f64, cy as f64,
+            );
+            u = (cx * by - cy * bx) as f32;
+            v = (ax * cy - ay * cx) as f32;
+            w = (bx * ay - by * ax) as f32;
+        }
+        if (u < 0.0 || v < 0.0 || w < 0.0) && (u > 0.0 || v > 0.0 || w > 0.0) {
+            return None;
+        }
+        let det = u + v + w;
+        if det == 0.0 {
+            return None;
+        }
+        let az = s.z * a[kz];
+        let bz = s.z * b[kz];
+        let cz = s.z * c[kz];
+        let tt = u * az + v * bz + w * cz;
+        let inv = 1.0 / det;
+        let t = tt * inv;
+        if !(t > r.tmin && t < r.tmax) {
+            return None;
+        }
+        Some(ShapeHit {
+            t,
+            u: v * inv,
+            v: w * inv,
+            ng: self.normal(),
+        })
+    }
+
+    /// The nearest hit in `(ray.tmin, ray.tmax)`.
+    #[inline]
+    pub fn intersect(&self, ray: &Ray) -> Option<ShapeHit> {
+        self.intersect_wt(&WatertightRay::new(ray))
+    }
+
+    /// The point with barycentrics `(1 − u − v, u, v)` and its error bound
+    /// (pbrt §6.8.4: γ₇ Σ|bᵢ pᵢ|).
+    pub fn surface(&self, u: f32, v: f32) -> SurfacePoint {
+        let b0 = 1.0 - u - v;
+        let p = self.p[0] * b0 + self.p[1] * u + self.p[2] * v;
+        let err = ((self.p[0] * b0).abs() + (self.p[1] * u).abs() + (self.p[2] * v).abs())
+            * gamma(7);
+        SurfacePoint {
+            p,
+            err,
+            ng: self.normal().normalize_or_zero(),
+        }
+    }
+}

@@ -1,0 +1,45 @@
+//! Scene loaders. They build a [`crate::Scene`] and never render.
+
+pub mod nff;
+
+use std::fmt;
+use std::path::{Path, PathBuf};
+
+/// A load failure, displayed as `path:line:col: message` (or `path: message` when it
+/// concerns the whole file).
+#[derive(Debug, Clone, PartialEq)]
+pub struct LoadError {
+    /// The file (or a label such as `<string>`).
+    pub path: PathBuf,
+    /// 1-based line, 0 when not applicable.
+    pub line: usize,
+    /// 1-based column, 0 when not applicable.
+    pub col: usize,
+    /// What is wrong.
+    pub message: String,
+}
+
+impl fmt::Display for LoadError {
+    fn fmt(&self, f: &mut fmt::Formatter<'_>) -> fmt::Result {
+        if self.line == 0 {
+            write!(f, "{}: {}", self.path.display(), self.message)
+        } else {
+            write!(
+                f,
+                "{}:{}:{}: {}",
+                self.path.display(),
+                self.line,
+                self.col,
+                self.message
+            )
+        }
+    }
+}
+
+impl std::error::Error for LoadError {}
+
+/// Load a scene file, choosing the format by extension (`.nff`; anything else is read
+/// as NFF too, the classic benchmark files have no fixed extension).
+pub fn load_path(path: &Path) -> Result<crate::Scene, LoadError> {
+    nff::load(path)
+}

@@ -1,0 +1,171 @@
+//! The `emray` command.
+
+mod cli;
+
+use anyhow::{bail, Context, Result};
+use clap::Parser;
+use cli::{Cli, Command, RenderArgs};
+use emray::accel::Backend;
+use emray::load;
+use emray::render::RenderSettings;
+use emray::Scene;
+use std::io::{IsTerminal, Write};
+use std::path::{Path, PathBuf};
+use std::process::ExitCode;
+use std::time::Instant;
+
+/// The built-in default scene.
+const DEFAULT_SCENE: &str = include_str!("../scenes/default.nff");
+
+fn main() -> ExitCode {
+    let cli = Cli::parse();
+    let args = match cli.command {
+        Some(Command::Render(a)) => a,
+        None => RenderArgs::default_scene(),
+    };
+    let level = match (args.quiet, args.verbose) {
+        (true, _) => "error",
+        (false, 0) => "warn",
+        (false, 1) => "info",
+        (false, 2) => "debug",
+        _ => "trace",
+    };
+    env_logger::Builder::from_env(env_logger::Env::default().default_filter_or(level))
+        .format_timestamp(None)
+        .init();
+    match render_all(&args) {
+        Ok(()) => ExitCode::SUCCESS,
+        Err(e) => {
+            eprintln!("emray: error: {e:#}");
+            ExitCode::from(1)
+        }
+    }
+}
+
+/// Where scene `scene` goes.
+fn output_for(args: &RenderArgs, scene: &Path) -> Result<PathBuf> {
+    let stem = scene
+        .file_stem()
+        .map(|s| s.to_string_lossy().into_owned())
+        .unwrap_or_else(|| "emray".into());
+    let out = match &args.output {
+        Some(t) if t.contains("{stem}") => t.replace("{stem}", &stem),
+        Some(t) => t.clone(),
+        None => format!("{stem}.png"),
+    };
+    Ok(PathBuf::from(out))
+}
+
+fn render_all(args: &RenderArgs) -> Result<()> {
+    if args.scenes.len() > 1 {
+        if let Some(o) = &args.output {
+            if !o.contains("{stem}") {
+                bail!("{} scenes but one output file '{o}': use a template such as '{{stem}}.png'", args.scenes.len());
+            }
+        }
+    }
+    // Refuse a bad output name before any work.
+    let jobs: Vec<(Option<&Path>, PathBuf)> = if args.scenes.is_empty() {
+        vec![(None, output_for(args, Path::new("emray"))?)]
+    } else {
+        args.scenes
+            .iter()
+            .map(|s| Ok((Some(s.as_path()), output_for(args, s)?)))
+            .collect::<Result<_>>()?
+    };
+    for (_, out) in &jobs {
+        emray::output::Format::from_path(out)?;
+    }
+    let mut builder = rayon::ThreadPoolBuilder::new();
+    if let Some(t) = args.threads {
+        builder = builder.num_threads(t as usize);
+    }
+    let pool = builder.build().context("cannot start the worker threads")?;
+    let mut failed = 0usize;
+    for (scene, out) in &jobs {
+        let result = pool.install(|| render_one(args, *scene, out));
+        if let Err(e) = result {
+            if jobs.len() == 1 {
+                return Err(e);
+            }
+            eprintln!("emray: error: {e:#}");
+            failed += 1;
+        }
+    }
+    if failed > 0 {
+        bail!("{failed} of {} scenes failed", jobs.len());
+    }
+    Ok(())
+}
+
+fn render_one(args: &RenderArgs, scene_path: Option<&Path>, out: &Path) -> Result<()> {
+    let t0 = Instant::now();
+    let (name, scene): (String, Scene) = match scene_path {
+        Some(p) => (p.display().to_string(), load::load_path(p)?),
+        None => (
+            "default".into(),
+            load::nff::parse_str(DEFAULT_SCENE, Path::new("<default scene>"))?,
+        ),
+    };
+    let load_ms = t0.elapsed().as_secs_f64() * 1e3;
+    let mut settings = RenderSettings::for_scene(&scene);
+    if let Some((w, h)) = args.res {
+        settings.width = w;
+        settings.height = h;
+    }
+    settings.spp = args.spp;
+    settings.max_depth = args.max_depth;
+    if args.spd {
+        // SPD testing mode: 512x512 from a 513x513 corner grid, depth 5, one sample.
+        if args.res.is_none() {
+            settings.width = 512;
+            settings.height = 512;
+        }
+        settings.spd = true;
+        settings.spp = 1;
+        settings.max_depth = 5;
+    }
+    let backend: Backend = args
+        .backend
+        .map(Backend::from)
+        .unwrap_or_else(Backend::default_available);
+
+    let show_bar = !args.quiet && std::io::stderr().is_terminal();
+    let bar = show_bar.then(|| {
+        let b = indicatif::ProgressBar::new(0);
+        b.set_style(
+            indicatif::ProgressStyle::with_template("{msg} [{bar:40}] {pos}/{len} tiles {elapsed_precise} eta {eta}")
+                .expect("static template")
+                .progress_chars("=> "),
+        );
+        b.set_message(name.clone());
+        b
+    });
+    let progress = |done: usize, total: usize| {
+        if let Some(b) = &bar {
+            b.set_length(total as u64);
+            b.set_position(done as u64);
+        }
+    };
+    let (film, report) =
+        emray::run::render_scene(&name, &scene, backend, &settings, load_ms, Some(&progress))?;
+    if let Some(b) = &bar {
+        b.finish_and_clear();
+    }
+    emray::output::write_image(out, &film, args.encoding.into())?;
+    if args.stats {
+        println!("{}\noutput     {}", report.summary(), out.display());
+    } else if !args.quiet {
+        log::info!("wrote {}", out.display());
+    }
+    if let Some(path) = &args.stats_json {
+        let line = serde_json::to_string(&report).expect("report serialises");
+        let mut f = std::fs::OpenOptions::new()
+            .create(true)
+            .append(true)
+            .open(path)
+            .with_context(|| format!("{}: cannot open for writing", path.display()))?;
+        writeln!(f, "{line}").with_context(|| format!("{}: cannot write", path.display()))?;
+    }
+    Ok(())
+}

@@ -1,0 +1,83 @@
+//! Rays, boxes, orthonormal frames and the floating-point error tools used for robust
+//! ray spawning.
+
+mod aabb;
+mod robust;
+
+pub use aabb::Aabb;
+pub use glam::{DVec3, Vec3};
+pub use robust::{gamma, next_float_down, next_float_up, offset_ray_origin};
+
+/// A ray with its valid parameter interval `[tmin, tmax]`.
+///
+/// `dir` need not be unit length; `t` is measured in units of `dir`.
+#[derive(Clone, Copy, Debug, PartialEq)]
+pub struct Ray {
+    /// Origin.
+    pub org: Vec3,
+    /// Direction.
+    pub dir: Vec3,
+    /// Smallest accepted hit distance.
+    pub tmin: f32,
+    /// Largest accepted hit distance.
+    pub tmax: f32,
+}
+
+impl Ray {
+    /// A ray over `[0, +inf)`.
+    pub fn new(org: Vec3, dir: Vec3) -> Self {
+        Ray {
+            org,
+            dir,
+            tmin: 0.0,
+            tmax: f32::INFINITY,
+        }
+    }
+
+    /// The point at parameter `t`.
+    #[inline]
+    pub fn at(&self, t: f32) -> Vec3 {
+        self.org + self.dir * t
+    }
+}
+
+/// The same ray in double precision, for reference computations.
+#[derive(Clone, Copy, Debug, PartialEq)]
+pub struct DRay {
+    /// Origin.
+    pub org: DVec3,
+    /// Direction.
+    pub dir: DVec3,
+}
+
+impl From<&Ray> for DRay {
+    fn from(r: &Ray) -> Self {
+        DRay {
+            org: r.org.as_dvec3(),
+            dir: r.dir.as_dvec3(),
+        }
+    }
+}
+
+/// A right-handed orthonormal frame.
+#[derive(Clone, Copy, Debug, PartialEq)]
+pub struct Frame {
+    /// First tangent.
+    pub x: Vec3,
+    /// Second tangent.
+    pub y: Vec3,
+    /// Normal (the frame's z axis).
+    pub z: Vec3,
+}
+
+impl Frame {
+    /// A frame whose z axis is the unit vector `n` (Duff et al. 2017, branchless ONB).
+    pub fn from_z(n: Vec3) -> Self {
+        let sign = 1.0f32.copysign(n.z);
+        let a = -1.0 / (sign + n.z);
+        let b = n.x * n.y * a;
+        let x = Vec3::new(1.0 + sign * n.x * n.x * a, sign * b, -sign * n.x);
+        let y = Vec3::new(b, sign + n.y * n.y * a, -n.y);
+        Frame { x, y, z: n }
+    }
+}

@@ -1,0 +1,198 @@
+//! Image output: PNG (sRGB-encoded by default) and OpenEXR (linear f32), chosen by the
+//! file extension, always written to a temporary file beside the target and renamed,
+//! so a failed or interrupted write never leaves a truncated image.
+
+use crate::render::Film;
+use std::fs;
+use std::io::{BufWriter, Write};
+use std::path::{Path, PathBuf};
+
+/// How PNG values are encoded.
+#[derive(Clone, Copy, Debug, Default, PartialEq, Eq)]
+pub enum Encoding {
+    /// Linear values through the sRGB transfer curve (what image viewers expect).
+    #[default]
+    Srgb,
+    /// Values written as they are, clamped to [0, 1] (the classic NFF renderers' way).
+    Linear,
+}
+
+/// Output file formats.
+#[derive(Clone, Copy, Debug, PartialEq, Eq)]
+pub enum Format {
+    /// 8-bit RGB PNG.
+    Png,
+    /// 32-bit float RGB OpenEXR.
+    Exr,
+}
+
+/// Output failures; each names the file.
+#[derive(Debug, thiserror::Error)]
+pub enum OutputError {
+    /// The extension is neither `.png` nor `.exr`.
+    #[error("{0}: unsupported output format (use a .png or .exr file name)")]
+    Format(PathBuf),
+    /// Writing failed.
+    #[error("{path}: cannot write: {message}")]
+    Write {
+        /// Target file.
+        path: PathBuf,
+        /// What went wrong.
+        message: String,
+    },
+}
+
+impl Format {
+    /// The format for a file name, by extension (case-insensitive).
+    pub fn from_path(path: &Path) -> Result<Format, OutputError> {
+        match path
+            .extension()
+            .and_then(|e| e.to_str())
+            .map(|e| e.to_ascii_lowercase())
+            .as_deref()
+        {
+            Some("png") => Ok(Format::Png),
+            Some("exr") => Ok(Format::Exr),
+            _ => Err(OutputError::Format(path.to_path_buf())),
+        }
+    }
+}
+
+/// The sRGB transfer function (IEC 61966-2-1) for a linear value in [0, 1].
+#[inline]
+pub fn srgb_encode(v: f32) -> f32 {
+    if v <= 0.003_130_8 {
+        12.92 * v
+    } else {
+        1.055 * v.powf(1.0 / 2.4) - 0.055
+    }
+}
+
+/// 8-bit RGB bytes of `film`, clamped to [0, 1] and encoded.
+pub fn to_rgb8(film: &Film, encoding: Encoding) -> Vec<u8> {
+    let mut out = Vec::with_capacity(film.pixels.len() * 3);
+    for p in &film.pixels {
+        for c in p.to_array() {
+            let c = if c.is_nan() { 0.0 } else { c.clamp(0.0, 1.0) };
+            let e = match encoding {
+                Encoding::Srgb => srgb_encode(c),
+                Encoding::Linear => c,
+            };
+            out.push((e * 255.0 + 0.5) as u8);
+        }
+    }
+    out
+}
+
+/// Write `film` to `path` (format by extension) through a temporary file and a rename.
+pub fn write_image(path: &Path, film: &Film, encoding: Encoding) -> Result<(), OutputError> {
+    let format = Format::from_path(path)?;
+    let err = |e: &dyn std::fmt::Display| OutputError::Write {
+        path: path.to_path_buf(),
+        message: e.to_string(),
+    };
+    let tmp = temp_name(path);
+    let result = (|| -> Result<(), OutputError> {
+        match format {
+            Format::Png => {
+                let file = fs::File::create(&tmp).map_err(|e| err(&e))?;
+                let mut w = BufWriter::new(file);
+                let enc = image::codecs::png::PngEncoder::new(&mut w);
+                image::ImageEncoder::write_image(
+                    enc,
+                    &to_rgb8(film, encoding),
+                    film.width,
+                    film.height,
+                    image::ExtendedColorType::Rgb8,
+                )
+                .map_err(|e| err(&e))?;
+                let file = w.into_inner().map_err(|e| err(&e.into_error()))?;
+                file.sync_all().map_err(|e| err(&e))?;
+            }
+            Format::Exr => {
+                let (w, h) = (film.width as usize, film.height as usize);
+                let px = &film.pixels;
+                let channels = exr::prelude::SpecificChannels::rgb(|p: exr::prelude::Vec2<usize>| {
+                    let v = px[p.y() * w + p.x()];
+                    (v.x, v.y, v.z)
+                });
+                let image = exr::prelude::Image::from_channels((w, h), channels);
+                let file = fs::File::create(&tmp).map_err(|e| err(&e))?;
+                let mut bw = BufWriter::new(file);
+                exr::prelude::WritableImage::write(&image)
+                    .to_buffered(&mut bw)
+                    .map_err(|e| err(&e))?;
+                bw.flush().map_err(|e| err(&e))?;
+            }
+        }
+        fs::rename(&tmp, path).map_err(|e| err(&e))
+    })();
+    if result.is_err() {
+        let _ = fs::remove_file(&tmp);
+    }
+    result
+}
+
+/// A hidden temporary name in the same directory (so the rename is atomic).
+fn temp_name(path: &Path) -> PathBuf {
+    let name = path
+        .file_name()
+        .map(|n| n.to_string_lossy().into_owned())
+        .unwrap_or_default();
+    path.with_file_name(format!(".{name}.{}.tmp", std::process::id()))
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+    use glam::Vec3;
+
+    #[test]
+    fn srgb_curve_endpoints_and_midpoint() {
+        assert_eq!(srgb_encode(0.0), 0.0);
+        assert!((srgb_encode(1.0) - 1.0).abs() < 1e-6);
+        // 18% grey encodes to about 46%.
+        assert!((srgb_encode(0.18) - 0.4613).abs() < 1e-3);
+    }
+
+    #[test]
+    fn rgb8_clamps_and_encodes() {
+        let mut f = Film::new(2, 1);
+        f.set(0, 0, Vec3::new(-1.0, 0.5, 2.0));
+        f.set(1, 0, Vec3::new(f32::NAN, 0.0, 1.0));
+        assert_eq!(to_rgb8(&f, Encoding::Linear), vec![0, 128, 255, 0, 0, 255]);
+        assert_eq!(to_rgb8(&f, Encoding::Srgb)[1], 188);
+    }
+
+    #[test]
+    fn png_and_exr_round_trip() {
+        let dir = tempfile::tempdir().unwrap();
+        let mut f = Film::new(3, 2);
+        f.set(2, 1, Vec3::new(0.25, 0.5, 1.5));
+        let png = dir.path().join("a.png");
+        write_image(&png, &f, Encoding::Linear).unwrap();
+        let img = image::open(&png).unwrap().to_rgb8();
+        assert_eq!(img.dimensions(), (3, 2));
+        assert_eq!(img.get_pixel(2, 1).0, [64, 128, 255]);
+        let exr_path = dir.path().join("a.exr");
+        write_image(&exr_path, &f, Encoding::Srgb).unwrap();
+        let read = exr::prelude::read_first_rgba_layer_from_file(
+            &exr_path,
+            |res, _| vec![[0f32; 3]; res.width() * res.height()],
+            |buf, pos, (r, g, b, _a): (f32, f32, f32, f32)| buf[pos.y() * 3 + pos.x()] = [r, g, b],
+        )
+        .unwrap();
+        assert_eq!(read.layer_data.channel_data.pixels[5], [0.25, 0.5, 1.5]);
+        // Only the two images: no temporary files left behind.
+        assert_eq!(std::fs::read_dir(dir.path()).unwrap().count(), 2);
+    }
+
+    #[test]
+    fn unknown_extension_is_refused_and_writes_nothing() {
+        let dir = tempfile::tempdir().unwrap();
+        let p = dir.path().join("a.jpg");
+        let e = write_image(&p, &Film::new(1, 1), Encoding::Srgb).unwrap_err();
+        assert!(e.to_string().contains("unsupported output format"));
+        assert_eq!(std::fs::read_dir(dir.path()).unwrap().count(), 0);
+    }
+}

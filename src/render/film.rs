@@ -1,0 +1,51 @@
+//! A linear RGB f32 image.
+
+use glam::Vec3;
+
+/// Linear RGB pixels, row-major from the top-left.
+#[derive(Clone, Debug, PartialEq)]
+pub struct Film {
+    /// Width in pixels.
+    pub width: u32,
+    /// Height in pixels.
+    pub height: u32,
+    /// Pixel values.
+    pub pixels: Vec<Vec3>,
+}
+
+impl Film {
+    /// A black film.
+    pub fn new(width: u32, height: u32) -> Self {
+        Film {
+            width,
+            height,
+            pixels: vec![Vec3::ZERO; width as usize * height as usize],
+        }
+    }
+
+    /// Pixel `(i, j)`.
+    #[inline]
+    pub fn get(&self, i: u32, j: u32) -> Vec3 {
+        self.pixels[(j * self.width + i) as usize]
+    }
+
+    /// Set pixel `(i, j)`.
+    #[inline]
+    pub fn set(&mut self, i: u32, j: u32, v: Vec3) {
+        self.pixels[(j * self.width + i) as usize] = v;
+    }
+
+    /// The `(w−1) × (h−1)` film whose pixels are the means of this film's 2×2 blocks of
+    /// neighbouring samples (SPD corner-ray mode).
+    pub fn average_corners(&self) -> Film {
+        let (w, h) = (self.width - 1, self.height - 1);
+        let mut out = Film::new(w, h);
+        for j in 0..h {
+            for i in 0..w {
+                let s = self.get(i, j) + self.get(i + 1, j) + self.get(i, j + 1) + self.get(i + 1, j + 1);
+                out.set(i, j, s * 0.25);
+            }
+        }
+        out
+    }
+}

@@ -1,0 +1,194 @@
+//! One render from start to end, with the phases timed separately (the SPD rule:
+//! preprocessing apart from ray tracing): load, build the backend, render.
+
+use crate::accel::{Accel, AccelError, AccelStats, Backend};
+use crate::geometry::Kind;
+use crate::render::{self, Film, Progress, RenderSettings, RenderStats};
+use crate::scene::Scene;
+use serde::Serialize;
+use std::collections::BTreeMap;
+use std::time::Instant;
+
+/// Wall times of the three phases in milliseconds.
+#[derive(Clone, Copy, Debug, Default, PartialEq, Serialize)]
+pub struct Timings {
+    /// Reading and parsing the scene.
+    pub load: f64,
+    /// Building the acceleration structure.
+    pub build: f64,
+    /// Tracing the rays.
+    pub render: f64,
+}
+
+/// Everything a render reports; serialises to the `--stats-json` record.
+#[derive(Clone, Debug, PartialEq, Serialize)]
+pub struct Report {
+    /// Scene name (file path or `default`).
+    pub scene: String,
+    /// Backend name.
+    pub backend: &'static str,
+    /// Image width.
+    pub width: u32,
+    /// Image height.
+    pub height: u32,
+    /// Worker threads.
+    pub threads: usize,
+    /// Samples per pixel.
+    pub spp: u32,
+    /// SPD testing mode.
+    pub spd: bool,
+    /// Maximum ray depth.
+    pub max_depth: u32,
+    /// Primitives by kind (`triangles`, `spheres`, `cones`).
+    pub prims: BTreeMap<&'static str, usize>,
+    /// Lights.
+    pub lights: usize,
+    /// Degenerate polygons dropped at load.
+    pub degenerate_dropped: usize,
+    /// Phase times.
+    pub time_ms: Timings,
+    /// Rays by type.
+    pub rays: BTreeMap<&'static str, u64>,
+    /// Millions of rays per second of render time.
+    pub mrays_per_s: f64,
+    /// Backend details.
+    pub accel: String,
+}
+
+impl Report {
+    fn new(
+        name: &str,
+        scene: &Scene,
+        settings: &RenderSettings,
+        accel: &AccelStats,
+        time_ms: Timings,
+        stats: &RenderStats,
+    ) -> Self {
+        let r = stats.rays;
+        Report {
+            scene: name.to_string(),
+            backend: accel.backend,
+            width: settings.width,
+            height: settings.height,
+            threads: rayon::current_num_threads(),
+            spp: settings.spp,
+            spd: settings.spd,
+            max_depth: settings.max_depth,
+            prims: Kind::ALL.iter().map(|&k| (k.name(), scene.count(k))).collect(),
+            lights: scene.lights.len(),
+            degenerate_dropped: scene.load_stats.degenerate_dropped,
+            time_ms,
+            rays: BTreeMap::from([
+                ("eye", r.eye),
+                ("eye_hit", r.eye_hit),
+                ("reflection", r.reflection),
+                ("refraction", r.refraction),
+                ("shadow", r.shadow),
+                ("tir", r.tir),
+                ("total", r.total()),
+            ]),
+            mrays_per_s: stats.mrays_per_s(),
+            accel: if accel.detail.is_empty() {
+                accel.backend.to_string()
+            } else {
+                format!("{}: {}", accel.backend, accel.detail)
+            },
+        }
+    }
+
+    /// A human-readable summary for `--stats`.
+    pub fn summary(&self) -> String {
+        let prims: Vec<String> = self
+            .prims
+            .iter()
+            .filter(|(_, &n)| n > 0)
+            .map(|(k, n)| format!("{n} {k}"))
+            .collect();
+        let t = &self.time_ms;
+        let r = &self.rays;
+        format!(
+            "scene      {}\n\
+             backend    {} ({} threads)\n\
+             image      {}x{}, {} spp, depth {}{}\n\
+             prims      {} ({} lights{})\n\
+             time       load {:.1} ms, build {:.1} ms, render {:.1} ms\n\
+             rays       eye {} (hit {}), reflection {}, refraction {}, shadow {}, total {}\n\
+             tir        {}\n\
+             speed      {:.2} Mrays/s",
+            self.scene,
+            self.accel,
+            self.threads,
+            self.width,
+            self.height,
+            self.spp,
+            self.max_depth,
+            if self.spd { ", SPD mode" } else { "" },
+            if prims.is_empty() { "none".to_string() } else { prims.join(", ") },
+            self.lights,
+            if self.degenerate_dropped > 0 {
+                format!(", {} degenerate polygons dropped", self.degenerate_dropped)
+            } else {
+                String::new()
+            },
+            t.load,
+            t.build,
+            t.render,
+            r["eye"],
+            r["eye_hit"],
+            r["reflection"],
+            r["refraction"],
+            r["shadow"],
+            r["total"],
+            r["tir"],
+            self.mrays_per_s,
+        )
+    }
+}
+
+fn finish<A: Accel>(
+    name: &str,
+    scene: &Scene,
+    accel: &A,
+    settings: &RenderSettings,
+    load_ms: f64,
+    build_ms: f64,
+    progress: Option<Progress<'_>>,
+) -> (Film, Report) {
+    let (film, stats) = render::render(scene, accel, settings, progress);
+    let t = Timings {
+        load: load_ms,
+        build: build_ms,
+        render: stats.render_ms,
+    };
+    let report = Report::new(name, scene, settings, &accel.stats(), t, &stats);
+    (film, report)
+}
+
+/// Build `backend` over `scene` and render it on the current rayon pool. This is the
+/// one place the backend is chosen: everything below is monomorphised per backend.
+pub fn render_scene(
+    name: &str,
+    scene: &Scene,
+    backend: Backend,
+    settings: &RenderSettings,
+    load_ms: f64,
+    progress: Option<Progress<'_>>,
+) -> Result<(Film, Report), AccelError> {
+    let t0 = Instant::now();
+    let ms = |t: Instant| t.elapsed().as_secs_f64() * 1e3;
+    match backend {
+        Backend::Bvh => {
+            let accel = crate::accel::bvh::Bvh::build(scene);
+            let build = ms(t0);
+            Ok(finish(name, scene, &accel, settings, load_ms, build, progress))
+        }
+        #[cfg(feature = "embree")]
+        Backend::Embree => {
+            let accel = crate::accel::embree::EmbreeAccel::build(scene)?;
+            let build = ms(t0);
+            Ok(finish(name, scene, &accel, settings, load_ms, build, progress))
+        }
+        #[cfg(not(feature = "embree"))]
+        Backend::Embree => Err(AccelError::Unavailable("embree")),
+    }
+}
