@@ -33,7 +33,14 @@ fn main() -> ExitCode {
     env_logger::Builder::from_env(env_logger::Env::default().default_filter_or(level))
         .format_timestamp(None)
         .init();
-    match render_all(&args) {
+    let jobs = match plan(&args) {
+        Ok(j) => j,
+        Err(e) => {
+            eprintln!("emray: error: {e}");
+            return ExitCode::from(2);
+        }
+    };
+    match render_all(&args, &jobs) {
         Ok(()) => ExitCode::SUCCESS,
         Err(e) => {
             eprintln!("emray: error: {e:#}");
@@ -43,47 +50,56 @@ fn main() -> ExitCode {
 }
 
 /// Where scene `scene` goes.
-fn output_for(args: &RenderArgs, scene: &Path) -> Result<PathBuf> {
+fn output_for(args: &RenderArgs, scene: &Path) -> PathBuf {
     let stem = scene
         .file_stem()
         .map(|s| s.to_string_lossy().into_owned())
         .unwrap_or_else(|| "emray".into());
-    let out = match &args.output {
+    PathBuf::from(match &args.output {
         Some(t) if t.contains("{stem}") => t.replace("{stem}", &stem),
         Some(t) => t.clone(),
         None => format!("{stem}.png"),
-    };
-    Ok(PathBuf::from(out))
+    })
 }
 
-fn render_all(args: &RenderArgs) -> Result<()> {
+/// One render: the scene (`None` = the built-in default) and its output file.
+type Job = (Option<PathBuf>, PathBuf);
+
+/// The jobs, or a usage error (exit status 2) found before any work is done.
+fn plan(args: &RenderArgs) -> Result<Vec<Job>, String> {
     if args.scenes.len() > 1 {
         if let Some(o) = &args.output {
             if !o.contains("{stem}") {
-                bail!("{} scenes but one output file '{o}': use a template such as '{{stem}}.png'", args.scenes.len());
+                return Err(format!(
+                    "{} scenes but one output file '{o}': use a template such as '{{stem}}.png'",
+                    args.scenes.len()
+                ));
             }
         }
     }
-    // Refuse a bad output name before any work.
-    let jobs: Vec<(Option<&Path>, PathBuf)> = if args.scenes.is_empty() {
-        vec![(None, output_for(args, Path::new("emray"))?)]
+    let jobs: Vec<Job> = if args.scenes.is_empty() {
+        vec![(None, output_for(args, Path::new("emray")))]
     } else {
         args.scenes
             .iter()
-            .map(|s| Ok((Some(s.as_path()), output_for(args, s)?)))
-            .collect::<Result<_>>()?
+            .map(|s| (Some(s.clone()), output_for(args, s)))
+            .collect()
     };
     for (_, out) in &jobs {
-        emray::output::Format::from_path(out)?;
+        emray::output::Format::from_path(out).map_err(|e| e.to_string())?;
     }
+    Ok(jobs)
+}
+
+fn render_all(args: &RenderArgs, jobs: &[Job]) -> Result<()> {
     let mut builder = rayon::ThreadPoolBuilder::new();
     if let Some(t) = args.threads {
         builder = builder.num_threads(t as usize);
     }
     let pool = builder.build().context("cannot start the worker threads")?;
     let mut failed = 0usize;
-    for (scene, out) in &jobs {
-        let result = pool.install(|| render_one(args, *scene, out));
+    for (scene, out) in jobs {
+        let result = pool.install(|| render_one(args, scene.as_deref(), out));
         if let Err(e) = result {
             if jobs.len() == 1 {
                 return Err(e);

@@ -282,3 +282,60 @@ fn shared_edges_are_watertight() {
     }
     assert_eq!(misses, 0, "rays slipped through the shared edge");
 }
+
+proptest! {
+    #![proptest_config(ProptestConfig::with_cases(3000))]
+
+    /// Rays leaving a cone hit from outside, towards the outside, never re-hit the cone
+    /// at t ≈ 0 (a later hit on the far wall of a concave view is legitimate, so only
+    /// hits closer than 1e-3 of the cone's size count as self-intersections).
+    #[test]
+    fn spawned_rays_do_not_self_intersect_cones(
+        (scale, off) in placement(), b in v3(), axis in unit(), h in 0.2f32..2.0,
+        rb in 0.05f32..1.0, ra in 0.0f32..1.0, o in unit(), w in unit(), aim in 0.05f32..0.95,
+    ) {
+        let base = off + b * scale;
+        let apex = base + axis * (h * scale);
+        let c = Cone::new(base, rb * scale, apex, ra * scale);
+        let r_t = (rb + (ra - rb) * aim) * scale;
+        let perp = (o - axis * o.dot(axis)).normalize_or(axis.any_orthonormal_vector());
+        let target = base + axis * (aim * h * scale) + perp * r_t;
+        let org = target + perp * (3.0 * scale) + axis * (0.3 * scale);
+        let ray = Ray::new(org, target - org);
+        let Some(hit) = c.intersect(&ray) else { return Ok(()); };
+        let sp = c.surface(&ray, hit.t);
+        let n = if sp.ng.dot(ray.dir) < 0.0 { sp.ng } else { -sp.ng };
+        let wout = if w.dot(n) > 0.0 { w } else { -w };
+        let po = offset_ray_origin(sp.p, sp.err, n, wout);
+        let size = (h + rb + ra) * scale;
+        if let Some(again) = c.intersect(&Ray::new(po, wout)) {
+            prop_assert!(again.t > 1e-3 * size, "self-hit at t = {} (size {size})", again.t);
+        }
+    }
+
+    /// The same for triangles: a ray leaving the surface never re-hits it, whatever
+    /// the triangle's size, position and orientation (axis-aligned ones included).
+    #[test]
+    fn spawned_rays_do_not_self_intersect_triangles(
+        (scale, off) in placement(), a in v3(), b in v3(), c in v3(), o in v3(), w in unit(),
+        axis_aligned in any::<bool>(), bary in (0.0f32..1.0, 0.0f32..1.0),
+    ) {
+        let mut p = [off + a * scale, off + b * scale, off + c * scale];
+        if axis_aligned {
+            for q in &mut p { q.z = off.z; }
+        }
+        let tri = Triangle { p };
+        prop_assume!(tri.area() > 1e-3 * scale * scale);
+        let (mut u, mut v) = bary;
+        if u + v > 1.0 { u = 1.0 - u; v = 1.0 - v; }
+        let target = p[0] * (1.0 - u - v) + p[1] * u + p[2] * v;
+        let org = off + o * (3.0 * scale) + tri.normal().normalize() * scale;
+        let ray = Ray::new(org, target - org);
+        let Some(hit) = tri.intersect(&ray) else { return Ok(()); };
+        let sp = tri.surface(hit.u, hit.v);
+        for dir in [w, -w] {
+            let po = offset_ray_origin(sp.p, sp.err, sp.ng, dir);
+            prop_assert!(tri.intersect(&Ray::new(po, dir)).is_none(), "self-hit leaving along {dir}");
+        }
+    }
+}

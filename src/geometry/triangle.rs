@@ -108,6 +108,21 @@ impl Triangle {
         if !(t > r.tmin && t < r.tmax) {
             return None;
         }
+        // Reject t within its own rounding error of zero (pbrt §6.8.7), so that a ray
+        // leaving the surface from a robustly offset origin cannot re-hit it.
+        let max_zt = az.abs().max(bz.abs()).max(cz.abs());
+        let max_xt = ax.abs().max(bx.abs()).max(cx.abs());
+        let max_yt = ay.abs().max(by.abs()).max(cy.abs());
+        let delta_z = gamma(3) * max_zt;
+        let delta_x = gamma(5) * (max_xt + max_zt);
+        let delta_y = gamma(5) * (max_yt + max_zt);
+        let delta_e = 2.0 * (gamma(2) * max_xt * max_yt + delta_y * max_xt + delta_x * max_yt);
+        let max_e = u.abs().max(v.abs()).max(w.abs());
+        let delta_t =
+            3.0 * (gamma(3) * max_e * max_zt + delta_e * max_zt + delta_z * max_e) * inv.abs();
+        if t <= delta_t {
+            return None;
+        }
         Some(ShapeHit {
             t,
             u: v * inv,
@@ -122,13 +137,21 @@ impl Triangle {
         self.intersect_wt(&WatertightRay::new(ray))
     }
 
-    /// The point with barycentrics `(1 − u − v, u, v)` and its error bound
-    /// (pbrt §6.8.4: γ₇ Σ|bᵢ pᵢ|).
+    /// The point with barycentrics `(1 − u − v, u, v)` and its error bound.
+    ///
+    /// pbrt's bound γ₇ Σ|bᵢ pᵢ| (§6.8.4) covers the interpolation, but it is zero along an
+    /// axis where all three vertices share a coordinate, and a ray starting exactly on
+    /// the plane may then re-hit it at a rounding-level `t` (the plane distance is
+    /// computed from edges as large as the triangle). So the bound also has a term
+    /// relative to the largest vertex coordinate: still no fixed epsilon, it scales with
+    /// the scene.
     pub fn surface(&self, u: f32, v: f32) -> SurfacePoint {
         let b0 = 1.0 - u - v;
         let p = self.p[0] * b0 + self.p[1] * u + self.p[2] * v;
+        let magnitude = self.p[0].abs().max(self.p[1].abs()).max(self.p[2].abs());
         let err = ((self.p[0] * b0).abs() + (self.p[1] * u).abs() + (self.p[2] * v).abs())
-            * gamma(7);
+            * gamma(7)
+            + Vec3::splat(magnitude.max_element() * gamma(8));
         SurfacePoint {
             p,
             err,

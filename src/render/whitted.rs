@@ -75,6 +75,18 @@ fn reflect(d: Vec3, n: Vec3) -> Vec3 {
     d - n * (2.0 * d.dot(n))
 }
 
+/// Snell's law: the refracted direction of unit `d` through a surface with unit normal
+/// `n` facing the incoming ray, for `eta = n₁/n₂`; `None` on total internal reflection.
+#[inline]
+fn refract(d: Vec3, n: Vec3, eta: f32) -> Option<Vec3> {
+    let cos_i = (-d).dot(n).min(1.0);
+    let k = 1.0 - eta * eta * (1.0 - cos_i * cos_i);
+    if k < 0.0 {
+        return None;
+    }
+    Some((d * eta + n * (eta * cos_i - k.sqrt())).normalize())
+}
+
 impl<'a, A: Accel> Tracer<'a, A> {
     pub(super) fn new(scene: &'a Scene, accel: &'a A, s: &RenderSettings) -> Self {
         Tracer {
@@ -164,16 +176,16 @@ impl<'a, A: Accel> Tracer<'a, A> {
         if m.t > 0.0 {
             // Snell's law; the medium is decided by the geometric normal's side.
             let eta = if entering { 1.0 / m.ior } else { m.ior };
-            let cos_i = (-d).dot(ns).min(1.0);
-            let k = 1.0 - eta * eta * (1.0 - cos_i * cos_i);
-            if k < 0.0 {
-                // Total internal reflection: the transmitted energy is reflected.
-                counts.tir += 1;
-                reflect_weight += m.t;
-            } else {
-                let dir = (d * eta + ns * (eta * cos_i - k.sqrt())).normalize();
-                counts.refraction += 1;
-                color += m.t * self.trace(&spawn(dir), depth + 1, counts);
+            match refract(d, ns, eta) {
+                Some(dir) => {
+                    counts.refraction += 1;
+                    color += m.t * self.trace(&spawn(dir), depth + 1, counts);
+                }
+                None => {
+                    // Total internal reflection: the transmitted energy is reflected.
+                    counts.tir += 1;
+                    reflect_weight += m.t;
+                }
             }
         }
         if reflect_weight > 0.0 {
@@ -193,6 +205,26 @@ mod tests {
     fn reflect_mirrors_about_the_normal() {
         let r = reflect(Vec3::new(1.0, -1.0, 0.0), Vec3::Y);
         assert_eq!(r, Vec3::new(1.0, 1.0, 0.0));
+    }
+
+    #[test]
+    fn refraction_obeys_snell_and_total_internal_reflection() {
+        let n = Vec3::Z;
+        for deg in [0.0f32, 10.0, 30.0, 45.0, 60.0, 80.0] {
+            let th = deg.to_radians();
+            let d = Vec3::new(th.sin(), 0.0, -th.cos());
+            // Air to glass: sin θt = sin θi / 1.5.
+            let t = refract(d, n, 1.0 / 1.5).unwrap();
+            let sin_t = t.x;
+            assert!((sin_t - th.sin() / 1.5).abs() < 1e-6, "{deg}°");
+            assert!(t.z < 0.0, "goes through");
+            // Glass to air: TIR beyond the critical angle asin(1/1.5) = 41.8°.
+            let out = refract(d, n, 1.5);
+            assert_eq!(out.is_none(), deg > 41.81, "{deg}°");
+            if let Some(o) = out {
+                assert!((o.x - th.sin() * 1.5).abs() < 1e-5);
+            }
+        }
     }
 
     #[test]

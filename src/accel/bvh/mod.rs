@@ -198,3 +198,157 @@ mod tests {
         assert_eq!(std::mem::size_of::<Node>(), 32);
     }
 }
+
+#[cfg(test)]
+mod agreement {
+    //! The BVH against a brute-force loop over the same intersectors: it must find
+    //! exactly the same nearest hit (the same `t`, bit for bit).
+    use super::*;
+    use crate::geometry::{Cone, Sphere};
+    use crate::math::Vec3;
+    use crate::scene::{Camera, Material};
+
+    fn rng(seed: &mut u64) -> f32 {
+        *seed = seed.wrapping_mul(6364136223846793005).wrapping_add(1442695040888963407);
+        ((*seed >> 40) as f32) / (1u64 << 24) as f32
+    }
+
+    fn v(seed: &mut u64, s: f32) -> Vec3 {
+        Vec3::new(rng(seed) - 0.5, rng(seed) - 0.5, rng(seed) - 0.5) * s
+    }
+
+    pub(crate) fn random_scene(n: usize, seed: &mut u64) -> Scene {
+        let cam = Camera {
+            from: Vec3::Z * 10.0,
+            at: Vec3::ZERO,
+            up: Vec3::Y,
+            angle_deg: 45.0,
+            hither: 0.1,
+            width: 8,
+            height: 8,
+        };
+        let mut s = Scene::new(cam);
+        s.materials.push(Material::default());
+        for _ in 0..n {
+            let c = v(seed, 10.0);
+            match (rng(seed) * 3.0) as u32 {
+                0 => {
+                    s.triangles.push(
+                        Triangle {
+                            p: [c + v(seed, 1.0), c + v(seed, 1.0), c + v(seed, 1.0)],
+                        },
+                        0,
+                    );
+                    s.triangle_normals.push(u32::MAX);
+                }
+                1 => s.spheres.push(Sphere::new(c, 0.05 + rng(seed) * 0.5), 0),
+                _ => s.cones.push(
+                    Cone::new(c, rng(seed) * 0.5, c + v(seed, 2.0), rng(seed) * 0.5),
+                    0,
+                ),
+            }
+        }
+        s
+    }
+
+    fn brute(scene: &Scene, ray: &Ray) -> Option<(f32, u32, u32)> {
+        let mut best: Option<(f32, u32, u32)> = None;
+        let mut r = *ray;
+        for (i, t) in scene.triangles.items.iter().enumerate() {
+            if let Some(h) = t.intersect(&r) {
+                r.tmax = h.t;
+                best = Some((h.t, 0, i as u32));
+            }
+        }
+        for kind in [Kind::Sphere, Kind::Cone] {
+            for i in 0..scene.count(kind) {
+                if let Some(h) = scene.shape(kind, i as u32).unwrap().intersect(&r) {
+                    r.tmax = h.t;
+                    best = Some((h.t, kind as u32, i as u32));
+                }
+            }
+        }
+        best
+    }
+
+    #[test]
+    fn bvh_equals_brute_force() {
+        let mut seed = 7u64;
+        for n in [0usize, 1, 5, 100, 2000] {
+            let scene = random_scene(n, &mut seed);
+            let bvh = Bvh::build(&scene);
+            let mut hits = 0;
+            for _ in 0..3000 {
+                let org = v(&mut seed, 30.0);
+                let dir = (v(&mut seed, 10.0) - org).normalize();
+                let mut ray = Ray::new(org, dir);
+                if rng(&mut seed) < 0.3 {
+                    ray.tmax = rng(&mut seed) * 30.0;
+                }
+                let want = brute(&scene, &ray);
+                let got = bvh.intersect(&ray);
+                assert_eq!(got.map(|h| h.t), want.map(|w| w.0), "n={n} ray {ray:?}");
+                if let (Some(g), Some(w)) = (got, want) {
+                    hits += 1;
+                    // Same primitive unless two primitives are hit at the same t.
+                    if (g.geom_id, g.prim_id) != (w.1, w.2) {
+                        assert_eq!(g.t, w.0);
+                    }
+                }
+                assert_eq!(bvh.occluded(&ray), want.is_some(), "occluded, n={n}");
+            }
+            if n >= 100 {
+                assert!(hits > 300, "test rays should hit often ({hits})");
+            }
+        }
+    }
+
+    #[test]
+    fn tree_is_well_formed() {
+        let mut seed = 3u64;
+        let scene = random_scene(5000, &mut seed);
+        let bvh = Bvh::build(&scene);
+        // Every primitive in exactly one leaf, every child inside its parent.
+        let mut seen = vec![0u32; bvh.prims.len()];
+        let mut stack = vec![(0usize, 0usize)];
+        let mut max_depth = 0;
+        while let Some((i, depth)) = stack.pop() {
+            max_depth = max_depth.max(depth);
+            let n = bvh.nodes[i];
+            if n.count > 0 {
+                for k in n.offset as usize..(n.offset + n.count as u32) as usize {
+                    seen[k] += 1;
+                    let b = match bvh.prims[k] {
+                        Prim::Triangle(t) => t.bounds(),
+                        Prim::Shape(s) => s.bounds(),
+                    };
+                    assert!(n.bounds.contains(b.min) && n.bounds.contains(b.max));
+                }
+            } else {
+                for c in [i + 1, n.offset as usize] {
+                    let cb = bvh.nodes[c].bounds;
+                    assert!(n.bounds.contains(cb.min) && n.bounds.contains(cb.max));
+                    stack.push((c, depth + 1));
+                }
+            }
+        }
+        assert!(seen.iter().all(|&c| c == 1));
+        assert!(max_depth < STACK, "depth {max_depth}");
+        // A SAH tree over 5000 scattered primitives is far shallower than a list.
+        assert!(max_depth < 40, "depth {max_depth}");
+    }
+
+    #[test]
+    fn coincident_primitives_still_build() {
+        // 10 000 identical spheres: no split separates them; median splits must.
+        let mut s = random_scene(0, &mut 1);
+        for _ in 0..10_000 {
+            s.spheres.push(Sphere::new(Vec3::ZERO, 1.0), 0);
+        }
+        let bvh = Bvh::build(&s);
+        let h = bvh
+            .intersect(&Ray::new(Vec3::Z * 5.0, -Vec3::Z))
+            .expect("hit");
+        assert_eq!(h.t, 4.0);
+    }
+}

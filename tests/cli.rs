@@ -1,0 +1,128 @@
+//! The `emray` command: exit codes, messages, and no output left behind on error.
+
+use std::path::Path;
+use std::process::{Command, Output};
+
+fn emray(args: &[&str], cwd: &Path) -> Output {
+    Command::new(env!("CARGO_BIN_EXE_emray"))
+        .args(args)
+        .current_dir(cwd)
+        .output()
+        .expect("run emray")
+}
+
+fn stderr(o: &Output) -> String {
+    String::from_utf8_lossy(&o.stderr).into_owned()
+}
+
+const SCENE: &str = "v\nfrom 0 0 10\nat 0 0 0\nup 0 1 0\nangle 30\nhither 1\nresolution 40 30\n\
+                     b 0.1 0.2 0.3\nl 3 3 10\nf 1 0 0 1 0 0 0 1\ns 0 0 0 2\n";
+
+#[test]
+fn renders_a_scene_to_png_with_stats() {
+    let dir = tempfile::tempdir().unwrap();
+    std::fs::write(dir.path().join("a.nff"), SCENE).unwrap();
+    let o = emray(
+        &["render", "a.nff", "-o", "out.png", "--backend", "bvh", "--stats", "--stats-json", "s.jsonl"],
+        dir.path(),
+    );
+    assert!(o.status.success(), "{}", stderr(&o));
+    let img = image::open(dir.path().join("out.png")).unwrap();
+    assert_eq!((img.width(), img.height()), (40, 30));
+    let out = String::from_utf8_lossy(&o.stdout);
+    assert!(out.contains("Mrays/s") && out.contains("1 spheres"), "{out}");
+    let json: serde_json::Value =
+        serde_json::from_str(std::fs::read_to_string(dir.path().join("s.jsonl")).unwrap().trim()).unwrap();
+    for key in ["scene", "backend", "width", "height", "threads", "spp", "prims", "time_ms", "rays", "mrays_per_s"] {
+        assert!(json.get(key).is_some(), "missing {key}: {json}");
+    }
+    assert_eq!(json["prims"]["spheres"], 1);
+    assert_eq!(json["rays"]["eye"], 40 * 30);
+    assert_eq!(json["backend"], "bvh");
+}
+
+#[test]
+fn res_and_exr_output() {
+    let dir = tempfile::tempdir().unwrap();
+    std::fs::write(dir.path().join("a.nff"), SCENE).unwrap();
+    let o = emray(&["render", "a.nff", "-o", "x.exr", "--res", "16x8", "-q"], dir.path());
+    assert!(o.status.success(), "{}", stderr(&o));
+    let meta = exr::meta::MetaData::read_from_file(dir.path().join("x.exr"), false).unwrap();
+    let size = meta.headers[0].layer_size;
+    assert_eq!((size.width(), size.height()), (16, 8));
+}
+
+#[test]
+fn missing_file_is_an_input_error_and_writes_nothing() {
+    let dir = tempfile::tempdir().unwrap();
+    let o = emray(&["render", "nope.nff", "-o", "out.png"], dir.path());
+    assert_eq!(o.status.code(), Some(1));
+    let e = stderr(&o);
+    assert!(e.contains("nope.nff") && e.contains("cannot read"), "{e}");
+    assert_eq!(e.lines().count(), 1, "one line, no backtrace: {e}");
+    assert_eq!(std::fs::read_dir(dir.path()).unwrap().count(), 0);
+}
+
+#[test]
+fn malformed_scene_reports_path_line_col() {
+    let dir = tempfile::tempdir().unwrap();
+    let bad = SCENE.replace("s 0 0 0 2", "s 0 0 zero 2");
+    std::fs::write(dir.path().join("bad.nff"), bad).unwrap();
+    let o = emray(&["render", "bad.nff", "-o", "out.png"], dir.path());
+    assert_eq!(o.status.code(), Some(1));
+    let e = stderr(&o);
+    assert!(e.contains("bad.nff:11:7:"), "{e}");
+    assert!(!dir.path().join("out.png").exists());
+}
+
+#[test]
+fn usage_errors_exit_2() {
+    let dir = tempfile::tempdir().unwrap();
+    std::fs::write(dir.path().join("a.nff"), SCENE).unwrap();
+    for args in [
+        vec!["render", "a.nff", "--res", "0x10"],
+        vec!["render", "a.nff", "--res", "1000000x1000000"],
+        vec!["render", "a.nff", "--backend", "optix"],
+        vec!["render", "a.nff", "--spp", "0"],
+        vec!["render", "--bogus", "a.nff"],
+        vec!["render"],
+        vec!["render", "a.nff", "a.nff", "-o", "one.png"],
+        vec!["render", "a.nff", "-o", "out.jpg"],
+    ] {
+        let o = emray(&args, dir.path());
+        assert_eq!(o.status.code(), Some(2), "{args:?}: {}", stderr(&o));
+        assert!(!stderr(&o).is_empty());
+    }
+    // Nothing was written by any of them.
+    assert_eq!(std::fs::read_dir(dir.path()).unwrap().count(), 1);
+}
+
+#[test]
+fn several_scenes_with_a_template_and_a_failure() {
+    let dir = tempfile::tempdir().unwrap();
+    std::fs::write(dir.path().join("a.nff"), SCENE).unwrap();
+    std::fs::write(dir.path().join("b.nff"), "v\nfrom 0 0 1\n").unwrap();
+    let o = emray(&["render", "a.nff", "b.nff", "-o", "{stem}-out.png", "-q"], dir.path());
+    assert_eq!(o.status.code(), Some(1));
+    let e = stderr(&o);
+    assert!(e.contains("b.nff:"), "{e}");
+    assert!(dir.path().join("a-out.png").exists());
+    assert!(!dir.path().join("b-out.png").exists());
+}
+
+#[test]
+fn no_arguments_renders_the_default_scene() {
+    let dir = tempfile::tempdir().unwrap();
+    let o = Command::new(env!("CARGO_BIN_EXE_emray"))
+        .current_dir(dir.path())
+        .output()
+        .unwrap();
+    assert!(o.status.success(), "{}", stderr(&o));
+    let img = image::open(dir.path().join("emray.png")).unwrap().to_rgb8();
+    assert_eq!(img.dimensions(), (640, 480));
+    // Not a flat image: many distinct colours.
+    let mut colours: Vec<[u8; 3]> = img.pixels().map(|p| p.0).collect();
+    colours.sort();
+    colours.dedup();
+    assert!(colours.len() > 1000, "{} colours", colours.len());
+}

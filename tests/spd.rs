@@ -1,0 +1,70 @@
+//! Every SPD scene renders on both backends and the two images agree.
+//!
+//! Needs the SPD files, which are not part of the repository: run with
+//! `EMRAY_SPD_DIR=path/to/spd cargo test --release --test spd -- --ignored`
+//! (`.ci/spd-check` does this when `../shared/spd` exists).
+
+use emray::accel::Backend;
+use emray::render::RenderSettings;
+use std::path::PathBuf;
+
+fn spd_files() -> Vec<PathBuf> {
+    let dir = std::env::var_os("EMRAY_SPD_DIR").expect("set EMRAY_SPD_DIR to the SPD folder");
+    let mut v: Vec<PathBuf> = std::fs::read_dir(&dir)
+        .expect("SPD folder readable")
+        .map(|e| e.unwrap().path())
+        .filter(|p| p.extension().is_some_and(|e| e == "nff"))
+        .collect();
+    v.sort();
+    assert!(!v.is_empty(), "no .nff files in {dir:?}");
+    v
+}
+
+#[test]
+#[ignore = "needs the SPD scene files (EMRAY_SPD_DIR)"]
+#[cfg(feature = "embree")]
+fn spd_scenes_agree_across_backends() {
+    for path in spd_files() {
+        let scene = emray::load::load_path(&path).unwrap_or_else(|e| panic!("{e}"));
+        let mut s = RenderSettings::for_scene(&scene);
+        s.width = 256;
+        s.height = 256;
+        let name = path.display().to_string();
+        let (a, ra) =
+            emray::run::render_scene(&name, &scene, Backend::Embree, &s, 0.0, None).unwrap();
+        let (b, rb) = emray::run::render_scene(&name, &scene, Backend::Bvh, &s, 0.0, None).unwrap();
+        let pa = emray::output::to_rgb8(&a, emray::output::Encoding::Srgb);
+        let pb = emray::output::to_rgb8(&b, emray::output::Encoding::Srgb);
+        let differ = pa
+            .chunks(3)
+            .zip(pb.chunks(3))
+            .filter(|(x, y)| x != y)
+            .count();
+        let share = 1.0 - differ as f64 / (a.pixels.len() as f64);
+        println!(
+            "{:<22} agree {:>8.4}%  embree {:>8.1} ms  bvh {:>8.1} ms  rays {}",
+            path.file_name().unwrap().to_string_lossy(),
+            share * 100.0,
+            ra.time_ms.render,
+            rb.time_ms.render,
+            ra.rays["total"]
+        );
+        assert!(share >= 0.999, "{name}: backends agree on only {:.4}%", share * 100.0);
+        let lit = pa.iter().filter(|&&c| c > 0).count();
+        assert!(lit > pa.len() / 10, "{name}: image is nearly black");
+    }
+}
+
+#[test]
+#[ignore = "needs the SPD scene files (EMRAY_SPD_DIR)"]
+#[cfg(not(feature = "embree"))]
+fn spd_scenes_render_on_the_bvh() {
+    for path in spd_files() {
+        let scene = emray::load::load_path(&path).unwrap_or_else(|e| panic!("{e}"));
+        let mut s = RenderSettings::for_scene(&scene);
+        s.width = 128;
+        s.height = 128;
+        let (f, _) = emray::run::render_scene("spd", &scene, Backend::Bvh, &s, 0.0, None).unwrap();
+        assert!(f.pixels.iter().any(|p| p.max_element() > 0.0));
+    }
+}
