@@ -74,7 +74,10 @@ impl Report {
             spp: settings.spp,
             spd: settings.spd,
             max_depth: settings.max_depth,
-            prims: Kind::ALL.iter().map(|&k| (k.name(), scene.count(k))).collect(),
+            prims: Kind::ALL
+                .iter()
+                .map(|&k| (k.name(), scene.count(k)))
+                .collect(),
             lights: scene.lights.len(),
             degenerate_dropped: scene.load_stats.degenerate_dropped,
             time_ms,
@@ -123,7 +126,11 @@ impl Report {
             self.spp,
             self.max_depth,
             if self.spd { ", SPD mode" } else { "" },
-            if prims.is_empty() { "none".to_string() } else { prims.join(", ") },
+            if prims.is_empty() {
+                "none".to_string()
+            } else {
+                prims.join(", ")
+            },
             self.lights,
             if self.degenerate_dropped > 0 {
                 format!(", {} degenerate polygons dropped", self.degenerate_dropped)
@@ -180,13 +187,17 @@ pub fn render_scene(
         Backend::Bvh => {
             let accel = crate::accel::bvh::Bvh::build(scene);
             let build = ms(t0);
-            Ok(finish(name, scene, &accel, settings, load_ms, build, progress))
+            Ok(finish(
+                name, scene, &accel, settings, load_ms, build, progress,
+            ))
         }
         #[cfg(feature = "embree")]
         Backend::Embree => {
             let accel = crate::accel::embree::EmbreeAccel::build(scene)?;
             let build = ms(t0);
-            Ok(finish(name, scene, &accel, settings, load_ms, build, progress))
+            Ok(finish(
+                name, scene, &accel, settings, load_ms, build, progress,
+            ))
         }
         #[cfg(not(feature = "embree"))]
         Backend::Embree => Err(AccelError::Unavailable("embree")),

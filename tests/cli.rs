@@ -23,17 +23,45 @@ fn renders_a_scene_to_png_with_stats() {
     let dir = tempfile::tempdir().unwrap();
     std::fs::write(dir.path().join("a.nff"), SCENE).unwrap();
     let o = emray(
-        &["render", "a.nff", "-o", "out.png", "--backend", "bvh", "--stats", "--stats-json", "s.jsonl"],
+        &[
+            "render",
+            "a.nff",
+            "-o",
+            "out.png",
+            "--backend",
+            "bvh",
+            "--stats",
+            "--stats-json",
+            "s.jsonl",
+        ],
         dir.path(),
     );
     assert!(o.status.success(), "{}", stderr(&o));
     let img = image::open(dir.path().join("out.png")).unwrap();
     assert_eq!((img.width(), img.height()), (40, 30));
     let out = String::from_utf8_lossy(&o.stdout);
-    assert!(out.contains("Mrays/s") && out.contains("1 spheres"), "{out}");
-    let json: serde_json::Value =
-        serde_json::from_str(std::fs::read_to_string(dir.path().join("s.jsonl")).unwrap().trim()).unwrap();
-    for key in ["scene", "backend", "width", "height", "threads", "spp", "prims", "time_ms", "rays", "mrays_per_s"] {
+    assert!(
+        out.contains("Mrays/s") && out.contains("1 spheres"),
+        "{out}"
+    );
+    let json: serde_json::Value = serde_json::from_str(
+        std::fs::read_to_string(dir.path().join("s.jsonl"))
+            .unwrap()
+            .trim(),
+    )
+    .unwrap();
+    for key in [
+        "scene",
+        "backend",
+        "width",
+        "height",
+        "threads",
+        "spp",
+        "prims",
+        "time_ms",
+        "rays",
+        "mrays_per_s",
+    ] {
         assert!(json.get(key).is_some(), "missing {key}: {json}");
     }
     assert_eq!(json["prims"]["spheres"], 1);
@@ -45,7 +73,10 @@ fn renders_a_scene_to_png_with_stats() {
 fn res_and_exr_output() {
     let dir = tempfile::tempdir().unwrap();
     std::fs::write(dir.path().join("a.nff"), SCENE).unwrap();
-    let o = emray(&["render", "a.nff", "-o", "x.exr", "--res", "16x8", "-q"], dir.path());
+    let o = emray(
+        &["render", "a.nff", "-o", "x.exr", "--res", "16x8", "-q"],
+        dir.path(),
+    );
     assert!(o.status.success(), "{}", stderr(&o));
     let meta = exr::meta::MetaData::read_from_file(dir.path().join("x.exr"), false).unwrap();
     let size = meta.headers[0].layer_size;
@@ -102,7 +133,10 @@ fn several_scenes_with_a_template_and_a_failure() {
     let dir = tempfile::tempdir().unwrap();
     std::fs::write(dir.path().join("a.nff"), SCENE).unwrap();
     std::fs::write(dir.path().join("b.nff"), "v\nfrom 0 0 1\n").unwrap();
-    let o = emray(&["render", "a.nff", "b.nff", "-o", "{stem}-out.png", "-q"], dir.path());
+    let o = emray(
+        &["render", "a.nff", "b.nff", "-o", "{stem}-out.png", "-q"],
+        dir.path(),
+    );
     assert_eq!(o.status.code(), Some(1));
     let e = stderr(&o);
     assert!(e.contains("b.nff:"), "{e}");

@@ -19,7 +19,11 @@ fn unit() -> impl Strategy<Value = Vec3> {
 /// object stays at least 1000 f32 ulps of its offset across (smaller ones are not
 /// representable in f32 at all).
 fn placement() -> impl Strategy<Value = (f32, Vec3)> {
-    (-6i32..=6, v3(), prop_oneof![Just(0.0f32), Just(1e3), Just(1e5)])
+    (
+        -6i32..=6,
+        v3(),
+        prop_oneof![Just(0.0f32), Just(1e3), Just(1e5)],
+    )
         .prop_map(|(e, off, far)| (10f32.powi(e), off * far))
         .prop_filter("object too small for its offset", |(s, off)| {
             *s >= off.abs().max_element() * 1e-4
@@ -38,7 +42,8 @@ fn tol(scale: f64, cos: f64) -> f64 {
 /// Plus the rounding of the coordinates themselves: nothing finer than a few ulps of
 /// the largest coordinate is representable in f32.
 fn tol_at(scale: f64, cos: f64, coord: Vec3) -> f64 {
-    tol(scale, cos) + 8.0 * f32::EPSILON as f64 * coord.abs().max_element() as f64 / cos.abs().max(1e-3)
+    tol(scale, cos)
+        + 8.0 * f32::EPSILON as f64 * coord.abs().max_element() as f64 / cos.abs().max(1e-3)
 }
 
 proptest! {
@@ -75,8 +80,8 @@ proptest! {
             (None, None) => {}
             (g, w) => {
                 // Only tangent rays and hits at t≈0 (origin on the surface) may differ.
-                let near_zero = w.map_or(false, |w| w < 1e-4 * scale_d)
-                    || g.map_or(false, |g| (g.t as f64) < 1e-4 * scale_d);
+                let near_zero = w.is_some_and(|w| w < 1e-4 * scale_d)
+                    || g.is_some_and(|g| (g.t as f64) < 1e-4 * scale_d);
                 prop_assert!(margin.abs() < 1e-3 || near_zero,
                     "disagree: f32 {g:?} f64 {w:?} margin {margin}");
             }
@@ -179,7 +184,7 @@ proptest! {
             (None, None) => {}
             (g, w) => {
                 let edge = u.abs().min(v.abs()).min((1.0 - u - v).abs()) < 1e-4;
-                let behind = w.map_or(false, |w| w.0 < 1e-5 * scale_d);
+                let behind = w.is_some_and(|w| w.0 < 1e-5 * scale_d);
                 prop_assert!(edge || behind, "disagree: f32 {g:?} f64 {w:?} (u {u}, v {v})");
             }
         }
@@ -239,20 +244,34 @@ fn cylinder_and_cone_analytic() {
     let r = Ray::new(Vec3::new(5.0, 0.0, 1.0), -Vec3::X);
     assert!((c.intersect(&r).unwrap().t - 4.0).abs() < 1e-6);
     // Above the top: open, no cap.
-    assert!(c.intersect(&Ray::new(Vec3::new(5.0, 0.0, 2.5), -Vec3::X)).is_none());
+    assert!(c
+        .intersect(&Ray::new(Vec3::new(5.0, 0.0, 2.5), -Vec3::X))
+        .is_none());
     // Straight down the axis: no caps, so no hit.
-    assert!(c.intersect(&Ray::new(Vec3::new(0.0, 0.0, 5.0), -Vec3::Z)).is_none());
+    assert!(c
+        .intersect(&Ray::new(Vec3::new(0.0, 0.0, 5.0), -Vec3::Z))
+        .is_none());
     // Cone radius 1 at z=0 to 0 at z=1: at height 0.5 the radius is 0.5.
     let k = Cone::new(Vec3::ZERO, 1.0, Vec3::Z, 0.0);
-    let h = k.intersect(&Ray::new(Vec3::new(5.0, 0.0, 0.5), -Vec3::X)).unwrap();
+    let h = k
+        .intersect(&Ray::new(Vec3::new(5.0, 0.0, 0.5), -Vec3::X))
+        .unwrap();
     assert!((h.t - 4.5).abs() < 1e-6);
     // Ray parallel to the cone's side (a → 0: the quadratic degenerates to linear).
     let side = Vec3::new(-1.0, 0.0, 1.0).normalize();
     let org = Vec3::new(2.0, 0.0, -1.0) + Vec3::new(0.1, 0.0, 0.1);
     let got = k.intersect(&Ray::new(org, side));
     let want = reference::cone(
-        &DRay { org: org.as_dvec3(), dir: side.as_dvec3() },
-        DVec3::ZERO, 1.0, DVec3::Z, 0.0, false, 0.0,
+        &DRay {
+            org: org.as_dvec3(),
+            dir: side.as_dvec3(),
+        },
+        DVec3::ZERO,
+        1.0,
+        DVec3::Z,
+        0.0,
+        false,
+        0.0,
     );
     assert_eq!(got.is_some(), want.is_some());
     if let (Some(g), Some(w)) = (got, want) {

@@ -41,9 +41,16 @@ fn sphere_silhouette_matches_the_projected_area() {
         let (film, report) = render(&s, b, &settings);
         let hit = report.rays["eye_hit"] as f64;
         let lit = film.pixels.iter().filter(|p| p.max_element() > 0.0).count() as f64;
-        assert_eq!(hit, lit, "{b:?}: every hit pixel is lit (ambient), every miss black");
+        assert_eq!(
+            hit, lit,
+            "{b:?}: every hit pixel is lit (ambient), every miss black"
+        );
         let err = (hit - exact).abs() / exact;
-        assert!(err < 0.005, "{b:?}: {hit} pixels vs exact {exact:.1} ({:.3}%)", err * 100.0);
+        assert!(
+            err < 0.005,
+            "{b:?}: {hit} pixels vs exact {exact:.1} ({:.3}%)",
+            err * 100.0
+        );
     }
 }
 
@@ -65,11 +72,20 @@ fn mirror_reflects_a_known_colour() {
         let (film, _) = render(&s, b, &settings);
         let centre = film.get(32, 32);
         let want = glam::Vec3::new(0.4, 0.05, 0.05);
-        assert!((centre - want).abs().max_element() < 1e-5, "{b:?}: centre {centre}");
+        assert!(
+            (centre - want).abs().max_element() < 1e-5,
+            "{b:?}: centre {centre}"
+        );
         // The sphere subtends asin(8/41) ≈ 11° from the mirror image of the eye (at
         // z = -12): the corners (15° off axis) show the background.
         let corner = film.get(0, 0);
-        assert!((corner - glam::Vec3::new(0.2, 0.3, 0.4)).abs().max_element() < 1e-6, "{b:?}: {corner}");
+        assert!(
+            (corner - glam::Vec3::new(0.2, 0.3, 0.4))
+                .abs()
+                .max_element()
+                < 1e-6,
+            "{b:?}: {corner}"
+        );
     }
 }
 
@@ -98,7 +114,10 @@ fn shadow_rays_darken_what_is_occluded() {
         let under = shaded(b, "from 0 -10 0.5\nat 0 0.1 0");
         let open = shaded(b, "from 20 -10 0.5\nat 20 0.1 0");
         // Ambient 1/(2·1)·... with one coloured light the ambient is sqrt(1)/2 = 0.5.
-        assert!((under.x - 0.5).abs() < 1e-3, "{b:?}: shadowed floor {under}");
+        assert!(
+            (under.x - 0.5).abs() < 1e-3,
+            "{b:?}: shadowed floor {under}"
+        );
         assert!(open.x > 0.55, "{b:?}: lit floor {open}");
     }
 }
@@ -119,7 +138,10 @@ fn refraction_and_total_internal_reflection_are_counted() {
         assert_eq!(report.rays["refraction"], 2, "{b:?}");
         assert_eq!(report.rays["reflection"], 0, "{b:?}");
         // T = 1 twice, ambient term 0 (Kd = 0): the background comes through unchanged.
-        assert!((film.get(0, 0) - glam::Vec3::new(0.0, 0.0, 1.0)).length() < 1e-5, "{b:?}");
+        assert!(
+            (film.get(0, 0) - glam::Vec3::new(0.0, 0.0, 1.0)).length() < 1e-5,
+            "{b:?}"
+        );
     }
     // Camera inside a glass slab (two planes with outward normals) looking at its top
     // face 70° off the normal: leaving glass (n = 1.5) beyond the critical angle of
@@ -149,8 +171,14 @@ fn output_is_deterministic_across_thread_counts() {
     st.height = 64;
     st.spp = 4;
     for b in backends() {
-        let one = rayon::ThreadPoolBuilder::new().num_threads(1).build().unwrap();
-        let two = rayon::ThreadPoolBuilder::new().num_threads(2).build().unwrap();
+        let one = rayon::ThreadPoolBuilder::new()
+            .num_threads(1)
+            .build()
+            .unwrap();
+        let two = rayon::ThreadPoolBuilder::new()
+            .num_threads(2)
+            .build()
+            .unwrap();
         let (a, ra) = one.install(|| render(&s, b, &st));
         let (c, rc) = two.install(|| render(&s, b, &st));
         assert_eq!(a, c, "{b:?}: images differ between 1 and 2 threads");
@@ -199,7 +227,15 @@ fn backends_agree_on_every_primitive_kind() {
     let (b, rb) = render(&s, Backend::Bvh, &st);
     let pa = emray::output::to_rgb8(&a, emray::output::Encoding::Srgb);
     let pb = emray::output::to_rgb8(&b, emray::output::Encoding::Srgb);
-    let differ = pa.chunks(3).zip(pb.chunks(3)).filter(|(x, y)| x != y).count();
-    assert!(differ * 1000 <= a.pixels.len(), "{differ} of {} pixels differ", a.pixels.len());
+    let differ = pa
+        .chunks(3)
+        .zip(pb.chunks(3))
+        .filter(|(x, y)| x != y)
+        .count();
+    assert!(
+        differ * 1000 <= a.pixels.len(),
+        "{differ} of {} pixels differ",
+        a.pixels.len()
+    );
     assert_eq!(ra.rays["eye_hit"], rb.rays["eye_hit"]);
 }

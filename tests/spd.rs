@@ -49,7 +49,11 @@ fn spd_scenes_agree_across_backends() {
             rb.time_ms.render,
             ra.rays["total"]
         );
-        assert!(share >= 0.999, "{name}: backends agree on only {:.4}%", share * 100.0);
+        assert!(
+            share >= 0.999,
+            "{name}: backends agree on only {:.4}%",
+            share * 100.0
+        );
         let lit = pa.iter().filter(|&&c| c > 0).count();
         assert!(lit > pa.len() / 10, "{name}: image is nearly black");
     }

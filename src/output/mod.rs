@@ -112,10 +112,11 @@ pub fn write_image(path: &Path, film: &Film, encoding: Encoding) -> Result<(), O
             Format::Exr => {
                 let (w, h) = (film.width as usize, film.height as usize);
                 let px = &film.pixels;
-                let channels = exr::prelude::SpecificChannels::rgb(|p: exr::prelude::Vec2<usize>| {
-                    let v = px[p.y() * w + p.x()];
-                    (v.x, v.y, v.z)
-                });
+                let channels =
+                    exr::prelude::SpecificChannels::rgb(|p: exr::prelude::Vec2<usize>| {
+                        let v = px[p.y() * w + p.x()];
+                        (v.x, v.y, v.z)
+                    });
                 let image = exr::prelude::Image::from_channels((w, h), channels);
                 let file = fs::File::create(&tmp).map_err(|e| err(&e))?;
                 let mut bw = BufWriter::new(file);

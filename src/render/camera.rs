@@ -72,7 +72,10 @@ mod tests {
         assert!(top.y > 0.0 && bottom.y < 0.0, "top row looks up");
         let left = g.ray(0.5, 32.0).dir;
         let right = g.ray(63.5, 32.0).dir;
-        assert!(left.x < 0.0 && right.x > 0.0, "right-handed: +x to the right");
+        assert!(
+            left.x < 0.0 && right.x > 0.0,
+            "right-handed: +x to the right"
+        );
         assert!((left.angle_between(right).to_degrees() - 40.0).abs() < 1e-3);
     }
 

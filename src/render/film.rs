@@ -42,7 +42,10 @@ impl Film {
         let mut out = Film::new(w, h);
         for j in 0..h {
             for i in 0..w {
-                let s = self.get(i, j) + self.get(i + 1, j) + self.get(i, j + 1) + self.get(i + 1, j + 1);
+                let s = self.get(i, j)
+                    + self.get(i + 1, j)
+                    + self.get(i, j + 1)
+                    + self.get(i + 1, j + 1);
                 out.set(i, j, s * 0.25);
             }
         }

@@ -138,10 +138,13 @@ impl<'a, A: Accel> Tracer<'a, A> {
         // Both sides are surfaces: face the normals towards the incoming ray.
         let entering = ng_out.dot(d) < 0.0;
         let ng = if entering { ng_out } else { -ng_out };
-        let ns = if surf.ns.dot(d) > 0.0 { -surf.ns } else { surf.ns };
-        let spawn = |dir: Vec3| -> Ray {
-            Ray::new(offset_ray_origin(p, surf.point.err, ng, dir), dir)
+        let ns = if surf.ns.dot(d) > 0.0 {
+            -surf.ns
+        } else {
+            surf.ns
         };
+        let spawn =
+            |dir: Vec3| -> Ray { Ray::new(offset_ray_origin(p, surf.point.err, ng, dir), dir) };
 
         let mut color = scene.ambient * m.color * m.ka;
         let view = -d;

@@ -184,7 +184,11 @@ impl Accel for Bvh {
             bytes: self.nodes.len() * std::mem::size_of::<Node>()
                 + self.prims.len()
                     * (std::mem::size_of::<Prim>() + std::mem::size_of::<(u32, u32)>()),
-            detail: format!("binned SAH, {} bins, max leaf {}", build::BINS, build::MAX_LEAF),
+            detail: format!(
+                "binned SAH, {} bins, max leaf {}",
+                build::BINS,
+                build::MAX_LEAF
+            ),
         }
     }
 }
@@ -209,7 +213,9 @@ mod agreement {
     use crate::scene::{Camera, Material};
 
     fn rng(seed: &mut u64) -> f32 {
-        *seed = seed.wrapping_mul(6364136223846793005).wrapping_add(1442695040888963407);
+        *seed = seed
+            .wrapping_mul(6364136223846793005)
+            .wrapping_add(1442695040888963407);
         ((*seed >> 40) as f32) / (1u64 << 24) as f32
     }
 
@@ -316,9 +322,10 @@ mod agreement {
             max_depth = max_depth.max(depth);
             let n = bvh.nodes[i];
             if n.count > 0 {
-                for k in n.offset as usize..(n.offset + n.count as u32) as usize {
-                    seen[k] += 1;
-                    let b = match bvh.prims[k] {
+                let range = n.offset as usize..(n.offset + n.count as u32) as usize;
+                for (k, prim) in bvh.prims[range.clone()].iter().enumerate() {
+                    seen[range.start + k] += 1;
+                    let b = match prim {
                         Prim::Triangle(t) => t.bounds(),
                         Prim::Shape(s) => s.bounds(),
                     };
