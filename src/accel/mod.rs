@@ -94,6 +94,8 @@ pub enum AccelError {
     #[error(transparent)]
     Embree(#[from] embree::EmbreeError),
     /// The requested backend is not compiled in.
-    #[error("backend `{0}` is not available in this build (it was built without the `embree` feature)")]
+    #[error(
+        "backend `{0}` is not available in this build (it was built without the `embree` feature)"
+    )]
     Unavailable(&'static str),
 }

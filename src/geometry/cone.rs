@@ -65,7 +65,8 @@ impl Cone {
         let ea = k * self.apex_radius;
         let b = Aabb::from_points(self.base - eb, self.base + eb)
             .union(&Aabb::from_points(self.apex - ea, self.apex + ea));
-        let slack = (b.min.abs().max(b.max.abs()) + Vec3::splat(self.base_radius.max(self.apex_radius)))
+        let slack = (b.min.abs().max(b.max.abs())
+            + Vec3::splat(self.base_radius.max(self.apex_radius)))
             * gamma(4);
         Aabb {
             min: b.min - slack,
