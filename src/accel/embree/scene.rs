@@ -1,0 +1,425 @@
+//! Scene building (triangles natively, spheres and cones as user geometry) and the
+//! committed, immutable scene the ray queries run on.
+
+use super::device::Device;
+use super::error::EmbreeError;
+use super::sys;
+use super::user::{self, UserPrims, UserShape};
+use crate::accel::Hit;
+use crate::geometry::{Kind, Triangle};
+use crate::math::{Ray, Vec3};
+
+/// An owned geometry handle during the build; released once attached (the scene keeps
+/// its own reference).
+struct Geometry(sys::RTCGeometry);
+
+impl Drop for Geometry {
+    fn drop(&mut self) {
+        // SAFETY: `self.0` is a live geometry created by `rtcNewGeometry`; this drops our
+        // reference only.
+        unsafe { sys::rtcReleaseGeometry(self.0) }
+    }
+}
+
+impl Geometry {
+    fn new(
+        device: &Device,
+        kind: sys::RTCGeometryType,
+        what: &str,
+    ) -> Result<Geometry, EmbreeError> {
+        // SAFETY: `device` is live; a bad type only sets an error and returns null.
+        let raw = unsafe { sys::rtcNewGeometry(device.raw(), kind) };
+        if raw.is_null() {
+            device.check(format!("rtcNewGeometry({what})"))?;
+            return Err(EmbreeError::emray(
+                format!("rtcNewGeometry({what})"),
+                "Embree returned no geometry",
+            ));
+        }
+        Ok(Geometry(raw))
+    }
+
+    /// Commit and attach under the geometry id `kind` (our `Kind` discriminant).
+    fn commit_and_attach(
+        self,
+        device: &Device,
+        scene: &CommittedScene,
+        kind: Kind,
+    ) -> Result<(), EmbreeError> {
+        // SAFETY: both handles are live and belong to the same device; the id is unused
+        // in this scene (one geometry per kind).
+        unsafe {
+            sys::rtcCommitGeometry(self.0);
+            sys::rtcAttachGeometryByID(scene.raw, self.0, kind as u32);
+        }
+        device.check(format!("attaching the {} geometry", kind.name()))
+    }
+}
+
+/// A committed Embree scene, owning its geometries (through Embree's reference counts)
+/// and the primitive data their callbacks read. Immutable after
+/// [`CommittedScene::build`]; queried from any number of threads.
+#[derive(Debug)]
+pub(super) struct CommittedScene {
+    raw: sys::RTCScene,
+    /// Dropped after `Drop::drop` has released `raw`, so no callback can outlive it.
+    user: UserData,
+}
+
+// SAFETY: the handle refers to Embree's reference-counted scene object; it is only
+// mutated inside `build`, before it is shared.
+unsafe impl Send for CommittedScene {}
+// SAFETY: after `rtcCommitScene` the scene is never modified, and Embree documents
+// `rtcIntersect1`/`rtcOccluded1` on a committed scene as safe to call from many threads
+// at once. The user data the callbacks read is immutable (`UserPrims` of `Copy` shapes).
+unsafe impl Sync for CommittedScene {}
+
+impl Drop for CommittedScene {
+    fn drop(&mut self) {
+        // SAFETY: `self.raw` is a live scene; no query can be running (they borrow
+        // `self`). Releasing it releases the geometries it holds; `self.user` is freed
+        // only after this.
+        unsafe { sys::rtcReleaseScene(self.raw) }
+    }
+}
+
+/// The user data of the analytic geometries (boxed: Embree holds their addresses).
+/// Never read from Rust, only kept alive for the callbacks.
+#[derive(Debug, Default)]
+struct UserData {
+    _spheres: Option<Box<UserPrims<crate::geometry::Sphere>>>,
+    _cones: Option<Box<UserPrims<crate::geometry::Cone>>>,
+}
+
+impl CommittedScene {
+    /// Build and commit the scene of `scene`'s primitives.
+    pub(super) fn build(
+        device: &Device,
+        scene: &crate::scene::Scene,
+    ) -> Result<CommittedScene, EmbreeError> {
+        // SAFETY: `device` is live.
+        let raw = unsafe { sys::rtcNewScene(device.raw()) };
+        if raw.is_null() {
+            device.check("rtcNewScene")?;
+            return Err(EmbreeError::emray(
+                "rtcNewScene",
+                "Embree returned no scene",
+            ));
+        }
+        let mut committed = CommittedScene {
+            raw,
+            user: UserData::default(),
+        };
+        // Robust traversal: no arithmetic shortcuts that can miss grazing rays.
+        // SAFETY: `raw` is a live, uncommitted scene.
+        unsafe { sys::rtcSetSceneFlags(raw, sys::RTCSceneFlags::RTC_SCENE_FLAG_ROBUST) };
+        device.check("rtcSetSceneFlags")?;
+
+        if !scene.triangles.is_empty() {
+            attach_triangles(device, &committed, &scene.triangles.items)?;
+        }
+        committed.user._spheres =
+            attach_user(device, &committed, Kind::Sphere, &scene.spheres.items)?;
+        committed.user._cones = attach_user(device, &committed, Kind::Cone, &scene.cones.items)?;
+
+        // SAFETY: `raw` is live; every attached geometry is committed and its user data
+        // is boxed in `committed.user`, which lives as long as the scene.
+        unsafe { sys::rtcCommitScene(raw) };
+        device.check("rtcCommitScene")?;
+        Ok(committed)
+    }
+
+    /// The nearest hit with `t` in `[max(ray.tmin, 0), ray.tmax]` (Embree requires
+    /// `tnear >= 0`).
+    #[inline]
+    pub(super) fn intersect(&self, ray: &Ray) -> Option<Hit> {
+        let tnear = ray.tmin.max(0.0);
+        if ray.tmax.is_nan() || ray.tmax < tnear {
+            return None;
+        }
+        let mut rayhit = sys::RTCRayHit {
+            ray: rtc_ray(ray, tnear),
+            hit: empty_hit(),
+        };
+        query::intersect(self.raw, &mut rayhit);
+        let hit = &rayhit.hit;
+        if hit.geomID == sys::INVALID_GEOMETRY_ID {
+            return None;
+        }
+        Some(Hit {
+            t: rayhit.ray.tfar,
+            geom_id: hit.geomID,
+            prim_id: hit.primID,
+            u: hit.u,
+            v: hit.v,
+            ng: Vec3::new(hit.Ng_x, hit.Ng_y, hit.Ng_z),
+        })
+    }
+
+    /// Whether anything lies in the ray's interval (any hit).
+    #[inline]
+    pub(super) fn occluded(&self, ray: &Ray) -> bool {
+        let tnear = ray.tmin.max(0.0);
+        if ray.tmax.is_nan() || ray.tmax < tnear {
+            return false;
+        }
+        let mut r = rtc_ray(ray, tnear);
+        query::occluded(self.raw, &mut r);
+        r.tfar == f32::NEG_INFINITY
+    }
+}
+
+// `rtcIntersect1` requires a 16-byte aligned `RTCRayHit`; bindgen carries the header's
+// `RTC_ALIGN(16)` over, so every `RTCRayHit` value on the stack is aligned.
+const _: () = assert!(std::mem::align_of::<sys::RTCRayHit>() == 16);
+const _: () = assert!(std::mem::align_of::<sys::RTCRay>() == 16);
+
+/// Our ray as an `RTCRay`: mask all ones (a zero mask hits nothing), no flags, time 0.
+#[inline(always)]
+fn rtc_ray(ray: &Ray, tnear: f32) -> sys::RTCRay {
+    sys::RTCRay {
+        org_x: ray.org.x,
+        org_y: ray.org.y,
+        org_z: ray.org.z,
+        tnear,
+        dir_x: ray.dir.x,
+        dir_y: ray.dir.y,
+        dir_z: ray.dir.z,
+        time: 0.0,
+        tfar: ray.tmax,
+        mask: u32::MAX,
+        id: 0,
+        flags: 0,
+    }
+}
+
+/// A hit record that says "no hit": all ids `RTC_INVALID_GEOMETRY_ID` (a zeroed one
+/// would claim geometry 0).
+#[inline(always)]
+fn empty_hit() -> sys::RTCHit {
+    let mut hit = sys::RTCHit {
+        geomID: sys::INVALID_GEOMETRY_ID,
+        primID: sys::INVALID_GEOMETRY_ID,
+        ..Default::default()
+    };
+    hit.instID.fill(sys::INVALID_GEOMETRY_ID);
+    #[cfg(embree_instance_array)]
+    hit.instPrimID.fill(sys::INVALID_GEOMETRY_ID);
+    hit
+}
+
+/// `rtcIntersect1`/`rtcOccluded1`, whose arguments differ between Embree 3 and 4.
+#[cfg(embree3)]
+mod query {
+    use super::sys;
+
+    /// The context `rtcInitIntersectContext` (a static inline function bindgen drops)
+    /// would produce: incoherent, no filter, empty instance stack (and, depending on the
+    /// build, `instStackSize = 0`, `minWidthDistanceFactor = 0`: the zeroed default).
+    #[inline(always)]
+    fn context() -> sys::RTCIntersectContext {
+        let mut ctx = sys::RTCIntersectContext {
+            flags: sys::RTCIntersectContextFlags::RTC_INTERSECT_CONTEXT_FLAG_INCOHERENT,
+            filter: None,
+            ..Default::default()
+        };
+        ctx.instID.fill(sys::INVALID_GEOMETRY_ID);
+        ctx
+    }
+
+    #[inline(always)]
+    pub(super) fn intersect(scene: sys::RTCScene, rayhit: &mut sys::RTCRayHit) {
+        let mut ctx = context();
+        // SAFETY: `scene` is live and committed; `ctx` is initialised as the header's
+        // `rtcInitIntersectContext` does; `rayhit` is a valid, 16-byte aligned
+        // `RTCRayHit` with mask, tnear <= tfar and invalid ids set.
+        unsafe { sys::rtcIntersect1(scene, &mut ctx, rayhit) }
+    }
+
+    #[inline(always)]
+    pub(super) fn occluded(scene: sys::RTCScene, ray: &mut sys::RTCRay) {
+        let mut ctx = context();
+        // SAFETY: as in `intersect`, for an `RTCRay`.
+        unsafe { sys::rtcOccluded1(scene, &mut ctx, ray) }
+    }
+}
+
+/// `rtcIntersect1`/`rtcOccluded1`, whose arguments differ between Embree 3 and 4.
+#[cfg(embree4)]
+// The argument structs have one more field (`minWidthDistanceFactor`) in Embree builds
+// with min-width support; `..Default::default()` zeroes it there and is a no-op here.
+#[allow(clippy::needless_update)]
+mod query {
+    use super::sys;
+
+    /// What `rtcInitRayQueryContext` (static inline, dropped by bindgen) produces.
+    #[inline(always)]
+    fn context() -> sys::RTCRayQueryContext {
+        let mut ctx = sys::RTCRayQueryContext::default();
+        ctx.instID.fill(sys::INVALID_GEOMETRY_ID);
+        #[cfg(embree_instance_array)]
+        ctx.instPrimID.fill(sys::INVALID_GEOMETRY_ID);
+        ctx
+    }
+
+    #[inline(always)]
+    pub(super) fn intersect(scene: sys::RTCScene, rayhit: &mut sys::RTCRayHit) {
+        let mut ctx = context();
+        // As `rtcInitIntersectArguments`: incoherent, all features, no filter or
+        // argument callbacks; plus our context.
+        let mut args = sys::RTCIntersectArguments {
+            flags: sys::RTCRayQueryFlags::RTC_RAY_QUERY_FLAG_INCOHERENT,
+            feature_mask: sys::RTCFeatureFlags::RTC_FEATURE_FLAG_ALL,
+            context: &mut ctx,
+            filter: None,
+            intersect: None,
+            ..Default::default()
+        };
+        // SAFETY: `scene` is live and committed; `args` and the context it points to are
+        // initialised as the header's init functions do and outlive the call; `rayhit`
+        // is a valid, 16-byte aligned `RTCRayHit` with mask, tnear <= tfar and invalid
+        // ids set.
+        unsafe { sys::rtcIntersect1(scene, rayhit, &mut args) }
+    }
+
+    #[inline(always)]
+    pub(super) fn occluded(scene: sys::RTCScene, ray: &mut sys::RTCRay) {
+        let mut ctx = context();
+        let mut args = sys::RTCOccludedArguments {
+            flags: sys::RTCRayQueryFlags::RTC_RAY_QUERY_FLAG_INCOHERENT,
+            feature_mask: sys::RTCFeatureFlags::RTC_FEATURE_FLAG_ALL,
+            context: &mut ctx,
+            filter: None,
+            occluded: None,
+            ..Default::default()
+        };
+        // SAFETY: as in `intersect`, for an `RTCRay`.
+        unsafe { sys::rtcOccluded1(scene, ray, &mut args) }
+    }
+}
+
+/// One native triangle mesh holding all triangles, three vertices each, so that
+/// `primID` is the index in `scene.triangles`.
+fn attach_triangles(
+    device: &Device,
+    scene: &CommittedScene,
+    tris: &[Triangle],
+) -> Result<(), EmbreeError> {
+    let count = tris.len();
+    let too_many = || {
+        EmbreeError::emray(
+            "building the triangle mesh",
+            format!("{count} triangles exceed Embree's 32-bit vertex indices"),
+        )
+    };
+    let vertex_count = count
+        .checked_mul(3)
+        .filter(|&v| u32::try_from(v).is_ok())
+        .ok_or_else(too_many)?;
+    let geometry = Geometry::new(
+        device,
+        sys::RTCGeometryType::RTC_GEOMETRY_TYPE_TRIANGLE,
+        "triangles",
+    )?;
+
+    // Embree allocates these buffers (and pads vertex buffers so the last vertex can be
+    // read with a 16-byte load, as its SSE code does).
+    // SAFETY: live geometry; stride 12 bytes (3 x f32 / 3 x u32) is 4-byte aligned.
+    let vertices = unsafe {
+        sys::rtcSetNewGeometryBuffer(
+            geometry.0,
+            sys::RTCBufferType::RTC_BUFFER_TYPE_VERTEX,
+            0,
+            sys::RTCFormat::RTC_FORMAT_FLOAT3,
+            3 * size_of::<f32>(),
+            vertex_count,
+        )
+    }
+    .cast::<f32>();
+    // SAFETY: as above.
+    let indices = unsafe {
+        sys::rtcSetNewGeometryBuffer(
+            geometry.0,
+            sys::RTCBufferType::RTC_BUFFER_TYPE_INDEX,
+            0,
+            sys::RTCFormat::RTC_FORMAT_UINT3,
+            3 * size_of::<u32>(),
+            count,
+        )
+    }
+    .cast::<u32>();
+    if vertices.is_null() || indices.is_null() {
+        device.check("rtcSetNewGeometryBuffer(triangles)")?;
+        return Err(EmbreeError::emray(
+            "rtcSetNewGeometryBuffer(triangles)",
+            "Embree returned no buffer",
+        ));
+    }
+    // SAFETY: Embree returned buffers of `vertex_count` FLOAT3 and `count` UINT3 items,
+    // suitably aligned for f32/u32, owned by the geometry (alive: we hold it), and not
+    // aliased by anything else while these slices exist.
+    let (vertices, indices) = unsafe {
+        (
+            std::slice::from_raw_parts_mut(vertices, vertex_count * 3),
+            std::slice::from_raw_parts_mut(indices, vertex_count),
+        )
+    };
+    for (tri, out) in tris.iter().zip(vertices.chunks_exact_mut(9)) {
+        for (p, o) in tri.p.iter().zip(out.chunks_exact_mut(3)) {
+            o.copy_from_slice(&p.to_array());
+        }
+    }
+    for (i, idx) in (0u32..).zip(indices.iter_mut()) {
+        *idx = i;
+    }
+    device.check("filling the triangle buffers")?;
+    geometry.commit_and_attach(device, scene, Kind::Triangle)
+}
+
+/// One user geometry holding all `prims` of `kind` (none when there are none). Returns
+/// the boxed user data Embree's callbacks read, which must outlive `scene`'s handle.
+fn attach_user<T: UserShape>(
+    device: &Device,
+    scene: &CommittedScene,
+    kind: Kind,
+    prims: &[T],
+) -> Result<Option<Box<UserPrims<T>>>, EmbreeError> {
+    if prims.is_empty() {
+        return Ok(None);
+    }
+    let count = u32::try_from(prims.len()).map_err(|_| {
+        EmbreeError::emray(
+            format!("building the {} geometry", kind.name()),
+            format!(
+                "{} primitives exceed Embree's 32-bit primitive ids",
+                prims.len()
+            ),
+        )
+    })?;
+    let data = Box::new(UserPrims {
+        items: prims.to_vec().into_boxed_slice(),
+    });
+    let geometry = Geometry::new(
+        device,
+        sys::RTCGeometryType::RTC_GEOMETRY_TYPE_USER,
+        kind.name(),
+    )?;
+    // SAFETY: live user geometry. The user pointer is the boxed `UserPrims<T>` that the
+    // callbacks (instantiated for the same `T`) read; it is returned to the caller, who
+    // stores it in the `CommittedScene`, where it is freed only after the scene is
+    // released.
+    unsafe {
+        sys::rtcSetGeometryUserPrimitiveCount(geometry.0, count);
+        sys::rtcSetGeometryUserData(geometry.0, data.as_user_ptr());
+        sys::rtcSetGeometryBoundsFunction(
+            geometry.0,
+            Some(user::bounds::<T>),
+            std::ptr::null_mut(),
+        );
+        sys::rtcSetGeometryIntersectFunction(geometry.0, Some(user::intersect::<T>));
+        sys::rtcSetGeometryOccludedFunction(geometry.0, Some(user::occluded::<T>));
+    }
+    device.check(format!("setting up the {} geometry", kind.name()))?;
+    geometry.commit_and_attach(device, scene, kind)?;
+    Ok(Some(data))
+}

@@ -1,0 +1,511 @@
+//! Behaviour of the Embree backend against the installed library (Embree 3.13 on
+//! bookworm): ids, triangle parametrisation and normal, agreement with the shared
+//! intersectors, intervals, occlusion, empty scenes, errors.
+
+use super::*;
+use crate::geometry::{Cone, Kind, ShapeHit, Sphere, Triangle};
+use crate::math::Vec3;
+use crate::scene::{Camera, Material};
+
+fn scene() -> Scene {
+    let mut s = Scene::new(Camera {
+        from: Vec3::ZERO,
+        at: Vec3::Z,
+        up: Vec3::Y,
+        angle_deg: 45.0,
+        hither: 0.0,
+        width: 8,
+        height: 8,
+    });
+    s.materials.push(Material::default());
+    s
+}
+
+fn add_triangle(s: &mut Scene, p0: Vec3, p1: Vec3, p2: Vec3) {
+    s.triangles.push(Triangle { p: [p0, p1, p2] }, 0);
+    s.triangle_normals.push(u32::MAX);
+}
+
+fn build(s: &Scene) -> EmbreeAccel {
+    EmbreeAccel::build(s).expect("Embree build")
+}
+
+fn ray(org: Vec3, dir: Vec3) -> Ray {
+    Ray::new(org, dir)
+}
+
+/// Hit and shared-intersector result agree exactly (same t, u, v, ng bits).
+fn assert_same(hit: Option<Hit>, reference: Option<ShapeHit>, kind: Kind, prim: u32, r: &Ray) {
+    match (hit, reference) {
+        (None, None) => {}
+        (Some(h), Some(s)) => {
+            assert_eq!(
+                h.t.to_bits(),
+                s.t.to_bits(),
+                "t for {r:?}: {} vs {}",
+                h.t,
+                s.t
+            );
+            assert_eq!(h.u.to_bits(), s.u.to_bits(), "u for {r:?}");
+            assert_eq!(h.v.to_bits(), s.v.to_bits(), "v for {r:?}");
+            assert_eq!(
+                h.ng.to_array().map(f32::to_bits),
+                s.ng.to_array().map(f32::to_bits),
+                "ng for {r:?}"
+            );
+            assert_eq!(h.geom_id, kind as u32);
+            assert_eq!(h.prim_id, prim);
+        }
+        (h, s) => panic!("Embree {h:?} vs shared intersector {s:?} for {r:?}"),
+    }
+}
+
+/// Directions from `org` over a grid covering a cone of half-angle ~`spread` around
+/// `towards`.
+fn fan(org: Vec3, towards: Vec3, spread: f32, n: i32) -> Vec<Ray> {
+    let f = (towards - org).normalize();
+    let frame = crate::math::Frame::from_z(f);
+    let mut rays = Vec::new();
+    for i in -n..=n {
+        for j in -n..=n {
+            let a = spread * i as f32 / n as f32;
+            let b = spread * j as f32 / n as f32;
+            rays.push(ray(org, f + frame.x * a + frame.y * b));
+        }
+    }
+    rays
+}
+
+#[test]
+fn one_triangle_hit_t_u_v_and_normal() {
+    let mut s = scene();
+    let (p0, p1, p2) = (
+        Vec3::new(-1.0, -1.0, 5.0),
+        Vec3::new(2.0, -1.0, 5.5),
+        Vec3::new(-1.0, 2.5, 4.5),
+    );
+    add_triangle(&mut s, p0, p1, p2);
+    let tri = s.triangles.items[0];
+    let accel = build(&s);
+
+    for (u, v) in [(0.2f32, 0.3f32), (0.6, 0.1), (0.05, 0.9), (0.33, 0.33)] {
+        let target = p0 * (1.0 - u - v) + p1 * u + p2 * v;
+        // From the front (origin) and from behind the triangle: both sides are hit.
+        for org in [Vec3::ZERO, Vec3::new(0.3, -0.2, 9.0)] {
+            let r = ray(org, target - org);
+            let h = accel.intersect(&r).expect("hit inside the triangle");
+            let reference = tri.intersect(&r).expect("reference hit");
+            assert!((h.t - 1.0).abs() < 1e-5, "t = {}", h.t);
+            assert!((h.t - reference.t).abs() < 1e-5);
+            // p = (1-u-v) p0 + u p1 + v p2
+            assert!(
+                (h.u - u).abs() < 1e-5 && (h.v - v).abs() < 1e-5,
+                "u,v = {},{} want {u},{v}",
+                h.u,
+                h.v
+            );
+            assert!((h.u - reference.u).abs() < 1e-5 && (h.v - reference.v).abs() < 1e-5);
+            // Ng is (p1 - p0) x (p2 - p0): same direction (and length, up to rounding),
+            // whichever side the ray comes from.
+            let n = tri.normal();
+            assert!(
+                h.ng.dot(n) > 0.0,
+                "Embree Ng {:?} opposes (p1-p0)x(p2-p0) = {n:?}",
+                h.ng
+            );
+            assert!((h.ng.normalize() - n.normalize()).length() < 1e-5);
+            assert!((h.ng.length() / n.length() - 1.0).abs() < 1e-4);
+            assert_eq!((h.geom_id, h.prim_id), (Kind::Triangle as u32, 0));
+            assert_eq!(h.kind(), Kind::Triangle);
+        }
+    }
+
+    // Outside the triangle (u + v > 1, u < 0), and pointing away.
+    for (u, v) in [(0.8f32, 0.5f32), (-0.1, 0.5), (0.5, -0.05)] {
+        let target = p0 * (1.0 - u - v) + p1 * u + p2 * v;
+        assert_eq!(
+            accel.intersect(&ray(Vec3::ZERO, target)),
+            None,
+            "({u}, {v})"
+        );
+        assert!(!accel.occluded(&ray(Vec3::ZERO, target)));
+    }
+    assert_eq!(accel.intersect(&ray(Vec3::ZERO, -Vec3::Z)), None);
+}
+
+#[test]
+fn sphere_hits_equal_the_shared_intersector() {
+    let mut s = scene();
+    let sphere = Sphere::new(Vec3::new(0.5, -0.25, 6.0), 1.5);
+    s.spheres.push(sphere, 0);
+    let accel = build(&s);
+    let origins = [
+        Vec3::ZERO,
+        Vec3::new(3.0, 2.0, -1.0),
+        Vec3::new(0.4, -0.2, 6.1),
+    ]; // last: inside
+    let mut hits = 0;
+    for org in origins {
+        for r in fan(org, sphere.center, 0.5, 12) {
+            let h = accel.intersect(&r);
+            hits += usize::from(h.is_some());
+            assert_same(h, sphere.intersect(&r), Kind::Sphere, 0, &r);
+            assert_eq!(accel.occluded(&r), sphere.occluded(&r), "{r:?}");
+        }
+    }
+    assert!(hits > 100, "too few hits ({hits}) to mean anything");
+}
+
+#[test]
+fn cone_hits_equal_the_shared_intersector() {
+    let cones = [
+        Cone::new(
+            Vec3::new(0.0, -1.0, 6.0),
+            1.0,
+            Vec3::new(0.5, 1.5, 6.5),
+            0.25,
+        ), // cone
+        Cone::new(
+            Vec3::new(-1.0, 0.0, 5.0),
+            0.5,
+            Vec3::new(1.0, 0.2, 5.5),
+            0.5,
+        ), // cylinder
+        Cone::new(
+            Vec3::new(0.0, -1.0, 6.0),
+            -1.0,
+            Vec3::new(0.0, 1.0, 6.0),
+            -1.0,
+        ), // inside only
+    ];
+    for cone in cones {
+        let mut s = scene();
+        s.cones.push(cone, 0);
+        let accel = build(&s);
+        let centre = (cone.base + cone.apex) * 0.5;
+        let mut hits = 0;
+        for org in [
+            Vec3::ZERO,
+            Vec3::new(-2.0, 3.0, 1.0),
+            centre + Vec3::new(0.01, 0.02, 0.0),
+        ] {
+            for r in fan(org, centre, 0.6, 12) {
+                let h = accel.intersect(&r);
+                hits += usize::from(h.is_some());
+                assert_same(h, cone.intersect(&r), Kind::Cone, 0, &r);
+                assert_eq!(accel.occluded(&r), cone.occluded(&r), "{r:?}");
+            }
+        }
+        assert!(hits > 50, "too few hits ({hits}) for {cone:?}");
+    }
+}
+
+#[test]
+fn ids_are_kind_and_index_with_several_prims_of_each_kind() {
+    let mut s = scene();
+    // Three of each kind side by side along x, all at depth ~10; prims are pushed in an
+    // order that differs from their x order.
+    let xs = [4.0f32, -4.0, 0.0];
+    for &x in &xs {
+        add_triangle(
+            &mut s,
+            Vec3::new(x - 0.5, 2.5, 10.0),
+            Vec3::new(x + 0.5, 2.5, 10.0),
+            Vec3::new(x, 3.5, 10.0),
+        );
+        s.spheres.push(Sphere::new(Vec3::new(x, 0.0, 10.0), 0.5), 0);
+        s.cones.push(
+            Cone::new(Vec3::new(x, -3.5, 10.0), 0.5, Vec3::new(x, -2.5, 10.0), 0.5),
+            0,
+        );
+    }
+    let accel = build(&s);
+    assert_eq!(accel.stats().prims, 9);
+    for (i, &x) in xs.iter().enumerate() {
+        let cases = [
+            (Kind::Triangle, 2.8f32),
+            (Kind::Sphere, 0.0),
+            (Kind::Cone, -3.0),
+        ];
+        for (kind, y) in cases {
+            let r = ray(Vec3::ZERO, Vec3::new(x, y, 10.0));
+            let h = accel
+                .intersect(&r)
+                .unwrap_or_else(|| panic!("{kind:?} {i} missed"));
+            assert_eq!(h.kind(), kind);
+            assert_eq!(h.geom_id, kind as u32);
+            assert_eq!(h.prim_id, i as u32, "{kind:?} at x = {x}");
+            assert!(accel.occluded(&r));
+        }
+    }
+}
+
+#[test]
+fn nearest_hit_across_kinds() {
+    let mut s = scene();
+    // Along +z: a triangle at z = 3, a sphere spanning z in [5, 7], a cone (cylinder
+    // across the ray) at z = 9.
+    add_triangle(
+        &mut s,
+        Vec3::new(-1.0, -1.0, 3.0),
+        Vec3::new(1.0, -1.0, 3.0),
+        Vec3::new(0.0, 1.0, 3.0),
+    );
+    s.spheres
+        .push(Sphere::new(Vec3::new(0.0, 0.0, 6.0), 1.0), 0);
+    s.cones.push(
+        Cone::new(
+            Vec3::new(-2.0, 0.0, 9.0),
+            0.5,
+            Vec3::new(2.0, 0.0, 9.0),
+            0.5,
+        ),
+        0,
+    );
+    let accel = build(&s);
+    let at = |tmin: f32| {
+        let mut r = ray(Vec3::ZERO, Vec3::Z);
+        r.tmin = tmin;
+        accel.intersect(&r).map(|h| (h.kind(), h.t))
+    };
+    for (tmin, kind, t) in [
+        (0.0, Kind::Triangle, 3.0),
+        (3.5, Kind::Sphere, 5.0),
+        (5.5, Kind::Sphere, 7.0),
+        (7.5, Kind::Cone, 8.5),
+        (9.0, Kind::Cone, 9.5),
+    ] {
+        let (k, got) = at(tmin).unwrap_or_else(|| panic!("miss from tmin {tmin}"));
+        assert_eq!(k, kind, "from tmin {tmin}");
+        assert!((got - t).abs() < 1e-5, "t {got}, want {t}");
+    }
+    assert_eq!(at(9.6), None);
+}
+
+#[test]
+fn occluded_true_and_false() {
+    let mut s = scene();
+    add_triangle(
+        &mut s,
+        Vec3::new(-1.0, -1.0, 3.0),
+        Vec3::new(1.0, -1.0, 3.0),
+        Vec3::new(0.0, 1.0, 3.0),
+    );
+    s.spheres
+        .push(Sphere::new(Vec3::new(5.0, 0.0, 6.0), 1.0), 0);
+    s.cones.push(
+        Cone::new(
+            Vec3::new(-5.0, -1.0, 6.0),
+            1.0,
+            Vec3::new(-5.0, 1.0, 6.0),
+            1.0,
+        ),
+        0,
+    );
+    let accel = build(&s);
+    for target in [
+        Vec3::new(0.0, 0.0, 3.0),
+        Vec3::new(5.0, 0.0, 6.0),
+        Vec3::new(-5.0, 0.0, 6.0),
+    ] {
+        let mut r = ray(Vec3::ZERO, target);
+        assert!(accel.occluded(&r), "towards {target:?}");
+        // A shadow ray that stops before the blocker is not occluded.
+        r.tmax = 0.4;
+        assert!(!accel.occluded(&r), "towards {target:?} with tmax 0.4");
+        // Nor one that starts after it.
+        r.tmin = 1.6;
+        r.tmax = f32::INFINITY;
+        assert!(!accel.occluded(&r), "towards {target:?} from tmin 1.6");
+    }
+    assert!(!accel.occluded(&ray(Vec3::ZERO, Vec3::Y)));
+    assert!(!accel.occluded(&ray(Vec3::ZERO, -Vec3::Z)));
+}
+
+#[test]
+fn tmin_and_tmax_are_honoured() {
+    let mut s = scene();
+    s.spheres
+        .push(Sphere::new(Vec3::new(0.0, 0.0, 5.0), 1.0), 0);
+    add_triangle(
+        &mut s,
+        Vec3::new(2.0, -1.0, 5.0),
+        Vec3::new(4.0, -1.0, 5.0),
+        Vec3::new(3.0, 1.0, 5.0),
+    );
+    let accel = build(&s);
+    let sphere = s.spheres.items[0];
+    let with = |dir: Vec3, tmin: f32, tmax: f32| Ray {
+        org: Vec3::ZERO,
+        dir,
+        tmin,
+        tmax,
+    };
+    // Sphere: front at t = 4, back at t = 6.
+    for (tmin, tmax, want) in [
+        (0.0, 3.0, None),
+        (0.0, 3.999, None),
+        (0.0, 5.0, Some(4.0)),
+        (4.5, f32::INFINITY, Some(6.0)),
+        (4.5, 5.5, None),
+        (6.5, f32::INFINITY, None),
+    ] {
+        let r = with(Vec3::Z, tmin, tmax);
+        let h = accel.intersect(&r);
+        assert_eq!(h.is_some(), want.is_some(), "tmin {tmin} tmax {tmax}");
+        if let (Some(h), Some(t)) = (h, want) {
+            assert!((h.t - t).abs() < 1e-5, "t {}, want {t}", h.t);
+        }
+        assert_same(h, sphere.intersect(&r), Kind::Sphere, 0, &r);
+        assert_eq!(accel.occluded(&r), want.is_some());
+    }
+    // Triangle at t = 1 along (3, 0, 5).
+    let d = Vec3::new(3.0, 0.0, 5.0);
+    assert!(accel.intersect(&with(d, 0.0, 1.001)).is_some());
+    assert!(accel.intersect(&with(d, 0.0, 0.999)).is_none());
+    assert!(accel.intersect(&with(d, 1.001, f32::INFINITY)).is_none());
+    assert!(!accel.occluded(&with(d, 0.0, 0.999)));
+    // An empty or invalid interval hits nothing.
+    assert!(accel.intersect(&with(Vec3::Z, 5.0, 4.0)).is_none());
+    assert!(!accel.occluded(&with(Vec3::Z, 0.0, f32::NAN)));
+}
+
+#[test]
+fn empty_scene_misses_everything() {
+    let s = scene();
+    let accel = build(&s);
+    for r in fan(Vec3::ZERO, Vec3::Z, 1.0, 3) {
+        assert_eq!(accel.intersect(&r), None);
+        assert!(!accel.occluded(&r));
+    }
+    let st = accel.stats();
+    assert_eq!((st.backend, st.prims), ("embree", 0));
+}
+
+#[test]
+fn inside_only_sphere_seen_from_outside_shows_its_far_side() {
+    let mut s = scene();
+    let sphere = Sphere::new(Vec3::new(0.0, 0.0, 5.0), -1.0);
+    assert!(sphere.inside_only);
+    s.spheres.push(sphere, 0);
+    let accel = build(&s);
+    let r = ray(Vec3::ZERO, Vec3::Z);
+    let h = accel.intersect(&r).expect("far side");
+    assert!((h.t - 6.0).abs() < 1e-5, "t = {}", h.t);
+    // The normal is the outward one; the ray leaves through it.
+    assert!(h.ng.dot(r.dir) > 0.0);
+    assert_same(Some(h), sphere.intersect(&r), Kind::Sphere, 0, &r);
+    let mut hits = 0;
+    for r in fan(Vec3::ZERO, sphere.center, 0.3, 8) {
+        let h = accel.intersect(&r);
+        if let Some(h) = h {
+            hits += 1;
+            // Only the far side: where the ray leaves the sphere (outward normal along
+            // the ray), never where it enters.
+            assert!(h.ng.dot(r.dir) > 0.0, "near side hit for {r:?}");
+        }
+        assert_same(h, sphere.intersect(&r), Kind::Sphere, 0, &r);
+    }
+    assert!(hits > 50, "{hits} hits");
+}
+
+#[test]
+fn stats_report_embree_and_its_version() {
+    let mut s = scene();
+    s.spheres
+        .push(Sphere::new(Vec3::new(0.0, 0.0, 5.0), 1.0), 0);
+    add_triangle(&mut s, Vec3::X, Vec3::Y, Vec3::Z);
+    let accel = build(&s);
+    let st = accel.stats();
+    assert_eq!(st.backend, "embree");
+    assert_eq!(st.prims, 2);
+    let v = accel.version();
+    assert!(v >= 30000, "version {v}");
+    let dotted = format!("Embree {}.{}.{}", v / 10000, v / 100 % 100, v % 100);
+    assert!(st.detail.starts_with(&dotted), "{} vs {dotted}", st.detail);
+    #[cfg(embree3)]
+    assert_eq!(v / 10000, 3);
+    #[cfg(embree4)]
+    assert_eq!(v / 10000, 4);
+    assert!(st.bytes > 0, "memory monitor saw no allocation");
+}
+
+#[test]
+fn queries_from_many_threads_agree() {
+    fn assert_send_sync<T: Send + Sync>() {}
+    assert_send_sync::<EmbreeAccel>();
+
+    let mut s = scene();
+    for i in 0..20 {
+        let x = i as f32 - 10.0;
+        s.spheres
+            .push(Sphere::new(Vec3::new(x, 0.3 * x, 12.0), 0.6), 0);
+        s.cones.push(
+            Cone::new(Vec3::new(x, -3.0, 14.0), 0.4, Vec3::new(x, 3.0, 14.0), 0.1),
+            0,
+        );
+        add_triangle(
+            &mut s,
+            Vec3::new(x, -1.0, 16.0),
+            Vec3::new(x + 1.0, -1.0, 16.0),
+            Vec3::new(x, 1.0, 16.0),
+        );
+    }
+    let accel = build(&s);
+    let rays = fan(Vec3::ZERO, Vec3::Z, 0.9, 40);
+    let serial: Vec<_> = rays
+        .iter()
+        .map(|r| (accel.intersect(r), accel.occluded(r)))
+        .collect();
+    assert!(serial.iter().filter(|h| h.0.is_some()).count() > 100);
+    std::thread::scope(|scope| {
+        for _ in 0..4 {
+            scope.spawn(|| {
+                for (r, want) in rays.iter().zip(&serial) {
+                    assert_eq!((accel.intersect(r), accel.occluded(r)), *want);
+                }
+            });
+        }
+    });
+}
+
+#[test]
+fn bad_device_configuration_is_an_error() {
+    let s = scene();
+    let e = EmbreeAccel::build_with_config(&s, "threads=1\0").unwrap_err();
+    assert_eq!(e.code(), None);
+    assert!(e.to_string().contains("NUL"), "{e}");
+    // Embree 3.13 fails to create the device on an unparsable value (RTC_ERROR_UNKNOWN).
+    let e = EmbreeAccel::build_with_config(&s, "threads=abc").unwrap_err();
+    assert!(e.code().is_some_and(|c| c != 0), "{e}");
+    assert!(
+        e.to_string().contains("rtcNewDevice(\"threads=abc\")"),
+        "{e}"
+    );
+    assert!(EmbreeAccel::build_with_config(&s, "threads=1").is_ok());
+}
+
+#[test]
+fn device_errors_carry_embree_code_and_message() {
+    let device = device::Device::new("").expect("device");
+    assert_eq!(device.check("nothing"), Ok(()));
+    // SAFETY: a live device; an unknown geometry type makes Embree report an error and
+    // return null (checked below), nothing else.
+    let geometry = unsafe { sys::rtcNewGeometry(device.raw(), sys::RTCGeometryType(9999)) };
+    assert!(geometry.is_null());
+    let e = device.check("rtcNewGeometry(9999)").unwrap_err();
+    // Embree 3.13 says RTC_ERROR_UNKNOWN, "invalid geometry type".
+    assert!(e.code().is_some_and(|c| c != 0), "{e}");
+    assert!(
+        !e.message().is_empty(),
+        "the error callback recorded no message: {e}"
+    );
+    let shown = e.to_string();
+    assert!(
+        shown.starts_with("Embree: rtcNewGeometry(9999) failed: RTC_ERROR_"),
+        "{e}"
+    );
+    assert!(shown.ends_with(e.message()), "{e}");
+    // Reported once: the next check is clean.
+    assert_eq!(device.check("nothing"), Ok(()));
+}
