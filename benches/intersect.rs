@@ -1,2 +1,108 @@
-//! Single-ray intersection throughput per primitive kind (filled in below).
-fn main() {}
+//! Single-ray throughput per primitive kind and backend: the same random rays into the
+//! same scene of 10 000 primitives of one kind, on the BVH and (with the `embree`
+//! feature) on Embree. Run with `cargo bench --bench intersect`.
+
+use criterion::{criterion_group, criterion_main, Criterion, Throughput};
+use emray::accel::bvh::Bvh;
+use emray::accel::Accel;
+use emray::geometry::{Cone, Kind, Sphere, Triangle};
+use emray::math::{Ray, Vec3};
+use emray::scene::{Camera, Material, Scene};
+use std::hint::black_box;
+
+struct Lcg(u64);
+
+impl Lcg {
+    fn f(&mut self) -> f32 {
+        self.0 = self
+            .0
+            .wrapping_mul(6364136223846793005)
+            .wrapping_add(1442695040888963407);
+        (self.0 >> 40) as f32 / (1u64 << 24) as f32
+    }
+    fn v(&mut self, s: f32) -> Vec3 {
+        Vec3::new(self.f() - 0.5, self.f() - 0.5, self.f() - 0.5) * s
+    }
+}
+
+fn scene(kind: Kind, n: usize) -> Scene {
+    let cam = Camera {
+        from: Vec3::Z * 30.0,
+        at: Vec3::ZERO,
+        up: Vec3::Y,
+        angle_deg: 40.0,
+        hither: 1.0,
+        width: 64,
+        height: 64,
+    };
+    let mut s = Scene::new(cam);
+    s.materials.push(Material::default());
+    let mut r = Lcg(42);
+    for _ in 0..n {
+        let c = r.v(20.0);
+        match kind {
+            Kind::Triangle => {
+                s.triangles.push(
+                    Triangle {
+                        p: [c + r.v(0.6), c + r.v(0.6), c + r.v(0.6)],
+                    },
+                    0,
+                );
+                s.triangle_normals.push(u32::MAX);
+            }
+            Kind::Sphere => s.spheres.push(Sphere::new(c, 0.1 + 0.2 * r.f()), 0),
+            Kind::Cone => s
+                .cones
+                .push(Cone::new(c, 0.2 * r.f(), c + r.v(1.0), 0.2 * r.f()), 0),
+        }
+    }
+    s
+}
+
+fn rays(n: usize) -> Vec<Ray> {
+    let mut r = Lcg(7);
+    (0..n)
+        .map(|_| {
+            let org = r.v(60.0);
+            Ray::new(org, (r.v(20.0) - org).normalize())
+        })
+        .collect()
+}
+
+fn run<A: Accel>(c: &mut Criterion, name: &str, accel: &A, rays: &[Ray]) {
+    let mut g = c.benchmark_group(name);
+    g.throughput(Throughput::Elements(rays.len() as u64));
+    g.bench_function("intersect", |b| {
+        b.iter(|| {
+            rays.iter()
+                .filter(|r| accel.intersect(black_box(r)).is_some())
+                .count()
+        })
+    });
+    g.bench_function("occluded", |b| {
+        b.iter(|| rays.iter().filter(|r| accel.occluded(black_box(r))).count())
+    });
+    g.finish();
+}
+
+fn bench(c: &mut Criterion) {
+    let rays = rays(10_000);
+    for kind in Kind::ALL {
+        let s = scene(kind, 10_000);
+        run(c, &format!("bvh/{}", kind.name()), &Bvh::build(&s), &rays);
+        #[cfg(feature = "embree")]
+        run(
+            c,
+            &format!("embree/{}", kind.name()),
+            &emray::accel::embree::EmbreeAccel::build(&s).expect("embree"),
+            &rays,
+        );
+    }
+}
+
+criterion_group! {
+    name = benches;
+    config = Criterion::default().sample_size(20).measurement_time(std::time::Duration::from_secs(2));
+    targets = bench
+}
+criterion_main!(benches);

@@ -1,0 +1,113 @@
+//! Embree and the pure-Rust BVH on the same random rays over a scene with every
+//! primitive kind: the same hit or miss, the same primitive (ties excepted), and `t`
+//! equal for the analytic shapes (both backends run the same intersector) and within
+//! a stated relative bound for triangles (Embree's own test against the watertight one).
+#![cfg(feature = "embree")]
+
+use emray::accel::bvh::Bvh;
+use emray::accel::embree::EmbreeAccel;
+use emray::accel::Accel;
+use emray::geometry::{Cone, Kind, Sphere, Triangle};
+use emray::math::{Ray, Vec3};
+use emray::scene::{Camera, Material, Scene};
+use proptest::prelude::*;
+
+/// Relative bound on the difference of triangle hit distances between the backends,
+/// away from edges and grazing angles.
+const TRI_REL: f32 = 1e-5;
+
+fn scene(seed: u64) -> Scene {
+    let mut s = Scene::new(Camera {
+        from: Vec3::Z * 30.0,
+        at: Vec3::ZERO,
+        up: Vec3::Y,
+        angle_deg: 40.0,
+        hither: 1.0,
+        width: 8,
+        height: 8,
+    });
+    s.materials.push(Material::default());
+    let mut x = seed;
+    let mut f = move || {
+        x = x
+            .wrapping_mul(6364136223846793005)
+            .wrapping_add(1442695040888963407);
+        (x >> 40) as f32 / (1u64 << 24) as f32
+    };
+    let v = |f: &mut dyn FnMut() -> f32, s: f32| Vec3::new(f() - 0.5, f() - 0.5, f() - 0.5) * s;
+    for i in 0..600 {
+        let c = v(&mut f, 20.0);
+        match i % 3 {
+            0 => {
+                let p = [c + v(&mut f, 2.0), c + v(&mut f, 2.0), c + v(&mut f, 2.0)];
+                s.triangles.push(Triangle { p }, 0);
+                s.triangle_normals.push(u32::MAX);
+            }
+            1 => {
+                let r = 0.1 + f();
+                s.spheres
+                    .push(Sphere::new(c, if f() < 0.2 { -r } else { r }), 0);
+            }
+            _ => {
+                let apex = c + v(&mut f, 3.0);
+                s.cones.push(Cone::new(c, f() * 0.6, apex, f() * 0.6), 0);
+            }
+        }
+    }
+    s
+}
+
+fn vec3() -> impl Strategy<Value = Vec3> {
+    (-1.0f32..1.0, -1.0f32..1.0, -1.0f32..1.0).prop_map(|(x, y, z)| Vec3::new(x, y, z))
+}
+
+proptest! {
+    #![proptest_config(ProptestConfig::with_cases(20))]
+
+    #[test]
+    fn embree_and_bvh_agree_on_random_rays(seed in any::<u64>(), rays in prop::collection::vec((vec3(), vec3(), 0.0f32..1.0), 2000)) {
+        let s = scene(seed);
+        let bvh = Bvh::build(&s);
+        let emb = EmbreeAccel::build(&s).unwrap();
+        let mut hits = 0;
+        for (o, target, cut) in rays {
+            let org = o * 40.0;
+            let mut ray = Ray::new(org, (target * 12.0 - org).normalize_or(Vec3::X));
+            if cut < 0.2 {
+                ray.tmax = cut * 200.0;
+            }
+            let a = bvh.intersect(&ray);
+            let b = emb.intersect(&ray);
+            match (a, b) {
+                (Some(a), Some(b)) => {
+                    hits += 1;
+                    let same = (a.geom_id, a.prim_id) == (b.geom_id, b.prim_id);
+                    if same && a.kind() != Kind::Triangle {
+                        prop_assert_eq!(a.t, b.t, "same shape, same intersector");
+                    } else if same {
+                        prop_assert!((a.t - b.t).abs() <= TRI_REL * a.t.max(b.t) + 1e-6,
+                            "triangle t {} vs {}", a.t, b.t);
+                    } else {
+                        // Different primitives only when both are (nearly) equally near.
+                        prop_assert!((a.t - b.t).abs() <= TRI_REL * a.t.max(b.t) + 1e-5,
+                            "bvh {a:?} vs embree {b:?}");
+                    }
+                }
+                (None, None) => {}
+                (a, b) => {
+                    // Only an edge or grazing triangle hit may differ between the two
+                    // triangle tests.
+                    let h = a.or(b).unwrap();
+                    prop_assert_eq!(h.kind(), Kind::Triangle, "bvh {:?} vs embree {:?}", a, b);
+                    let t = &s.triangles.items[h.prim_id as usize];
+                    let w = 1.0 - h.u - h.v;
+                    let edge = h.u.min(h.v).min(w) < 1e-4;
+                    let grazing = t.normal().normalize().dot(ray.dir).abs() < 1e-3;
+                    prop_assert!(edge || grazing, "bvh {:?} vs embree {:?}", a, b);
+                }
+            }
+            prop_assert_eq!(bvh.occluded(&ray), emb.occluded(&ray) , "occluded");
+        }
+        prop_assert!(hits > 200, "rays should hit often ({})", hits);
+    }
+}
