@@ -72,3 +72,50 @@ fn spd_scenes_render_on_the_bvh() {
         assert!(f.pixels.iter().any(|p| p.max_element() > 0.0));
     }
 }
+
+/// `emray gen` output equals what the SPD programs wrote, file by file
+/// (`NAME_default.nff` at the default size, `NAME_sN.nff` at size N). Set
+/// `EMRAY_SPD_ONLY=balls,tetra` to check some databases only.
+#[test]
+#[ignore = "needs the SPD scene files (EMRAY_SPD_DIR)"]
+fn generated_files_match_the_spd_programs() {
+    use emray::gen::{compare_nff, Database};
+    let only: Option<Vec<String>> = std::env::var("EMRAY_SPD_ONLY")
+        .ok()
+        .map(|s| s.split(',').map(str::to_string).collect());
+    let mut failures = Vec::new();
+    for path in spd_files() {
+        let stem = path.file_stem().unwrap().to_string_lossy().into_owned();
+        let (name, size) = stem.rsplit_once('_').expect("NAME_SIZE.nff");
+        let db = Database::from_name(name).unwrap_or_else(|| panic!("unknown database {name}"));
+        if only.as_ref().is_some_and(|o| !o.iter().any(|n| n == name)) {
+            continue;
+        }
+        let size = match size {
+            "default" => db.default_size(),
+            s => s.trim_start_matches('s').parse().expect("size factor"),
+        };
+        let theirs = std::fs::read_to_string(&path).unwrap();
+        let ours = db.generate(size);
+        let c = compare_nff(&ours, &theirs);
+        println!(
+            "{stem:<18} size {size:>2}  {}  tokens {:>7}  near {:>5}  max rel {:.1e}{}",
+            if c.identical {
+                "identical"
+            } else {
+                "differs  "
+            },
+            c.tokens,
+            c.near,
+            c.max_rel,
+            c.first_difference
+                .as_deref()
+                .map(|d| format!("  FIRST DIFF {d}"))
+                .unwrap_or_default()
+        );
+        if c.first_difference.is_some() {
+            failures.push(stem);
+        }
+    }
+    assert!(failures.is_empty(), "differ: {failures:?}");
+}
