@@ -17,8 +17,25 @@ pub struct Cli {
 /// Subcommands.
 #[derive(Subcommand, Debug)]
 pub enum Command {
-    /// Render one or more scene files.
+    /// Render one or more scene files (or `spd:NAME[?size=N]` generated scenes).
     Render(RenderArgs),
+    /// Write a Standard Procedural Database as NFF, as the SPD 3.14 programs do.
+    Gen(GenArgs),
+}
+
+/// `emray gen`.
+#[derive(Args, Debug, Clone)]
+pub struct GenArgs {
+    /// Database: balls, gears, jacks, lattice, mount, rings, shells, sombrero, teapot,
+    /// tetra, tree.
+    #[arg(value_name = "DATABASE")]
+    pub database: String,
+    /// Size factor (default: the SPD program's default for the database).
+    #[arg(short, long)]
+    pub size: Option<u32>,
+    /// Output file (default: standard output).
+    #[arg(short, long, value_name = "FILE.nff")]
+    pub output: Option<std::path::PathBuf>,
 }
 
 /// The backends as named on the command line.
@@ -60,7 +77,7 @@ impl From<EncodingArg> for Encoding {
 /// `emray render`.
 #[derive(Args, Debug, Clone)]
 pub struct RenderArgs {
-    /// Scene files (NFF).
+    /// Scene files (NFF), or generated SPD scenes as `spd:NAME` / `spd:NAME?size=N`.
     #[arg(required = true, value_name = "SCENE")]
     pub scenes: Vec<PathBuf>,
     /// Output file (.png or .exr), or a template with `{stem}` for several scenes.

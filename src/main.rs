@@ -6,6 +6,7 @@ use anyhow::{bail, Context, Result};
 use clap::Parser;
 use cli::{Cli, Command, RenderArgs};
 use emray::accel::Backend;
+use emray::gen::Database;
 use emray::load;
 use emray::render::RenderSettings;
 use emray::Scene;
@@ -21,6 +22,7 @@ fn main() -> ExitCode {
     let cli = Cli::parse();
     let args = match cli.command {
         Some(Command::Render(a)) => a,
+        Some(Command::Gen(g)) => return gen(&g),
         None => RenderArgs::default_scene(),
     };
     let level = match (args.quiet, args.verbose) {
@@ -49,12 +51,53 @@ fn main() -> ExitCode {
     }
 }
 
-/// Where scene `scene` goes.
-fn output_for(args: &RenderArgs, scene: &Path) -> PathBuf {
-    let stem = scene
+/// `emray gen`: exit 2 on a bad database or size, 1 when the file cannot be written.
+fn gen(g: &cli::GenArgs) -> ExitCode {
+    let Some(db) = Database::from_name(&g.database) else {
+        let names: Vec<&str> = Database::ALL.iter().map(|d| d.name()).collect();
+        eprintln!(
+            "emray: error: unknown database '{}' (one of {})",
+            g.database,
+            names.join(", ")
+        );
+        return ExitCode::from(2);
+    };
+    let size = g.size.unwrap_or_else(|| db.default_size());
+    if let Err(e) = db.check_size(size) {
+        eprintln!("emray: error: {e}");
+        return ExitCode::from(2);
+    }
+    let text = db.generate(size);
+    let result = match &g.output {
+        None => std::io::stdout()
+            .lock()
+            .write_all(text.as_bytes())
+            .context("cannot write to standard output"),
+        Some(path) => emray::output::write_text(path, &text).map_err(anyhow::Error::from),
+    };
+    match result {
+        Ok(()) => ExitCode::SUCCESS,
+        Err(e) => {
+            eprintln!("emray: error: {e:#}");
+            ExitCode::from(1)
+        }
+    }
+}
+
+/// The file-name stem of a scene: the file's, or `NAME_sN` for a generated one.
+fn scene_stem(scene: &Path) -> String {
+    if let Ok(Some((db, size))) = Database::parse_spec(&scene.to_string_lossy()) {
+        return format!("{}_s{size}", db.name());
+    }
+    scene
         .file_stem()
         .map(|s| s.to_string_lossy().into_owned())
-        .unwrap_or_else(|| "emray".into());
+        .unwrap_or_else(|| "emray".into())
+}
+
+/// Where scene `scene` goes.
+fn output_for(args: &RenderArgs, scene: &Path) -> PathBuf {
+    let stem = scene_stem(scene);
     PathBuf::from(match &args.output {
         Some(t) if t.contains("{stem}") => t.replace("{stem}", &stem),
         Some(t) => t.clone(),
@@ -85,8 +128,11 @@ fn plan(args: &RenderArgs) -> Result<Vec<Job>, String> {
             .map(|s| (Some(s.clone()), output_for(args, s)))
             .collect()
     };
-    for (_, out) in &jobs {
+    for (scene, out) in &jobs {
         emray::output::Format::from_path(out).map_err(|e| e.to_string())?;
+        if let Some(s) = scene {
+            Database::parse_spec(&s.to_string_lossy())?;
+        }
     }
     Ok(jobs)
 }
@@ -117,7 +163,16 @@ fn render_all(args: &RenderArgs, jobs: &[Job]) -> Result<()> {
 fn render_one(args: &RenderArgs, scene_path: Option<&Path>, out: &Path) -> Result<()> {
     let t0 = Instant::now();
     let (name, scene): (String, Scene) = match scene_path {
-        Some(p) => (p.display().to_string(), load::load_path(p)?),
+        Some(p) => {
+            let name = p.display().to_string();
+            match Database::parse_spec(&name).map_err(anyhow::Error::msg)? {
+                Some((db, size)) => {
+                    let text = db.generate(size);
+                    (name.clone(), load::nff::parse_str(&text, p)?)
+                }
+                None => (name, load::load_path(p)?),
+            }
+        }
         None => (
             "default".into(),
             load::nff::parse_str(DEFAULT_SCENE, Path::new("<default scene>"))?,

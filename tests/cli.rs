@@ -160,3 +160,42 @@ fn no_arguments_renders_the_default_scene() {
     colours.dedup();
     assert!(colours.len() > 1000, "{} colours", colours.len());
 }
+
+#[test]
+fn gen_writes_nff_that_renders() {
+    let dir = tempfile::tempdir().unwrap();
+    let o = emray(&["gen", "tetra", "-s", "2"], dir.path());
+    assert!(o.status.success(), "{}", stderr(&o));
+    let text = String::from_utf8(o.stdout).unwrap();
+    let scene = emray::load::nff::parse_str(&text, Path::new("tetra")).unwrap();
+    assert_eq!(scene.triangles.len(), 16, "4^2 triangles");
+    let o = emray(&["gen", "tetra", "-s", "2", "-o", "t.nff"], dir.path());
+    assert!(o.status.success(), "{}", stderr(&o));
+    assert_eq!(
+        std::fs::read_to_string(dir.path().join("t.nff")).unwrap(),
+        text
+    );
+    let o = emray(
+        &["render", "spd:tetra?size=2", "--res", "32x32", "-q"],
+        dir.path(),
+    );
+    assert!(o.status.success(), "{}", stderr(&o));
+    assert!(dir.path().join("tetra_s2.png").exists());
+}
+
+#[test]
+fn gen_refuses_bad_databases_and_sizes() {
+    let dir = tempfile::tempdir().unwrap();
+    for args in [
+        vec!["gen", "nope"],
+        vec!["gen", "balls", "-s", "0"],
+        vec!["gen", "balls", "-s", "1000"],
+        vec!["render", "spd:balls?size=1000"],
+        vec!["render", "spd:nope"],
+    ] {
+        let o = emray(&args, dir.path());
+        assert_eq!(o.status.code(), Some(2), "{args:?}: {}", stderr(&o));
+        assert!(stderr(&o).contains("emray: error:"), "{}", stderr(&o));
+    }
+    assert_eq!(std::fs::read_dir(dir.path()).unwrap().count(), 0);
+}

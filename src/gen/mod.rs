@@ -325,6 +325,63 @@ impl Database {
         }
     }
 
+    /// The largest size factor emray generates: the largest whose scene still renders
+    /// within 2 GB of memory (measured; see the README).
+    pub fn max_size(self) -> u32 {
+        match self {
+            Database::Balls => 7,
+            Database::Gears => 40,
+            Database::Jacks => 8,
+            Database::Lattice => 60,
+            Database::Mount => 10,
+            Database::Rings => 60,
+            Database::Shells => 10,
+            Database::Sombrero => 60,
+            Database::Teapot => 100,
+            Database::Tetra => 10,
+            Database::Tree => 20,
+        }
+    }
+
+    /// Parse a scene name of the form `spd:NAME` or `spd:NAME?size=N`; `Ok(None)` when
+    /// `spec` does not start with `spd:`.
+    pub fn parse_spec(spec: &str) -> Result<Option<(Database, u32)>, String> {
+        let Some(rest) = spec.strip_prefix("spd:") else {
+            return Ok(None);
+        };
+        let (name, query) = match rest.split_once('?') {
+            Some((n, q)) => (n, Some(q)),
+            None => (rest, None),
+        };
+        let names = || Database::ALL.map(|d| d.name()).join(", ");
+        let db = Database::from_name(name)
+            .ok_or_else(|| format!("{spec}: unknown database '{name}' (one of {})", names()))?;
+        let size = match query {
+            None => db.default_size(),
+            Some(q) => {
+                let v = q
+                    .strip_prefix("size=")
+                    .ok_or_else(|| format!("{spec}: expected '?size=N' after the database name"))?;
+                v.parse::<u32>()
+                    .map_err(|_| format!("{spec}: size '{v}' is not a whole number"))?
+            }
+        };
+        db.check_size(size).map_err(|e| format!("{spec}: {e}"))?;
+        Ok(Some((db, size)))
+    }
+
+    /// Refuse size factors outside `1..=max_size()`.
+    pub fn check_size(self, size: u32) -> Result<(), String> {
+        if size == 0 || size > self.max_size() {
+            return Err(format!(
+                "size factor {size} out of range for {} (1 to {})",
+                self.name(),
+                self.max_size()
+            ));
+        }
+        Ok(())
+    }
+
     /// The NFF text of the database at size factor `size`.
     pub fn generate(self, size: u32) -> String {
         let mut w = NffWriter::new();
@@ -372,6 +429,34 @@ mod tests {
         for (x, want) in cases {
             assert_eq!(fmt_g(x), want, "{x:e}");
         }
+    }
+
+    #[test]
+    fn spd_specs_parse_and_refuse() {
+        assert_eq!(Database::parse_spec("scene.nff"), Ok(None));
+        assert_eq!(
+            Database::parse_spec("spd:balls"),
+            Ok(Some((Database::Balls, Database::Balls.default_size())))
+        );
+        assert_eq!(
+            Database::parse_spec("spd:tetra?size=3"),
+            Ok(Some((Database::Tetra, 3)))
+        );
+        assert!(Database::parse_spec("spd:nope")
+            .unwrap_err()
+            .contains("unknown database"));
+        assert!(Database::parse_spec("spd:balls?size=x")
+            .unwrap_err()
+            .contains("whole number"));
+        assert!(Database::parse_spec("spd:balls?size=0")
+            .unwrap_err()
+            .contains("out of range"));
+        assert!(Database::parse_spec("spd:balls?size=99")
+            .unwrap_err()
+            .contains("out of range"));
+        assert!(Database::parse_spec("spd:balls?depth=2")
+            .unwrap_err()
+            .contains("?size=N"));
     }
 
     #[test]

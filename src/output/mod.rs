@@ -134,6 +134,22 @@ pub fn write_image(path: &Path, film: &Film, encoding: Encoding) -> Result<(), O
     result
 }
 
+/// Write a text file through a temporary file and a rename.
+pub fn write_text(path: &Path, text: &str) -> Result<(), OutputError> {
+    let err = |e: &dyn std::fmt::Display| OutputError::Write {
+        path: path.to_path_buf(),
+        message: e.to_string(),
+    };
+    let tmp = temp_name(path);
+    let result = fs::write(&tmp, text)
+        .and_then(|()| fs::rename(&tmp, path))
+        .map_err(|e| err(&e));
+    if result.is_err() {
+        let _ = fs::remove_file(&tmp);
+    }
+    result
+}
+
 /// A hidden temporary name in the same directory (so the rename is atomic).
 fn temp_name(path: &Path) -> PathBuf {
     let name = path
