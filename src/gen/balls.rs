@@ -16,7 +16,7 @@
 //! the order the SPD's vector library does, row-vector matrices included, so the
 //! printed numbers are the SPD's to the last digit.
 
-use super::NffWriter;
+use super::{phong_power, NffWriter};
 use glam::DVec3;
 use std::f64::consts::PI;
 
@@ -28,20 +28,6 @@ const CHILD_RATIO: f64 = 1.0 / 3.0;
 
 /// A 4×4 matrix applied to row vectors (`v' = v·M`), as in the SPD's `libvec.c`.
 type Matrix = [[f64; 4]; 4];
-
-/// The NFF Phong exponent the SPD 3.14 library (`lib_output_color`) derives from
-/// `ang`, the angle in degrees at which the highlight falls to half its maximum:
-/// `ln ½ / ln cos ang`, 100000 for no highlight and 1 for angles of 90° or more.
-pub(super) fn phong_power(ang: f64) -> f64 {
-    let a = PI * ang / 180.0;
-    if a <= 0.0 {
-        100_000.0
-    } else if a >= PI / 2.0 {
-        1.0
-    } else {
-        0.5f64.ln() / a.cos().ln()
-    }
-}
 
 fn identity() -> Matrix {
     let mut m = [[0.0; 4]; 4];

@@ -11,7 +11,7 @@
 //! Size factor `n`: n³ gears, each 2 + 144 polygons, plus the ground square:
 //! 146·n³ + 1 polygons (147, 1169, 3943, 9345, …).
 
-use super::NffWriter;
+use super::{phong_power, NffWriter};
 use glam::DVec3;
 use std::f64::consts::PI;
 
@@ -210,18 +210,6 @@ fn c_max(a: f64, b: f64) -> f64 {
         a
     } else {
         b
-    }
-}
-
-/// The SPD's Phong exponent for a highlight that falls to half at `ang` degrees.
-fn phong_power(ang: f64) -> f64 {
-    let r = PI * ang / 180.0;
-    if r <= 0.0 {
-        100000.0
-    } else if r >= PI / 2.0 {
-        1.0
-    } else {
-        0.5f64.ln() / r.cos().ln()
     }
 }
 

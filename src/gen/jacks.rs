@@ -11,16 +11,14 @@
 //! A jack is 3 cylinders and 6 spheres; size factor `n` nests `n` levels deep, so there
 //! are (8ⁿ − 1)/7 jacks: 9·(8ⁿ − 1)/7 primitives (9, 81, 657, 5265, 42129, …).
 
-use super::NffWriter;
+use super::{phong_power, NffWriter};
 use glam::DVec3;
 use std::f64::consts::PI;
 
-/// The SPD program's default size factor: `jacks.c` starts with
-/// `static int size_factor = 1;` and only a command-line argument changes it (SPD
-/// 3.14). Jacks was added to the SPD after the "largest size below 10,000 primitives"
-/// convention of the original seven databases, which would give 4 (5,265 primitives;
-/// size 5 has 42,129) — not what the program does.
-pub const DEFAULT_SIZE: u32 = 1;
+/// emray's default size factor: the SPD convention of the largest size below 10,000
+/// primitives, 4 (5,265 primitives; size 5 has 42,129). The `jacks.c` program itself
+/// starts from `size_factor = 1` (9 primitives), which is no benchmark; `-s 1` gives it.
+pub const DEFAULT_SIZE: u32 = 4;
 
 /// Write the database at size factor `size` (nesting depth; 0 writes no jacks).
 pub fn generate(size: u32, w: &mut NffWriter) {
@@ -87,18 +85,6 @@ fn jack(tx: &mut TxStack, w: &mut NffWriter) {
         w.sphere(tx.point(c), tx.radius(0.2));
     }
     tx.pop();
-}
-
-/// The SPD's Phong exponent for a highlight that falls to half at `ang` degrees.
-fn phong_power(ang: f64) -> f64 {
-    let r = PI * ang / 180.0;
-    if r <= 0.0 {
-        100000.0
-    } else if r >= PI / 2.0 {
-        1.0
-    } else {
-        0.5f64.ln() / r.cos().ln()
-    }
 }
 
 /// A 4×4 matrix in the SPD's row-vector convention (translation in the last row).

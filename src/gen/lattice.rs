@@ -6,9 +6,8 @@
 //! radius 1/(16n), each starting and ending just inside the spheres it joins.
 //! Everything gets its own `f` line before it, as the SPD program writes them.
 
-use super::NffWriter;
+use super::{phong_power, NffWriter};
 use glam::DVec3;
-use std::f64::consts::PI;
 
 /// The SPD program's default size factor: `lattice.c` starts with
 /// `static int size_factor = 12;` — 2,197 spheres and 6,084 cylinders (8,281
@@ -91,18 +90,6 @@ pub fn generate(size: u32, w: &mut NffWriter) {
                 }
             }
         }
-    }
-}
-
-/// The SPD's Phong exponent for a highlight that falls to half at `ang` degrees.
-fn phong_power(ang: f64) -> f64 {
-    let r = PI * ang / 180.0;
-    if r <= 0.0 {
-        100000.0
-    } else if r >= PI / 2.0 {
-        1.0
-    } else {
-        0.5f64.ln() / r.cos().ln()
     }
 }
 

@@ -63,6 +63,19 @@ fn strip_zeros(s: &str) -> &str {
     }
 }
 
+/// The SPD library's Phong exponent for a highlight of half-angle `ang` degrees: the
+/// power whose cosine lobe falls to ½ at `ang` (100000 for 0°, 1 from 90° on).
+pub(crate) fn phong_power(ang: f64) -> f64 {
+    let a = std::f64::consts::PI * ang / 180.0;
+    if a <= 0.0 {
+        100_000.0
+    } else if a >= std::f64::consts::FRAC_PI_2 {
+        1.0
+    } else {
+        0.5f64.ln() / a.cos().ln()
+    }
+}
+
 /// Writes NFF entities in the SPD library's formats.
 #[derive(Debug, Default)]
 pub struct NffWriter {

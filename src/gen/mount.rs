@@ -14,7 +14,7 @@
 //! comparability even though it repeats itself (the SPD README: version 2.4 fixed it,
 //! 3.x made the fix optional).
 
-use super::NffWriter;
+use super::{phong_power, NffWriter};
 use glam::DVec3;
 use std::f64::consts::PI;
 
@@ -64,19 +64,6 @@ pub(crate) fn gauss_rand(seed: i64) -> f64 {
             let fac = (-2.0 * r.ln() / r).sqrt();
             return v1 * fac;
         }
-    }
-}
-
-/// The NFF Phong exponent the SPD library derives from the angle (degrees) at which
-/// the highlight falls to half its maximum.
-fn phong_power(ang: f64) -> f64 {
-    let a = PI * ang / 180.0;
-    if a <= 0.0 {
-        100_000.0
-    } else if a >= PI / 4.0 {
-        0.000_001
-    } else {
-        -(2.0f64.ln() / a.cos().ln())
     }
 }
 
@@ -425,7 +412,9 @@ mod tests {
     #[test]
     fn phong_power_matches_the_spd_library() {
         assert_eq!(phong_power(0.0), 100_000.0);
-        assert_eq!(phong_power(45.0), 0.000_001);
+        assert_eq!(phong_power(90.0), 1.0);
+        // cos(60°)^1 = ½: the exponent is the half-power lobe's.
+        assert!((phong_power(60.0) - 1.0).abs() < 1e-12);
         assert_eq!(super::super::fmt_g(phong_power(6.7)), "101.148");
     }
 }

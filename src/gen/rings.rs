@@ -11,7 +11,7 @@
 //! Size factor `n`: n(n+1)(2n+1)/6 objects of 30 spheres and 30 cylinders, so
 //! 5·n(n+1)(2n+1) of each (30, 150, 420, …, 4200 at 7), plus the wall polygon.
 
-use super::NffWriter;
+use super::{phong_power, NffWriter};
 use glam::DVec3;
 use std::f64::consts::PI;
 
@@ -138,18 +138,6 @@ fn transform_point(v: DVec3, m: &[[f64; 4]; 4]) -> DVec3 {
         v.x * m[0][1] + v.y * m[1][1] + v.z * m[2][1] + m[3][1],
         v.x * m[0][2] + v.y * m[1][2] + v.z * m[2][2] + m[3][2],
     )
-}
-
-/// The SPD's Phong exponent for a highlight that falls to half at `ang` degrees.
-fn phong_power(ang: f64) -> f64 {
-    let r = PI * ang / 180.0;
-    if r <= 0.0 {
-        100000.0
-    } else if r >= PI / 2.0 {
-        1.0
-    } else {
-        0.5f64.ln() / r.cos().ln()
-    }
 }
 
 #[cfg(test)]

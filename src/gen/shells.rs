@@ -58,7 +58,7 @@ pub fn generate(size: u32, w: &mut NffWriter) {
         DVec3::new(1.0, 0.8, 0.4),
         0.8,
         0.2,
-        super::balls::phong_power(10.0),
+        super::phong_power(10.0),
         0.0,
         1.0,
     );

@@ -12,10 +12,10 @@
 use super::NffWriter;
 use glam::DVec3;
 
-/// The SPD program's default size factor: `sombrero.c` sets `size_factor = 1`
-/// (32×32 samples, 1922 triangles). This is the program's own default, not the
-/// largest size under 10,000 primitives, which would be 2 (7938 triangles).
-pub const DEFAULT_SIZE: u32 = 1;
+/// emray's default size factor: the SPD convention of the largest size below 10,000
+/// primitives, 2 (7,938 triangles; size 3 has 31,752). The `sombrero.c` program itself
+/// starts from `size_factor = 1` (1,922 triangles); `-s 1` gives it.
+pub const DEFAULT_SIZE: u32 = 2;
 
 /// The SPD's value of π in this program, truncated as `sombrero.c` writes it (kept so
 /// the heights round exactly as the SPD's do).
@@ -105,7 +105,7 @@ pub fn generate(size: u32, w: &mut NffWriter) {
         DVec3::new(1.0, 0.1, 0.1),
         0.8,
         0.0,
-        super::balls::phong_power(40.0),
+        super::phong_power(40.0),
         0.0,
         1.0,
     );

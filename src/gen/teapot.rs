@@ -18,7 +18,7 @@
 //! so that the printed rounding noise (e.g. normals `1.4538e-15 -1.67359e-15 1`)
 //! comes out the same.
 
-use super::NffWriter;
+use super::{phong_power, NffWriter};
 use glam::DVec3;
 
 /// The SPD program's default size factor.
@@ -541,19 +541,6 @@ pub fn generate(size: u32, w: &mut NffWriter) {
     w.light(DVec3::new(11.3, 5.1, 8.8));
     checkerboard(size, w);
     teapot(size, w);
-}
-
-/// The NFF `Shine` the SPD library derives from the angle (degrees) at which the
-/// highlight falls to half its peak: `cosⁿ(angle) = ½`.
-fn phong_power(angle_deg: f64) -> f64 {
-    let a = std::f64::consts::PI * angle_deg / 180.0;
-    if a <= 0.0 {
-        100000.0
-    } else if a >= std::f64::consts::FRAC_PI_2 {
-        0.000001
-    } else {
-        -(2.0f64.ln() / a.cos().ln())
-    }
 }
 
 /// A material the way the SPD library writes it for NFF: colour, Kd, Ks, Shine (from

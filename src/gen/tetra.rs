@@ -80,7 +80,7 @@ pub fn generate(size: u32, w: &mut NffWriter) {
         DVec3::new(1.0, 0.2, 0.2),
         1.0,
         0.0,
-        super::balls::phong_power(0.0),
+        super::phong_power(0.0),
         0.0,
         0.0,
     );
