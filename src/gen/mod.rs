@@ -338,21 +338,22 @@ impl Database {
         }
     }
 
-    /// The largest size factor emray generates: the largest whose scene still renders
-    /// within 2 GB of memory (measured; see the README).
+    /// The largest size factor emray accepts: the largest whose scene renders in less
+    /// than 2 GB (peak resident memory of `emray render spd:NAME?size=N --res 64x64` on
+    /// the BVH backend, which needs more than Embree; measured, see the README).
     pub fn max_size(self) -> u32 {
         match self {
             Database::Balls => 7,
-            Database::Gears => 40,
-            Database::Jacks => 8,
-            Database::Lattice => 60,
-            Database::Mount => 10,
-            Database::Rings => 60,
-            Database::Shells => 10,
-            Database::Sombrero => 60,
-            Database::Teapot => 100,
-            Database::Tetra => 10,
-            Database::Tree => 20,
+            Database::Gears => 24,
+            Database::Jacks => 7,
+            Database::Lattice => 118,
+            Database::Mount => 11,
+            Database::Rings => 72,
+            Database::Shells => 15,
+            Database::Sombrero => 7,
+            Database::Teapot => 340,
+            Database::Tetra => 11,
+            Database::Tree => 21,
         }
     }
 
