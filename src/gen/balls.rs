@@ -16,6 +16,7 @@
 //! the order the SPD's vector library does, row-vector matrices included, so the
 //! printed numbers are the SPD's to the last digit.
 
+use super::tx::{rotate, rotate_axis, transform_coord_w0, IDENTITY};
 use super::{phong_power, NffWriter};
 use glam::DVec3;
 use std::f64::consts::PI;
@@ -25,77 +26,6 @@ pub const DEFAULT_SIZE: u32 = 4;
 
 /// Ratio of a child's radius to its parent's.
 const CHILD_RATIO: f64 = 1.0 / 3.0;
-
-/// A 4×4 matrix applied to row vectors (`v' = v·M`), as in the SPD's `libvec.c`.
-type Matrix = [[f64; 4]; 4];
-
-fn identity() -> Matrix {
-    let mut m = [[0.0; 4]; 4];
-    for (i, row) in m.iter_mut().enumerate() {
-        row[i] = 1.0;
-    }
-    m
-}
-
-/// Rotation by `angle` about the Y axis.
-fn rotate_y(angle: f64) -> Matrix {
-    let (s, c) = (angle.sin(), angle.cos());
-    let mut m = [[0.0; 4]; 4];
-    m[1][1] = 1.0;
-    m[0][0] = c;
-    m[2][2] = c;
-    m[2][0] = s;
-    m[0][2] = -s;
-    m[3][3] = 1.0;
-    m
-}
-
-/// Rotation by `angle` about the Z axis.
-fn rotate_z(angle: f64) -> Matrix {
-    let (s, c) = (angle.sin(), angle.cos());
-    let mut m = [[0.0; 4]; 4];
-    m[2][2] = 1.0;
-    m[0][0] = c;
-    m[1][1] = c;
-    m[0][1] = s;
-    m[1][0] = -s;
-    m[3][3] = 1.0;
-    m
-}
-
-/// Rotation by `angle` about the unit axis `a`.
-fn rotate_axis(a: DVec3, angle: f64) -> Matrix {
-    let (s, c) = (angle.sin(), angle.cos());
-    let omc = 1.0 - c;
-    [
-        [
-            a.x * a.x + (1.0 - a.x * a.x) * c,
-            a.x * a.y * omc + a.z * s,
-            a.x * a.z * omc - a.y * s,
-            0.0,
-        ],
-        [
-            a.x * a.y * omc - a.z * s,
-            a.y * a.y + (1.0 - a.y * a.y) * c,
-            a.y * a.z * omc + a.x * s,
-            0.0,
-        ],
-        [
-            a.x * a.z * omc + a.y * s,
-            a.y * a.z * omc - a.x * s,
-            a.z * a.z + (1.0 - a.z * a.z) * c,
-            0.0,
-        ],
-        [0.0, 0.0, 0.0, 1.0],
-    ]
-}
-
-/// The direction `v` (homogeneous w = 0) times `m`, every term added as the SPD's
-/// `lib_transform_coord` does (the zero w term included: it turns −0 into +0).
-fn transform_dir(v: DVec3, m: &Matrix) -> DVec3 {
-    let col = |j: usize| v.x * m[0][j] + v.y * m[1][j] + v.z * m[2][j] + 0.0 * m[3][j];
-    DVec3::new(col(0), col(1), col(2))
-}
 
 /// `v / |v|`, or `v` unchanged when it is zero (`lib_normalize_vector`).
 fn normalize(v: DVec3) -> DVec3 {
@@ -128,12 +58,12 @@ fn child_directions() -> [DVec3; 9] {
         normalize(DVec3::new(1.0, -1.0, 0.0)),
         (2.0 / 6.0f64.sqrt()).asin(),
     );
-    let trio = trio.map(|v| transform_dir(v, &tilt));
+    let trio = trio.map(|v| transform_coord_w0(v, &tilt));
     let mut out = [DVec3::ZERO; 9];
     for set in 0..3 {
-        let m = rotate_z(set as f64 * 2.0 * PI / 3.0);
+        let m = rotate(2, set as f64 * 2.0 * PI / 3.0);
         for (k, v) in trio.iter().enumerate() {
-            out[set * 3 + k] = transform_dir(*v, &m);
+            out[set * 3 + k] = transform_coord_w0(*v, &m);
         }
     }
     out
@@ -185,9 +115,9 @@ fn grow(
     }
     // The rotation taking +Z to `dir` (the SPD allows for `dir` being a hair short).
     let m = if dir.z >= 0.9999 {
-        identity()
+        IDENTITY
     } else if dir.z <= -0.9999 {
-        rotate_y(PI)
+        rotate(1, PI)
     } else {
         let z = DVec3::new(0.0, 0.0, 1.0);
         let axis = normalize(cross(z, dir));
@@ -196,7 +126,7 @@ fn grow(
     };
     let scale = radius * (1.0 + CHILD_RATIO);
     for d in dirs {
-        let t = transform_dir(*d, &m);
+        let t = transform_coord_w0(*d, &m);
         let c = DVec3::new(
             t.x * scale + center.x,
             t.y * scale + center.y,

@@ -11,6 +11,7 @@
 //! A jack is 3 cylinders and 6 spheres; size factor `n` nests `n` levels deep, so there
 //! are (8ⁿ − 1)/7 jacks: 9·(8ⁿ − 1)/7 primitives (9, 81, 657, 5265, 42129, …).
 
+use super::tx::{multiply, Matrix, IDENTITY};
 use super::{phong_power, NffWriter};
 use glam::DVec3;
 use std::f64::consts::PI;
@@ -87,31 +88,10 @@ fn jack(tx: &mut TxStack, w: &mut NffWriter) {
     tx.pop();
 }
 
-/// A 4×4 matrix in the SPD's row-vector convention (translation in the last row).
-type Mat = [[f64; 4]; 4];
-
-const IDENTITY: Mat = [
-    [1.0, 0.0, 0.0, 0.0],
-    [0.0, 1.0, 0.0, 0.0],
-    [0.0, 0.0, 1.0, 0.0],
-    [0.0, 0.0, 0.0, 1.0],
-];
-
-/// `a · b`, each element summed left to right as the SPD's `lib_matrix_multiply`.
-fn mul(a: &Mat, b: &Mat) -> Mat {
-    let mut m = [[0.0; 4]; 4];
-    for (i, row) in m.iter_mut().enumerate() {
-        for (j, e) in row.iter_mut().enumerate() {
-            *e = a[i][0] * b[0][j] + a[i][1] * b[1][j] + a[i][2] * b[2][j] + a[i][3] * b[3][j];
-        }
-    }
-    m
-}
-
 /// The SPD's transformation stack.
 struct TxStack {
-    current: Mat,
-    saved: Vec<Mat>,
+    current: Matrix,
+    saved: Vec<Matrix>,
 }
 
 impl TxStack {
@@ -131,8 +111,8 @@ impl TxStack {
     }
 
     /// Apply `m` before everything already on the stack.
-    fn prepend(&mut self, m: &Mat) {
-        self.current = mul(m, &self.current);
+    fn prepend(&mut self, m: &Matrix) {
+        self.current = multiply(m, &self.current);
     }
 
     fn rotate_x(&mut self, angle: f64) {

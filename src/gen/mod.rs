@@ -16,6 +16,7 @@ mod sombrero;
 mod teapot;
 mod tetra;
 mod tree;
+mod tx;
 
 use glam::DVec3;
 use std::fmt::Write;

@@ -14,6 +14,7 @@
 //! comparability even though it repeats itself (the SPD README: version 2.4 fixed it,
 //! 3.x made the fix optional).
 
+use super::tx::{rotate, rotate_axis, transform_vector};
 use super::{phong_power, NffWriter};
 use glam::DVec3;
 use std::f64::consts::PI;
@@ -67,56 +68,6 @@ pub(crate) fn gauss_rand(seed: i64) -> f64 {
     }
 }
 
-type Matrix = [[f64; 4]; 4];
-
-/// Rotation by `angle` radians about the unit `axis` (row-vector convention).
-fn axis_rotate_matrix(axis: DVec3, angle: f64) -> Matrix {
-    let (c, s) = (angle.cos(), angle.sin());
-    let omc = 1.0 - c;
-    let (x, y, z) = (axis.x, axis.y, axis.z);
-    [
-        [
-            x * x + (1.0 - x * x) * c,
-            x * y * omc + z * s,
-            x * z * omc - y * s,
-            0.0,
-        ],
-        [
-            x * y * omc - z * s,
-            y * y + (1.0 - y * y) * c,
-            y * z * omc + x * s,
-            0.0,
-        ],
-        [
-            x * z * omc + y * s,
-            y * z * omc - x * s,
-            z * z + (1.0 - z * z) * c,
-            0.0,
-        ],
-        [0.0, 0.0, 0.0, 1.0],
-    ]
-}
-
-/// Rotation by `angle` radians about the Z axis (row-vector convention).
-fn z_rotate_matrix(angle: f64) -> Matrix {
-    let (c, s) = (angle.cos(), angle.sin());
-    [
-        [c, s, 0.0, 0.0],
-        [-s, c, 0.0, 0.0],
-        [0.0, 0.0, 1.0, 0.0],
-        [0.0, 0.0, 0.0, 1.0],
-    ]
-}
-
-/// `v · M` for a direction (no translation).
-fn transform_vector(v: DVec3, m: &Matrix) -> DVec3 {
-    DVec3::new(
-        v.x * m[0][0] + v.y * m[1][0] + v.z * m[2][0],
-        v.x * m[0][1] + v.y * m[1][1] + v.z * m[2][1],
-        v.x * m[0][2] + v.y * m[1][2] + v.z * m[2][2],
-    )
-}
-
 /// The pyramid of four spheres of radius `radius` resting around `center`: one on
 /// top, three below it spaced 120° apart, each touching the top one.
 fn create_spheres(w: &mut NffWriter, center: DVec3, radius: f64) {
@@ -131,9 +82,9 @@ fn create_spheres(w: &mut NffWriter, center: DVec3, radius: f64) {
         radius,
     );
 
-    let new_pt = transform_vector(pt, &axis_rotate_matrix(axis, angle));
+    let new_pt = transform_vector(pt, &rotate_axis(axis, angle));
     for i in 0..3 {
-        let mx = z_rotate_matrix(f64::from(i) * 2.0 * PI / 3.0);
+        let mx = rotate(2, f64::from(i) * 2.0 * PI / 3.0);
         let p = transform_vector(new_pt, &mx);
         w.sphere(
             DVec3::new(p.x + center.x, p.y + center.y, p.z + center.z),

@@ -11,6 +11,7 @@
 //! Size factor `n`: n(n+1)(2n+1)/6 objects of 30 spheres and 30 cylinders, so
 //! 5·n(n+1)(2n+1) of each (30, 150, 420, …, 4200 at 7), plus the wall polygon.
 
+use super::tx::{rotate, transform_point};
 use super::{phong_power, NffWriter};
 use glam::DVec3;
 use std::f64::consts::PI;
@@ -97,47 +98,17 @@ fn ring_points(minor_radius: f64) -> [DVec3; 30] {
     }
     // The angle between two adjacent dodecahedron faces.
     let x_rotation = 2.0 * ((PI / 3.0).cos() / (PI / 5.0).sin()).acos();
-    let xm = rotation(0, x_rotation);
+    let xm = rotate(0, x_rotation);
     for pentagon in 1..6 {
         // 1/10th plus N fifths of the way around.
         let z_rotation = PI * (2.0 * (pentagon - 1) as f64 + 1.0) / 5.0;
-        let zm = rotation(2, z_rotation);
+        let zm = rotate(2, z_rotation);
         for i in 0..5 {
             let t = transform_point(v[i], &xm);
             v[5 * pentagon + i] = transform_point(t, &zm);
         }
     }
     v
-}
-
-/// The SPD's rotation matrix about axis 0 (X) or 2 (Z), row-vector convention.
-fn rotation(axis: usize, angle: f64) -> [[f64; 4]; 4] {
-    let (s, c) = (angle.sin(), angle.cos());
-    let mut m = [[0.0; 4]; 4];
-    if axis == 0 {
-        m[0][0] = 1.0;
-        m[1][1] = c;
-        m[2][2] = c;
-        m[1][2] = s;
-        m[2][1] = -s;
-    } else {
-        m[2][2] = 1.0;
-        m[0][0] = c;
-        m[1][1] = c;
-        m[0][1] = s;
-        m[1][0] = -s;
-    }
-    m[3][3] = 1.0;
-    m
-}
-
-/// `lib_transform_point`: row vector times matrix, plus the translation row.
-fn transform_point(v: DVec3, m: &[[f64; 4]; 4]) -> DVec3 {
-    DVec3::new(
-        v.x * m[0][0] + v.y * m[1][0] + v.z * m[2][0] + m[3][0],
-        v.x * m[0][1] + v.y * m[1][1] + v.z * m[2][1] + m[3][1],
-        v.x * m[0][2] + v.y * m[1][2] + v.z * m[2][2] + m[3][2],
-    )
 }
 
 #[cfg(test)]

@@ -12,6 +12,7 @@
 //! from depth `size` down to 0, so size factor `n` gives `2ⁿ⁺¹ − 1` cones and as many
 //! spheres (4095 of each at the default 11), plus the one field polygon.
 
+use super::tx::{multiply, rotate, transform_point, Matrix, IDENTITY};
 use super::NffWriter;
 use glam::DVec3;
 use std::f64::consts::PI;
@@ -31,66 +32,12 @@ const DIV_ANGLE: f64 = 140.0;
 /// Base radius of a branch of unit scale.
 const WIDTH_HEIGHT_RATIO: f64 = 0.15;
 
-/// A 4×4 matrix acting on row vectors (`p' = p · M`, translation in row 3), as in the
-/// SPD library.
-type Matrix = [[f64; 4]; 4];
-
-const IDENTITY: Matrix = [
-    [1.0, 0.0, 0.0, 0.0],
-    [0.0, 1.0, 0.0, 0.0],
-    [0.0, 0.0, 1.0, 0.0],
-    [0.0, 0.0, 0.0, 1.0],
-];
-
-/// `a · b`, each element summed in the library's order (all four products, zeros
-/// included, so signs of zero and rounding match).
-fn multiply(a: &Matrix, b: &Matrix) -> Matrix {
-    let mut r = [[0.0; 4]; 4];
-    for (i, row) in r.iter_mut().enumerate() {
-        for (j, x) in row.iter_mut().enumerate() {
-            *x = a[i][0] * b[0][j] + a[i][1] * b[1][j] + a[i][2] * b[2][j] + a[i][3] * b[3][j];
-        }
-    }
-    r
-}
-
-/// Rotation by `angle` radians about the X axis.
-fn x_rotate_matrix(angle: f64) -> Matrix {
-    let (c, s) = (angle.cos(), angle.sin());
-    [
-        [1.0, 0.0, 0.0, 0.0],
-        [0.0, c, s, 0.0],
-        [0.0, -s, c, 0.0],
-        [0.0, 0.0, 0.0, 1.0],
-    ]
-}
-
-/// Rotation by `angle` radians about the Z axis.
-fn z_rotate_matrix(angle: f64) -> Matrix {
-    let (c, s) = (angle.cos(), angle.sin());
-    [
-        [c, s, 0.0, 0.0],
-        [-s, c, 0.0, 0.0],
-        [0.0, 0.0, 1.0, 0.0],
-        [0.0, 0.0, 0.0, 1.0],
-    ]
-}
-
-/// The point `p` through `m`.
-fn transform_point(p: DVec3, m: &Matrix) -> DVec3 {
-    DVec3::new(
-        p.x * m[0][0] + p.y * m[1][0] + p.z * m[2][0] + m[3][0],
-        p.x * m[0][1] + p.y * m[1][1] + p.z * m[2][1] + m[3][1],
-        p.x * m[0][2] + p.y * m[1][2] + p.z * m[2][2] + m[3][2],
-    )
-}
-
 /// The two child frames relative to their parent's.
 fn branch_matrices() -> [Matrix; 2] {
     let divergence = [90.0, DIV_ANGLE + 90.0];
     std::array::from_fn(|i| {
-        let rx = x_rotate_matrix(BR_ANGLE[i] * PI / 180.0);
-        let rz = z_rotate_matrix(divergence[i] * PI / 180.0);
+        let rx = rotate(0, BR_ANGLE[i] * PI / 180.0);
+        let rz = rotate(2, divergence[i] * PI / 180.0);
         let rotate = multiply(&rx, &rz);
         let c = BR_CONTR[i];
         let mut scale_translate = IDENTITY;
