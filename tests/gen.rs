@@ -72,13 +72,7 @@ fn databases_render_on_every_backend() {
             films.push(film);
         }
         if let [a, b] = &films[..] {
-            let pa = emray::output::to_rgb8(a, emray::output::Encoding::Srgb);
-            let pb = emray::output::to_rgb8(b, emray::output::Encoding::Srgb);
-            let differ = pa
-                .chunks(3)
-                .zip(pb.chunks(3))
-                .filter(|(x, y)| x != y)
-                .count();
+            let differ = emray::output::differing_pixels(a, b);
             assert!(
                 differ <= 1,
                 "{}: {differ} pixels differ between backends",

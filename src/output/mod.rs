@@ -84,6 +84,21 @@ pub fn to_rgb8(film: &Film, encoding: Encoding) -> Vec<u8> {
     out
 }
 
+/// How many pixels differ between two films of the same size once encoded as 8-bit
+/// sRGB (what a viewer of the PNGs would see).
+pub fn differing_pixels(a: &Film, b: &Film) -> usize {
+    assert_eq!(
+        (a.width, a.height),
+        (b.width, b.height),
+        "films of different sizes"
+    );
+    let (pa, pb) = (to_rgb8(a, Encoding::Srgb), to_rgb8(b, Encoding::Srgb));
+    pa.chunks(3)
+        .zip(pb.chunks(3))
+        .filter(|(x, y)| x != y)
+        .count()
+}
+
 /// Write `film` to `path` (format by extension) through a temporary file and a rename.
 pub fn write_image(path: &Path, film: &Film, encoding: Encoding) -> Result<(), OutputError> {
     let format = Format::from_path(path)?;
