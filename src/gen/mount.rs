@@ -187,14 +187,19 @@ pub fn generate(size: u32, w: &mut NffWriter) {
         0.0,
         0.0,
     );
+    for_each_triangle(size, |t| w.polygon(&t));
+}
+
+/// Subdivide the flat square into the fractal mountain at size factor `size`, passing
+/// each triangle to `emit` in the SPD's order.
+fn for_each_triangle(size: u32, emit: impl FnMut([DVec3; 3])) {
     let num_pts: i64 = 1 << size;
     let ratio = 2.0 / (2.0f64.ln() / (FRACTAL_DIMENSION - 1.0)).exp();
-    let roughness = (ratio * ratio - 1.0).sqrt();
     let mut m = Mountain {
-        emit: |t: [DVec3; 3]| w.polygon(&t),
+        emit,
         fnum_pts: num_pts as f64,
         size,
-        roughness,
+        roughness: (ratio * ratio - 1.0).sqrt(),
     };
     let flat = Corners {
         ll: 0.0,
@@ -220,21 +225,7 @@ mod tests {
     /// The mountain's triangles at size factor `size`, in full precision.
     fn mountain(size: u32) -> Vec<[DVec3; 3]> {
         let mut tris = Vec::new();
-        let num_pts: i64 = 1 << size;
-        let ratio = 2.0 / (2.0f64.ln() / (FRACTAL_DIMENSION - 1.0)).exp();
-        let mut m = Mountain {
-            emit: |t| tris.push(t),
-            fnum_pts: num_pts as f64,
-            size,
-            roughness: (ratio * ratio - 1.0).sqrt(),
-        };
-        let flat = Corners {
-            ll: 0.0,
-            lr: 0.0,
-            ur: 0.0,
-            ul: 0.0,
-        };
-        m.grow(num_pts, 0, 0, flat);
+        for_each_triangle(size, |t| tris.push(t));
         tris
     }
 
