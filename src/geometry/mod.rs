@@ -43,6 +43,55 @@ pub struct SurfacePoint {
     pub ng: Vec3,
 }
 
+/// The interface of every analytic primitive: both backends call exactly these (the
+/// BVH from its leaves, Embree from its user-geometry callbacks).
+///
+/// Rays need not have unit directions: instances transform rays into object space
+/// without renormalising, and `t` must stay in the units of `ray.dir`.
+pub trait Intersect {
+    /// Conservative bounds. Unbounded primitives (the infinite plane, unclipped
+    /// quadrics that are not ellipsoids) return bounds with infinite coordinates; the
+    /// backends keep those out of their hierarchies (see [`Aabb::is_finite`]).
+    fn bounds(&self) -> Aabb;
+    /// The nearest hit with `t` in `(ray.tmin, ray.tmax)`, from either side of the
+    /// surface; `ng` points out of the solid (or along the primitive's front side).
+    fn intersect(&self, ray: &Ray) -> Option<ShapeHit>;
+    /// Whether any hit lies in `(ray.tmin, ray.tmax)`.
+    fn occluded(&self, ray: &Ray) -> bool {
+        self.intersect(ray).is_some()
+    }
+    /// The accurate hit point for a hit this primitive reported for `ray`, with a
+    /// per-axis bound on its error and the unit outward geometric normal.
+    fn surface(&self, ray: &Ray, hit: &ShapeHit) -> SurfacePoint;
+}
+
+/// One stretch of a ray's line inside a solid: from `t_in` (entering, outward normal
+/// `n_in`) to `t_out` (leaving, outward normal `n_out`), `t_in <= t_out`. Either end
+/// may be infinite only for solids that are unbounded along the line.
+#[derive(Clone, Copy, Debug, PartialEq)]
+pub struct Span {
+    /// Parameter where the line enters.
+    pub t_in: f32,
+    /// Outward normal (not necessarily unit) at the entry.
+    pub n_in: Vec3,
+    /// Parameter where the line leaves.
+    pub t_out: f32,
+    /// Outward normal (not necessarily unit) at the exit.
+    pub n_out: Vec3,
+}
+
+/// A short list of spans, sorted by `t_in` and disjoint; inline up to four.
+pub type Spans = smallvec::SmallVec<[Span; 4]>;
+
+/// A closed solid usable in CSG: it can list every stretch of a line inside it.
+pub trait Solid: Intersect {
+    /// Append to `out`, sorted and disjoint, every span where the whole line
+    /// `ray.org + t·ray.dir`, `t ∈ (−∞, ∞)`, is inside the solid (ignoring `tmin`/`tmax`).
+    fn spans(&self, ray: &Ray, out: &mut Spans);
+    /// Whether point `p` is inside (boundary points may go either way).
+    fn contains(&self, p: Vec3) -> bool;
+}
+
 /// The primitive kinds. The discriminant is the geometry id both backends report in
 /// [`crate::Hit::geom_id`].
 #[derive(Clone, Copy, Debug, PartialEq, Eq, Hash, PartialOrd, Ord)]
@@ -157,5 +206,39 @@ pub(crate) fn quadratic_roots(a: f32, b: f32, c: f32, disc: f32) -> (f32, f32) {
         (r_cq, r_qa)
     } else {
         (r_qa, r_cq)
+    }
+}
+
+impl Intersect for Sphere {
+    fn bounds(&self) -> Aabb {
+        Sphere::bounds(self)
+    }
+    #[inline]
+    fn intersect(&self, ray: &Ray) -> Option<ShapeHit> {
+        Sphere::intersect(self, ray)
+    }
+    #[inline]
+    fn occluded(&self, ray: &Ray) -> bool {
+        Sphere::occluded(self, ray)
+    }
+    fn surface(&self, ray: &Ray, hit: &ShapeHit) -> SurfacePoint {
+        Sphere::surface(self, ray, hit.t)
+    }
+}
+
+impl Intersect for Cone {
+    fn bounds(&self) -> Aabb {
+        Cone::bounds(self)
+    }
+    #[inline]
+    fn intersect(&self, ray: &Ray) -> Option<ShapeHit> {
+        Cone::intersect(self, ray)
+    }
+    #[inline]
+    fn occluded(&self, ray: &Ray) -> bool {
+        Cone::occluded(self, ray)
+    }
+    fn surface(&self, ray: &Ray, hit: &ShapeHit) -> SurfacePoint {
+        Cone::surface(self, ray, hit.t)
     }
 }

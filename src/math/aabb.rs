@@ -30,7 +30,18 @@ impl Aabb {
         }
     }
 
-    /// True when the box contains no point.
+    /// True when every coordinate is finite (an empty box is not).
+    pub fn is_finite(&self) -> bool {
+        self.min.is_finite() && self.max.is_finite()
+    }
+
+    /// All of space: the bounds of unbounded primitives.
+    pub const INFINITE: Aabb = Aabb {
+        min: Vec3::splat(f32::NEG_INFINITY),
+        max: Vec3::splat(f32::INFINITY),
+    };
+
+    /// True when the box has no points (`min > max` on some axis).
     pub fn is_empty(&self) -> bool {
         self.min.x > self.max.x || self.min.y > self.max.y || self.min.z > self.max.z
     }
