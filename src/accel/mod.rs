@@ -22,9 +22,16 @@ pub struct Hit {
     pub u: f32,
     /// Second surface parameter (triangles: barycentric weight of vertex 2).
     pub v: f32,
-    /// Geometric normal, not normalised; for triangles `(p1 − p0) × (p2 − p0)`.
+    /// Geometric normal, not normalised; for triangles `(p1 − p0) × (p2 − p0)`. In the
+    /// object space of the instance for instanced hits.
     pub ng: Vec3,
+    /// Index of the instance hit ([`crate::scene::Scene::instances`]), or
+    /// [`NO_INSTANCE`] for top-level primitives.
+    pub inst_id: u32,
 }
+
+/// [`Hit::inst_id`] of a top-level primitive.
+pub const NO_INSTANCE: u32 = u32::MAX;
 
 impl Hit {
     /// The primitive kind hit.

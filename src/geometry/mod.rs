@@ -7,16 +7,19 @@
 //! tests to bound the f32 error.
 
 mod cone;
+pub mod csg;
 pub mod polygon;
 pub mod reference;
 mod sphere;
 mod triangle;
 
 pub use cone::Cone;
+pub use csg::{Csg, CsgOp, CsgTree};
 pub use sphere::Sphere;
 pub use triangle::{Triangle, WatertightRay};
 
 use crate::math::{Aabb, Ray, Vec3};
+use std::sync::Arc;
 
 /// What an intersector reports: the distance, two surface parameters and the
 /// (unnormalised) geometric normal, which for closed shapes points outwards.
@@ -97,40 +100,69 @@ pub trait Solid: Intersect {
 #[derive(Clone, Copy, Debug, PartialEq, Eq, Hash, PartialOrd, Ord)]
 #[repr(u32)]
 pub enum Kind {
-    /// Triangles (from NFF `p` and `pp`).
+    /// Triangles (NFF `p` and `pp`, meshes, tessellated patches).
     Triangle = 0,
     /// Spheres (NFF `s`).
     Sphere = 1,
     /// Open cones and cylinders (NFF `c`).
     Cone = 2,
+    /// Constructive solid geometry roots.
+    Csg = 3,
 }
 
 impl Kind {
     /// All kinds in geometry-id order.
-    pub const ALL: [Kind; 3] = [Kind::Triangle, Kind::Sphere, Kind::Cone];
+    pub const ALL: [Kind; 4] = [Kind::Triangle, Kind::Sphere, Kind::Cone, Kind::Csg];
 
     /// The kind with geometry id `id`.
     pub fn from_id(id: u32) -> Option<Kind> {
         Kind::ALL.get(id as usize).copied()
     }
 
-    /// Plural name used in statistics (`triangles`, `spheres`, `cones`).
+    /// Plural name used in statistics (`triangles`, `spheres`, `cones`, ...).
     pub fn name(self) -> &'static str {
         match self {
             Kind::Triangle => "triangles",
             Kind::Sphere => "spheres",
             Kind::Cone => "cones",
+            Kind::Csg => "csg",
+        }
+    }
+
+    /// Singular name for messages.
+    pub fn singular(self) -> &'static str {
+        match self {
+            Kind::Triangle => "triangle",
+            Kind::Sphere => "sphere",
+            Kind::Cone => "open cone",
+            Kind::Csg => "CSG solid",
         }
     }
 }
 
 /// An analytic primitive, intersected by user geometry on Embree.
-#[derive(Clone, Copy, Debug, PartialEq)]
+#[derive(Clone, Debug, PartialEq)]
 pub enum Shape {
     /// A sphere.
     Sphere(Sphere),
     /// An open cone or cylinder.
     Cone(Cone),
+    /// A CSG root.
+    Csg(Arc<Csg>),
+}
+
+/// Call `$f` on the primitive inside any [`Shape`].
+macro_rules! dispatch {
+    ($shape:expr, $s:ident => $e:expr) => {
+        match $shape {
+            Shape::Sphere($s) => $e,
+            Shape::Cone($s) => $e,
+            Shape::Csg(c) => {
+                let $s: &Csg = c;
+                $e
+            }
+        }
+    };
 }
 
 impl Shape {
@@ -139,41 +171,56 @@ impl Shape {
         match self {
             Shape::Sphere(_) => Kind::Sphere,
             Shape::Cone(_) => Kind::Cone,
+            Shape::Csg(_) => Kind::Csg,
         }
     }
 
-    /// Conservative bounds.
-    pub fn bounds(&self) -> Aabb {
+    /// Whether this is a closed solid (usable as a CSG operand).
+    pub fn is_solid(&self) -> bool {
         match self {
-            Shape::Sphere(s) => s.bounds(),
-            Shape::Cone(c) => c.bounds(),
+            Shape::Sphere(s) => !s.inside_only,
+            Shape::Cone(_) => false,
+            Shape::Csg(_) => true,
         }
     }
 
-    /// The nearest hit in `(ray.tmin, ray.tmax)`.
+    /// Append the spans of the whole line inside the solid (nothing for open surfaces).
     #[inline]
-    pub fn intersect(&self, ray: &Ray) -> Option<ShapeHit> {
+    pub fn spans(&self, ray: &Ray, out: &mut Spans) {
         match self {
-            Shape::Sphere(s) => s.intersect(ray),
-            Shape::Cone(c) => c.intersect(ray),
+            Shape::Sphere(s) => s.spans(ray, out),
+            Shape::Cone(_) => {}
+            Shape::Csg(c) => c.spans(ray, out),
         }
     }
 
-    /// Whether any hit lies in `(ray.tmin, ray.tmax)`.
+    /// Whether `p` is inside the solid (false for open surfaces).
+    pub fn contains(&self, p: Vec3) -> bool {
+        match self {
+            Shape::Sphere(s) => s.contains(p),
+            Shape::Cone(_) => false,
+            Shape::Csg(c) => c.contains(p),
+        }
+    }
+}
+
+impl Intersect for Shape {
+    fn bounds(&self) -> Aabb {
+        dispatch!(self, s => Intersect::bounds(s))
+    }
+
     #[inline]
-    pub fn occluded(&self, ray: &Ray) -> bool {
-        match self {
-            Shape::Sphere(s) => s.occluded(ray),
-            Shape::Cone(c) => c.occluded(ray),
-        }
+    fn intersect(&self, ray: &Ray) -> Option<ShapeHit> {
+        dispatch!(self, s => Intersect::intersect(s, ray))
     }
 
-    /// The accurate hit point for a hit at `t`.
-    pub fn surface(&self, ray: &Ray, t: f32) -> SurfacePoint {
-        match self {
-            Shape::Sphere(s) => s.surface(ray, t),
-            Shape::Cone(c) => c.surface(ray, t),
-        }
+    #[inline]
+    fn occluded(&self, ray: &Ray) -> bool {
+        dispatch!(self, s => Intersect::occluded(s, ray))
+    }
+
+    fn surface(&self, ray: &Ray, hit: &ShapeHit) -> SurfacePoint {
+        dispatch!(self, s => Intersect::surface(s, ray, hit))
     }
 }
 
@@ -240,5 +287,24 @@ impl Intersect for Cone {
     }
     fn surface(&self, ray: &Ray, hit: &ShapeHit) -> SurfacePoint {
         Cone::surface(self, ray, hit.t)
+    }
+}
+
+impl Solid for Sphere {
+    fn spans(&self, ray: &Ray, out: &mut Spans) {
+        if let Some((t0, t1)) = self.roots(ray) {
+            if t0 <= t1 {
+                out.push(Span {
+                    t_in: t0,
+                    n_in: ray.at(t0) - self.center,
+                    t_out: t1,
+                    n_out: ray.at(t1) - self.center,
+                });
+            }
+        }
+    }
+
+    fn contains(&self, p: Vec3) -> bool {
+        (p - self.center).length_squared() <= self.radius * self.radius
     }
 }

@@ -37,7 +37,7 @@ impl Sphere {
     /// (Haines et al., Ray Tracing Gems ch. 7: the discriminant from the distance between
     /// the centre and the line, which does not cancel).
     #[inline]
-    fn roots(&self, ray: &Ray) -> Option<(f32, f32)> {
+    pub(crate) fn roots(&self, ray: &Ray) -> Option<(f32, f32)> {
         let f = ray.org - self.center;
         let a = ray.dir.dot(ray.dir);
         let b = f.dot(ray.dir);

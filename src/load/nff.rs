@@ -448,7 +448,7 @@ impl<'a> Parser<'a, '_> {
         } else {
             Vec3::ZERO // set in `finish` once the number of lights is known
         };
-        self.lights.push(Light { pos, color });
+        self.lights.push(Light::point(pos, color));
         self.light_has_color.push(has_color);
         Ok(())
     }
@@ -466,8 +466,10 @@ impl<'a> Parser<'a, '_> {
             kd,
             ks,
             shine,
+            kr: ks,
             t,
             ior,
+            priority: 0,
         });
         self.current_material = Some(self.materials.len() as u32 - 1);
         Ok(())

@@ -175,7 +175,7 @@ impl<'a, A: Accel> Tracer<'a, A> {
         if depth >= self.max_depth {
             return color;
         }
-        let mut reflect_weight = m.ks;
+        let mut reflect_weight = m.kr;
         if m.t > 0.0 {
             // Snell's law; the medium is decided by the geometric normal's side.
             let eta = if entering { 1.0 / m.ior } else { m.ior };

@@ -1,8 +1,11 @@
 //! The backend-free scene: camera, lights, materials and primitives. No I/O here; the
 //! loaders in [`crate::load`] build it and the backends in [`crate::accel`] read it.
 
-use crate::geometry::{Cone, Kind, Shape, Sphere, SurfacePoint, Triangle};
-use crate::math::{Ray, Vec3};
+use crate::accel::NO_INSTANCE;
+use crate::geometry::{
+    Cone, Csg, Intersect, Kind, Shape, ShapeHit, Sphere, SurfacePoint, Triangle,
+};
+use crate::math::{Aabb, Ray, Vec3, Xform};
 use crate::Hit;
 
 /// The NFF viewpoint (`v`): see DESIGN.md §3 for the exact ray construction.
@@ -25,16 +28,68 @@ pub struct Camera {
     pub height: u32,
 }
 
-/// A point light.
+/// A point light, optionally a spot light, with OpenGL-style distance attenuation.
 #[derive(Clone, Copy, Debug, PartialEq)]
 pub struct Light {
     /// Position.
     pub pos: Vec3,
     /// Intensity per channel.
     pub color: Vec3,
+    /// Spot-light cone, if any.
+    pub spot: Option<Spot>,
+    /// Constant, linear and quadratic attenuation coefficients: the intensity at
+    /// distance `d` is divided by `c + l·d + q·d²`. `(1, 0, 0)`: none (NFF lights).
+    pub attenuation: Vec3,
 }
 
-/// NFF fill material (`f r g b Kd Ks Shine T ior`).
+/// The cone of a spot light (OpenGL's `GL_SPOT_*` model).
+#[derive(Clone, Copy, Debug, PartialEq)]
+pub struct Spot {
+    /// Unit direction the spot points to.
+    pub dir: Vec3,
+    /// Cosine of the cutoff half-angle: no light outside the cone.
+    pub cos_cutoff: f32,
+    /// Falloff exponent: inside the cone, intensity × `cos(angle)^exponent`.
+    pub exponent: f32,
+}
+
+impl Light {
+    /// A point light without attenuation (NFF's `l`).
+    pub fn point(pos: Vec3, color: Vec3) -> Light {
+        Light {
+            pos,
+            color,
+            spot: None,
+            attenuation: Vec3::X,
+        }
+    }
+
+    /// The light's intensity arriving at `p` (before shadowing and the surface's
+    /// response): colour × attenuation × spot factor.
+    #[inline]
+    pub fn intensity_at(&self, p: Vec3) -> Vec3 {
+        let mut k = 1.0;
+        if self.attenuation != Vec3::X {
+            let d = (p - self.pos).length();
+            let a = self.attenuation;
+            k /= a.x + a.y * d + a.z * d * d;
+        }
+        if let Some(spot) = &self.spot {
+            let c = (p - self.pos).normalize_or_zero().dot(spot.dir);
+            if c < spot.cos_cutoff {
+                return Vec3::ZERO;
+            }
+            if spot.exponent != 0.0 {
+                k *= c.max(0.0).powf(spot.exponent);
+            }
+        }
+        self.color * k
+    }
+}
+
+/// A Whitted material (NFF's `f r g b Kd Ks Shine T ior`, extended by the scene format
+/// with its own ambient weight, a mirror reflectance apart from the highlight and a
+/// priority for nested dielectrics).
 #[derive(Clone, Copy, Debug, PartialEq)]
 pub struct Material {
     /// Surface colour.
@@ -43,14 +98,20 @@ pub struct Material {
     pub ka: f32,
     /// Diffuse weight.
     pub kd: f32,
-    /// Phong highlight weight and mirror reflectance.
+    /// Phong highlight weight.
     pub ks: f32,
     /// Phong exponent.
     pub shine: f32,
+    /// Mirror reflectance: the weight of the reflected ray (NFF: Ks).
+    pub kr: f32,
     /// Transmittance: the weight of the refracted ray.
     pub t: f32,
     /// Index of refraction.
     pub ior: f32,
+    /// Nested-dielectric priority (Schmidt & Budge 2002): where transmissive solids
+    /// overlap, the one with the highest priority is the medium, and the surfaces of
+    /// the others inside it are skipped. Equal priorities: every surface counts.
+    pub priority: u32,
 }
 
 impl Default for Material {
@@ -62,8 +123,10 @@ impl Default for Material {
             kd: 1.0,
             ks: 0.0,
             shine: 0.0,
+            kr: 0.0,
             t: 0.0,
             ior: 1.0,
+            priority: 0,
         }
     }
 }
@@ -113,6 +176,37 @@ pub struct LoadStats {
     pub degenerate_dropped: usize,
 }
 
+/// Primitives: the top level of a scene, or an object that instances place.
+#[derive(Clone, Debug, Default, PartialEq)]
+pub struct Geometry {
+    /// Triangles.
+    pub triangles: Prims<Triangle>,
+    /// Per triangle: index into `vertex_normals`, or `u32::MAX` for flat shading.
+    pub triangle_normals: Vec<u32>,
+    /// Per-vertex shading normals of smooth triangles.
+    pub vertex_normals: Vec<[Vec3; 3]>,
+    /// Spheres.
+    pub spheres: Prims<Sphere>,
+    /// Open cones and cylinders.
+    pub cones: Prims<Cone>,
+    /// Every other analytic primitive (any order; `Kind` from [`Shape::kind`]).
+    pub shapes: Prims<Shape>,
+}
+
+/// Material index meaning "the material of the instance that places this object".
+pub const INHERIT: u32 = u32::MAX;
+
+/// An object placed in the scene under an affine transform.
+#[derive(Clone, Debug, PartialEq)]
+pub struct Instance {
+    /// Index into [`Scene::objects`].
+    pub object: u32,
+    /// Object to world.
+    pub xform: Xform,
+    /// Material of the object's primitives whose material is [`INHERIT`].
+    pub material: u32,
+}
+
 /// A whole scene.
 #[derive(Clone, Debug, PartialEq)]
 pub struct Scene {
@@ -126,18 +220,28 @@ pub struct Scene {
     pub ambient: Vec3,
     /// Materials, indexed by the primitives.
     pub materials: Vec<Material>,
-    /// Triangles.
-    pub triangles: Prims<Triangle>,
-    /// Per triangle: index into `vertex_normals`, or `u32::MAX` for flat shading.
-    pub triangle_normals: Vec<u32>,
-    /// Per-vertex shading normals of smooth (`pp`) triangles.
-    pub vertex_normals: Vec<[Vec3; 3]>,
-    /// Spheres.
-    pub spheres: Prims<Sphere>,
-    /// Open cones and cylinders.
-    pub cones: Prims<Cone>,
+    /// The top-level primitives (also reachable as `scene.triangles` etc. through
+    /// `Deref`).
+    pub geometry: Geometry,
+    /// Objects that [`Scene::instances`] place (one level of instancing).
+    pub objects: Vec<Geometry>,
+    /// Placed objects.
+    pub instances: Vec<Instance>,
     /// What the loader counted.
     pub load_stats: LoadStats,
+}
+
+impl std::ops::Deref for Scene {
+    type Target = Geometry;
+    fn deref(&self) -> &Geometry {
+        &self.geometry
+    }
+}
+
+impl std::ops::DerefMut for Scene {
+    fn deref_mut(&mut self) -> &mut Geometry {
+        &mut self.geometry
+    }
 }
 
 /// Everything shading needs about a hit.
@@ -158,53 +262,103 @@ pub fn default_light_intensity(n: usize) -> f32 {
     n.sqrt() / (2.0 * n)
 }
 
-impl Scene {
-    /// An empty scene with the given camera, a black background and no lights.
-    pub fn new(camera: Camera) -> Self {
-        Scene {
-            camera,
-            background: Vec3::ZERO,
-            lights: Vec::new(),
-            ambient: Vec3::splat(default_light_intensity(0)),
-            materials: Vec::new(),
-            triangles: Prims::default(),
-            triangle_normals: Vec::new(),
-            vertex_normals: Vec::new(),
-            spheres: Prims::default(),
-            cones: Prims::default(),
-            load_stats: LoadStats::default(),
-        }
-    }
-
+impl Geometry {
     /// Number of primitives of `kind`.
     pub fn count(&self, kind: Kind) -> usize {
         match kind {
             Kind::Triangle => self.triangles.len(),
             Kind::Sphere => self.spheres.len(),
             Kind::Cone => self.cones.len(),
+            k => self.shapes.items.iter().filter(|s| s.kind() == k).count(),
         }
     }
 
     /// Total number of primitives.
     pub fn prim_count(&self) -> usize {
-        Kind::ALL.iter().map(|&k| self.count(k)).sum()
+        self.triangles.len() + self.spheres.len() + self.cones.len() + self.shapes.len()
     }
 
-    /// The analytic shape with geometry id `kind` and index `prim`
-    /// (`None` for triangles).
+    /// Add an analytic primitive: spheres and cones to their own lists, everything else
+    /// to `shapes`.
+    pub fn add_shape(&mut self, shape: Shape, material: u32) {
+        match shape {
+            Shape::Sphere(s) => self.spheres.push(s, material),
+            Shape::Cone(c) => self.cones.push(c, material),
+            other => self.shapes.push(other, material),
+        }
+    }
+
+    /// Add a flat triangle.
+    pub fn add_triangle(&mut self, tri: Triangle, material: u32) {
+        self.triangles.push(tri, material);
+        self.triangle_normals.push(u32::MAX);
+    }
+
+    /// Add a triangle with per-vertex shading normals.
+    pub fn add_smooth_triangle(&mut self, tri: Triangle, normals: [Vec3; 3], material: u32) {
+        self.triangles.push(tri, material);
+        self.triangle_normals.push(self.vertex_normals.len() as u32);
+        self.vertex_normals.push(normals);
+    }
+
+    /// The analytic shape of a hit on geometry `kind`, primitive `prim` (`None` for
+    /// triangles). Spheres and cones index their own lists, other kinds `shapes`.
     #[inline]
     pub fn shape(&self, kind: Kind, prim: u32) -> Option<Shape> {
         match kind {
             Kind::Triangle => None,
             Kind::Sphere => Some(Shape::Sphere(self.spheres.items[prim as usize])),
             Kind::Cone => Some(Shape::Cone(self.cones.items[prim as usize])),
+            _ => self.shapes.items.get(prim as usize).cloned(),
         }
     }
 
-    /// The surface at a hit reported by a backend for `ray`.
+    /// Every analytic primitive with its `(kind, prim_id)`.
+    pub fn analytic(&self) -> impl Iterator<Item = (Kind, u32, Shape)> + '_ {
+        let spheres = (0u32..)
+            .zip(&self.spheres.items)
+            .map(|(i, s)| (Kind::Sphere, i, Shape::Sphere(*s)));
+        let cones = (0u32..)
+            .zip(&self.cones.items)
+            .map(|(i, c)| (Kind::Cone, i, Shape::Cone(*c)));
+        let others = (0u32..)
+            .zip(&self.shapes.items)
+            .map(|(i, s)| (s.kind(), i, s.clone()));
+        spheres.chain(cones).chain(others)
+    }
+
+    /// Bounds of everything (infinite when an unbounded primitive is present).
+    pub fn bounds(&self) -> Aabb {
+        let mut b = Aabb::EMPTY;
+        for t in &self.triangles.items {
+            b = b.union(&t.bounds());
+        }
+        for (_, _, s) in self.analytic() {
+            b = b.union(&s.bounds());
+        }
+        b
+    }
+
+    /// The surface at a hit on these primitives, for `ray` in their space.
     pub fn surface(&self, hit: &Hit, ray: &Ray) -> Surface {
         let kind = Kind::from_id(hit.geom_id).expect("backend reported an unknown geometry");
         let i = hit.prim_id as usize;
+        let analytic = |shape: &dyn Intersect, material: u32| {
+            let point = shape.surface(
+                ray,
+                &ShapeHit {
+                    t: hit.t,
+                    u: hit.u,
+                    v: hit.v,
+                    ng: hit.ng,
+                },
+            );
+            Surface {
+                point,
+                ns: point.ng,
+                material,
+            }
+        };
         match kind {
             Kind::Triangle => {
                 let tri = &self.triangles.items[i];
@@ -223,22 +377,80 @@ impl Scene {
                     material: self.triangles.material[i],
                 }
             }
-            Kind::Sphere => {
-                let point = self.spheres.items[i].surface(ray, hit.t);
-                Surface {
-                    point,
-                    ns: point.ng,
-                    material: self.spheres.material[i],
+            Kind::Sphere => analytic(&self.spheres.items[i], self.spheres.material[i]),
+            Kind::Cone => analytic(&self.cones.items[i], self.cones.material[i]),
+            _ => {
+                let shape = &self.shapes.items[i];
+                let mut material = self.shapes.material[i];
+                if let Shape::Csg(c) = shape {
+                    let (leaf, _) = Csg::hit_leaf(&ShapeHit {
+                        t: hit.t,
+                        u: hit.u,
+                        v: hit.v,
+                        ng: hit.ng,
+                    });
+                    material = c.leaf_material(leaf).unwrap_or(material);
                 }
+                analytic(shape, material)
             }
-            Kind::Cone => {
-                let point = self.cones.items[i].surface(ray, hit.t);
-                Surface {
-                    point,
-                    ns: point.ng,
-                    material: self.cones.material[i],
-                }
-            }
+        }
+    }
+}
+
+impl Scene {
+    /// An empty scene with the given camera, a black background and no lights.
+    pub fn new(camera: Camera) -> Self {
+        Scene {
+            camera,
+            background: Vec3::ZERO,
+            lights: Vec::new(),
+            ambient: Vec3::splat(default_light_intensity(0)),
+            materials: Vec::new(),
+            geometry: Geometry::default(),
+            objects: Vec::new(),
+            instances: Vec::new(),
+            load_stats: LoadStats::default(),
+        }
+    }
+
+    /// Number of primitives of `kind` in the scene, counting each instance's copy.
+    pub fn count(&self, kind: Kind) -> usize {
+        self.geometry.count(kind)
+            + self
+                .instances
+                .iter()
+                .map(|i| self.objects[i.object as usize].count(kind))
+                .sum::<usize>()
+    }
+
+    /// Total number of primitives, counting each instance's copy.
+    pub fn prim_count(&self) -> usize {
+        self.geometry.prim_count()
+            + self
+                .instances
+                .iter()
+                .map(|i| self.objects[i.object as usize].prim_count())
+                .sum::<usize>()
+    }
+
+    /// The surface at a hit reported by a backend for `ray` (world space).
+    pub fn surface(&self, hit: &Hit, ray: &Ray) -> Surface {
+        if hit.inst_id == NO_INSTANCE {
+            return self.geometry.surface(hit, ray);
+        }
+        let inst = &self.instances[hit.inst_id as usize];
+        let object = &self.objects[inst.object as usize];
+        let local = object.surface(hit, &inst.xform.ray_to_object(ray));
+        let point = inst.xform.surface_to_world(&local.point);
+        let ns = inst.xform.normal_to_world(local.ns).normalize_or(point.ng);
+        Surface {
+            point,
+            ns,
+            material: if local.material == INHERIT {
+                inst.material
+            } else {
+                local.material
+            },
         }
     }
 }

@@ -4,10 +4,11 @@
 
 mod build;
 
-use crate::accel::{Accel, AccelStats, Hit};
-use crate::geometry::{Kind, Shape, Triangle, WatertightRay};
-use crate::math::{Aabb, Ray};
-use crate::scene::Scene;
+use crate::accel::{Accel, AccelStats, Hit, NO_INSTANCE};
+use crate::geometry::{Intersect, Kind, Shape, Triangle, WatertightRay};
+use crate::math::{Aabb, Ray, Xform};
+use crate::scene::{Geometry, Scene};
+use std::sync::Arc;
 
 /// One node: 32 bytes.
 #[derive(Clone, Copy, Debug)]
@@ -24,52 +25,128 @@ struct Node {
 }
 
 /// A primitive as stored in the leaves, in traversal order.
-#[derive(Clone, Copy, Debug)]
+#[derive(Clone, Debug)]
 enum Prim {
     Triangle(Triangle),
     Shape(Shape),
+    /// An index into `Bvh::instances`.
+    Instance(u32),
 }
 
-/// The built hierarchy.
+impl Prim {
+    fn bounds(&self, instances: &[PlacedObject]) -> Aabb {
+        match self {
+            Prim::Triangle(t) => t.bounds(),
+            Prim::Shape(s) => s.bounds(),
+            Prim::Instance(i) => instances[*i as usize].bounds,
+        }
+    }
+}
+
+/// An instance: the object's own hierarchy under a transform.
+struct PlacedObject {
+    xform: Xform,
+    object: Arc<Bvh>,
+    bounds: Aabb,
+}
+
+/// The built hierarchy: two levels when the scene has instances (the top level's
+/// leaves hold instances, whose objects have hierarchies of their own).
 pub struct Bvh {
     nodes: Vec<Node>,
     prims: Vec<Prim>,
-    /// `(geom_id, prim_id)` of each entry of `prims`.
+    /// `(geom_id, prim_id)` of each entry of `prims` (`(u32::MAX, instance)` for
+    /// instances).
     ids: Vec<(u32, u32)>,
+    /// Primitives with infinite bounds (planes, unbounded quadrics, instances of
+    /// them): kept out of the tree and tested against every ray before it.
+    unbounded: Vec<usize>,
+    instances: Vec<PlacedObject>,
 }
 
 /// Traversal stack depth; the builder caps the tree depth below it.
 const STACK: usize = 64;
 
 impl Bvh {
-    /// Build over every primitive of `scene`.
+    /// Build over every primitive of `scene`: a hierarchy per instanced object, and a
+    /// top-level one over the scene's own primitives and the instances.
     pub fn build(scene: &Scene) -> Bvh {
-        let mut prims = Vec::with_capacity(scene.prim_count());
-        let mut ids = Vec::with_capacity(scene.prim_count());
-        for (i, t) in scene.triangles.items.iter().enumerate() {
+        let objects: Vec<Arc<Bvh>> = scene
+            .objects
+            .iter()
+            .map(|g| Arc::new(Bvh::build_level(g, Vec::new())))
+            .collect();
+        let instances = scene
+            .instances
+            .iter()
+            .map(|inst| {
+                let object = objects[inst.object as usize].clone();
+                let bounds = inst.xform.bounds_to_world(&object.bounds());
+                PlacedObject {
+                    xform: inst.xform,
+                    object,
+                    bounds,
+                }
+            })
+            .collect();
+        Bvh::build_level(&scene.geometry, instances)
+    }
+
+    fn build_level(geometry: &Geometry, instances: Vec<PlacedObject>) -> Bvh {
+        let n = geometry.prim_count() + instances.len();
+        let mut prims = Vec::with_capacity(n);
+        let mut ids = Vec::with_capacity(n);
+        for (i, t) in geometry.triangles.items.iter().enumerate() {
             prims.push(Prim::Triangle(*t));
             ids.push((Kind::Triangle as u32, i as u32));
         }
-        for kind in [Kind::Sphere, Kind::Cone] {
-            for i in 0..scene.count(kind) {
-                let shape = scene.shape(kind, i as u32).expect("analytic kind");
-                prims.push(Prim::Shape(shape));
-                ids.push((kind as u32, i as u32));
-            }
+        for (kind, i, shape) in geometry.analytic() {
+            prims.push(Prim::Shape(shape));
+            ids.push((kind as u32, i));
         }
-        let bounds: Vec<Aabb> = prims
-            .iter()
-            .map(|p| match p {
-                Prim::Triangle(t) => t.bounds(),
-                Prim::Shape(s) => s.bounds(),
-            })
+        for i in 0..instances.len() {
+            prims.push(Prim::Instance(i as u32));
+            ids.push((u32::MAX, i as u32));
+        }
+        let all_bounds: Vec<Aabb> = prims.iter().map(|p| p.bounds(&instances)).collect();
+        // Unbounded primitives stay out of the tree; empty ones (an instance of an empty
+        // object) are dropped.
+        let unbounded_idx: Vec<usize> = (0..prims.len())
+            .filter(|&i| !all_bounds[i].is_finite() && !all_bounds[i].is_empty())
             .collect();
+        let bounded: Vec<usize> = (0..prims.len())
+            .filter(|&i| all_bounds[i].is_finite())
+            .collect();
+        let bounds: Vec<Aabb> = bounded.iter().map(|&i| all_bounds[i]).collect();
         let (nodes, order) = build::build(&bounds);
+        let mut out_prims: Vec<Prim> = order
+            .iter()
+            .map(|&k| prims[bounded[k as usize]].clone())
+            .collect();
+        let mut out_ids: Vec<(u32, u32)> =
+            order.iter().map(|&k| ids[bounded[k as usize]]).collect();
+        let mut unbounded = Vec::with_capacity(unbounded_idx.len());
+        for i in unbounded_idx {
+            unbounded.push(out_prims.len());
+            out_prims.push(prims[i].clone());
+            out_ids.push(ids[i]);
+        }
         Bvh {
             nodes,
-            prims: order.iter().map(|&i| prims[i as usize]).collect(),
-            ids: order.iter().map(|&i| ids[i as usize]).collect(),
+            prims: out_prims,
+            ids: out_ids,
+            unbounded,
+            instances,
         }
+    }
+
+    /// Bounds of everything in this level (infinite with unbounded primitives).
+    fn bounds(&self) -> Aabb {
+        let mut b = self.nodes.first().map_or(Aabb::EMPTY, |n| n.bounds);
+        for &i in &self.unbounded {
+            b = b.union(&self.prims[i].bounds(&self.instances));
+        }
+        b
     }
 
     /// Number of nodes.
@@ -123,33 +200,65 @@ impl Bvh {
     }
 }
 
-impl Accel for Bvh {
-    fn intersect(&self, ray: &Ray) -> Option<Hit> {
+impl Bvh {
+    /// The nearest hit of primitive `i` in `(ray.tmin, tmax)`.
+    #[inline]
+    fn hit_prim(&self, i: usize, ray: &Ray, wt: &mut WatertightRay, tmax: f32) -> Option<Hit> {
+        let (geom_id, prim_id) = self.ids[i];
+        let h = match &self.prims[i] {
+            Prim::Triangle(t) => {
+                wt.set_tmax(tmax);
+                t.intersect_wt(wt)
+            }
+            Prim::Shape(s) => s.intersect(&Ray { tmax, ..*ray }),
+            Prim::Instance(k) => {
+                let inst = &self.instances[*k as usize];
+                let local = inst.xform.ray_to_object(&Ray { tmax, ..*ray });
+                return inst.object.nearest(&local).map(|h| Hit {
+                    inst_id: prim_id,
+                    ..h
+                });
+            }
+        }?;
+        Some(Hit {
+            t: h.t,
+            geom_id,
+            prim_id,
+            u: h.u,
+            v: h.v,
+            ng: h.ng,
+            inst_id: NO_INSTANCE,
+        })
+    }
+
+    /// Whether primitive `i` has any hit in the ray's interval.
+    #[inline]
+    fn occludes(&self, i: usize, ray: &Ray, wt: &WatertightRay) -> bool {
+        match &self.prims[i] {
+            Prim::Triangle(t) => t.intersect_wt(wt).is_some(),
+            Prim::Shape(s) => s.occluded(ray),
+            Prim::Instance(k) => {
+                let inst = &self.instances[*k as usize];
+                inst.object.any(&inst.xform.ray_to_object(ray))
+            }
+        }
+    }
+
+    fn nearest(&self, ray: &Ray) -> Option<Hit> {
         let mut best: Option<Hit> = None;
         let mut wt = WatertightRay::new(ray);
-        let mut r = *ray;
-        self.traverse(ray, |i, tmax| {
-            let h = match &self.prims[i] {
-                Prim::Triangle(t) => {
-                    wt.set_tmax(tmax);
-                    t.intersect_wt(&wt)
-                }
-                Prim::Shape(s) => {
-                    r.tmax = tmax;
-                    s.intersect(&r)
-                }
-            };
-            match h {
+        let mut tmax = ray.tmax;
+        for &i in &self.unbounded {
+            if let Some(h) = self.hit_prim(i, ray, &mut wt, tmax) {
+                tmax = h.t;
+                best = Some(h);
+            }
+        }
+        let ray = Ray { tmax, ..*ray };
+        self.traverse(&ray, |i, tmax| {
+            match self.hit_prim(i, &ray, &mut wt, tmax) {
                 Some(h) => {
-                    let (geom_id, prim_id) = self.ids[i];
-                    best = Some(Hit {
-                        t: h.t,
-                        geom_id,
-                        prim_id,
-                        u: h.u,
-                        v: h.v,
-                        ng: h.ng,
-                    });
+                    best = Some(h);
                     Some(h.t)
                 }
                 None => Some(tmax),
@@ -158,15 +267,14 @@ impl Accel for Bvh {
         best
     }
 
-    fn occluded(&self, ray: &Ray) -> bool {
-        let mut hit = false;
+    fn any(&self, ray: &Ray) -> bool {
         let wt = WatertightRay::new(ray);
+        if self.unbounded.iter().any(|&i| self.occludes(i, ray, &wt)) {
+            return true;
+        }
+        let mut hit = false;
         self.traverse(ray, |i, tmax| {
-            let h = match &self.prims[i] {
-                Prim::Triangle(t) => t.intersect_wt(&wt).is_some(),
-                Prim::Shape(s) => s.occluded(ray),
-            };
-            if h {
+            if self.occludes(i, ray, &wt) {
                 hit = true;
                 None
             } else {
@@ -174,6 +282,16 @@ impl Accel for Bvh {
             }
         });
         hit
+    }
+}
+
+impl Accel for Bvh {
+    fn intersect(&self, ray: &Ray) -> Option<Hit> {
+        self.nearest(ray)
+    }
+
+    fn occluded(&self, ray: &Ray) -> bool {
+        self.any(ray)
     }
 
     fn stats(&self) -> AccelStats {
@@ -325,10 +443,7 @@ mod agreement {
                 let range = n.offset as usize..(n.offset + n.count as u32) as usize;
                 for (k, prim) in bvh.prims[range.clone()].iter().enumerate() {
                     seen[range.start + k] += 1;
-                    let b = match prim {
-                        Prim::Triangle(t) => t.bounds(),
-                        Prim::Shape(s) => s.bounds(),
-                    };
+                    let b = prim.bounds(&bvh.instances);
                     assert!(n.bounds.contains(b.min) && n.bounds.contains(b.max));
                 }
             } else {

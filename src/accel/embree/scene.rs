@@ -5,9 +5,10 @@ use super::device::Device;
 use super::error::EmbreeError;
 use super::sys;
 use super::user::{self, UserPrims, UserShape};
-use crate::accel::Hit;
-use crate::geometry::{Kind, Triangle};
-use crate::math::{Ray, Vec3};
+use crate::accel::{Hit, NO_INSTANCE};
+use crate::geometry::{Cone, Intersect, Kind, Shape, Sphere, Triangle};
+use crate::math::{Ray, Vec3, Xform};
+use crate::scene::Geometry as SceneGeometry;
 
 /// An owned geometry handle during the build; released once attached (the scene keeps
 /// its own reference).
@@ -39,46 +40,43 @@ impl Geometry {
         Ok(Geometry(raw))
     }
 
-    /// Commit and attach under the geometry id `kind` (our `Kind` discriminant).
+    /// Commit and attach under geometry id `id` (our `Kind` discriminant, or
+    /// `INSTANCE_BASE + i` for instance `i`).
     fn commit_and_attach(
         self,
         device: &Device,
-        scene: &CommittedScene,
-        kind: Kind,
+        scene: &Level,
+        id: u32,
+        what: &str,
     ) -> Result<(), EmbreeError> {
         // SAFETY: both handles are live and belong to the same device; the id is unused
-        // in this scene (one geometry per kind).
+        // in this scene (one geometry per kind, one per instance).
         unsafe {
             sys::rtcCommitGeometry(self.0);
-            sys::rtcAttachGeometryByID(scene.raw, self.0, kind as u32);
+            sys::rtcAttachGeometryByID(scene.raw, self.0, id);
         }
-        device.check(format!("attaching the {} geometry", kind.name()))
+        device.check(format!("attaching the {what} geometry"))
     }
 }
 
-/// A committed Embree scene, owning its geometries (through Embree's reference counts)
-/// and the primitive data their callbacks read. Immutable after
-/// [`CommittedScene::build`]; queried from any number of threads.
+/// Geometry id of the first instance in the top-level scene (kinds use 0..).
+const INSTANCE_BASE: u32 = 64;
+
+/// One Embree scene, the top level or an instanced object, owning the user data its
+/// callbacks read.
 #[derive(Debug)]
-pub(super) struct CommittedScene {
+struct Level {
     raw: sys::RTCScene,
     /// Dropped after `Drop::drop` has released `raw`, so no callback can outlive it.
     user: UserData,
 }
 
-// SAFETY: the handle refers to Embree's reference-counted scene object; it is only
-// mutated inside `build`, before it is shared.
-unsafe impl Send for CommittedScene {}
-// SAFETY: after `rtcCommitScene` the scene is never modified, and Embree documents
-// `rtcIntersect1`/`rtcOccluded1` on a committed scene as safe to call from many threads
-// at once. The user data the callbacks read is immutable (`UserPrims` of `Copy` shapes).
-unsafe impl Sync for CommittedScene {}
-
-impl Drop for CommittedScene {
+impl Drop for Level {
     fn drop(&mut self) {
-        // SAFETY: `self.raw` is a live scene; no query can be running (they borrow
-        // `self`). Releasing it releases the geometries it holds; `self.user` is freed
-        // only after this.
+        // SAFETY: `self.raw` is a live scene; no query can be running (queries borrow
+        // the `CommittedScene`). Releasing it releases the geometries it holds (instance
+        // geometries hold their own reference to an object's scene); `self.user` is
+        // freed only after this.
         unsafe { sys::rtcReleaseScene(self.raw) }
     }
 }
@@ -87,16 +85,45 @@ impl Drop for CommittedScene {
 /// Never read from Rust, only kept alive for the callbacks.
 #[derive(Debug, Default)]
 struct UserData {
-    _spheres: Option<Box<UserPrims<crate::geometry::Sphere>>>,
-    _cones: Option<Box<UserPrims<crate::geometry::Cone>>>,
+    _spheres: Option<Box<UserPrims<Sphere>>>,
+    _cones: Option<Box<UserPrims<Cone>>>,
+    _shapes: Vec<Box<UserPrims<Shape>>>,
 }
 
-impl CommittedScene {
-    /// Build and commit the scene of `scene`'s primitives.
-    pub(super) fn build(
-        device: &Device,
-        scene: &crate::scene::Scene,
-    ) -> Result<CommittedScene, EmbreeError> {
+/// A primitive Embree cannot hold (infinite bounds), intersected in Rust before each
+/// query: a plane, an unbounded quadric, possibly inside an instance.
+#[derive(Debug)]
+struct Unbounded {
+    shape: Shape,
+    kind: Kind,
+    prim: u32,
+    /// `(instance index, its transform)` for instanced ones.
+    inst: Option<(u32, Xform)>,
+}
+
+/// A committed Embree scene: the top level (with one instance geometry per instance),
+/// the objects' scenes, and the unbounded primitives. Immutable after
+/// [`CommittedScene::build`]; queried from any number of threads.
+#[derive(Debug)]
+pub(super) struct CommittedScene {
+    // Fields drop in declaration order: the top level first, so the instance
+    // geometries let go of the objects' scenes before those are released.
+    top: Level,
+    _objects: Vec<Level>,
+    unbounded: Vec<Unbounded>,
+}
+
+// SAFETY: the handles refer to Embree's reference-counted scene objects; they are only
+// mutated inside `build`, before they are shared.
+unsafe impl Send for CommittedScene {}
+// SAFETY: after `rtcCommitScene` the scenes are never modified, and Embree documents
+// `rtcIntersect1`/`rtcOccluded1` on a committed scene as safe to call from many threads
+// at once. The user data the callbacks read is immutable, and `Shape` is `Sync`.
+unsafe impl Sync for CommittedScene {}
+
+impl Level {
+    /// A new, empty scene with robust traversal.
+    fn new(device: &Device) -> Result<Level, EmbreeError> {
         // SAFETY: `device` is live.
         let raw = unsafe { sys::rtcNewScene(device.raw()) };
         if raw.is_null() {
@@ -106,7 +133,7 @@ impl CommittedScene {
                 "Embree returned no scene",
             ));
         }
-        let mut committed = CommittedScene {
+        let level = Level {
             raw,
             user: UserData::default(),
         };
@@ -114,25 +141,186 @@ impl CommittedScene {
         // SAFETY: `raw` is a live, uncommitted scene.
         unsafe { sys::rtcSetSceneFlags(raw, sys::RTCSceneFlags::RTC_SCENE_FLAG_ROBUST) };
         device.check("rtcSetSceneFlags")?;
+        Ok(level)
+    }
 
-        if !scene.triangles.is_empty() {
-            attach_triangles(device, &committed, &scene.triangles.items)?;
+    /// Attach every bounded primitive of `geometry`; returns the unbounded ones as
+    /// `(kind, prim_id, shape)`.
+    fn attach_geometry(
+        &mut self,
+        device: &Device,
+        geometry: &SceneGeometry,
+    ) -> Result<Vec<(Kind, u32, Shape)>, EmbreeError> {
+        if !geometry.triangles.is_empty() {
+            attach_triangles(device, self, &geometry.triangles.items)?;
         }
-        committed.user._spheres =
-            attach_user(device, &committed, Kind::Sphere, &scene.spheres.items)?;
-        committed.user._cones = attach_user(device, &committed, Kind::Cone, &scene.cones.items)?;
+        let all = |n: usize| (0..n as u32).collect::<Vec<u32>>();
+        self.user._spheres = attach_user(
+            device,
+            self,
+            Kind::Sphere,
+            &geometry.spheres.items,
+            all(geometry.spheres.len()),
+        )?;
+        self.user._cones = attach_user(
+            device,
+            self,
+            Kind::Cone,
+            &geometry.cones.items,
+            all(geometry.cones.len()),
+        )?;
+        let mut unbounded = Vec::new();
+        for kind in Kind::ALL.into_iter().filter(|k| *k > Kind::Cone) {
+            let mut items = Vec::new();
+            let mut ids = Vec::new();
+            for (i, shape) in (0u32..).zip(&geometry.shapes.items) {
+                if shape.kind() != kind {
+                    continue;
+                }
+                if shape.bounds().is_finite() {
+                    items.push(shape.clone());
+                    ids.push(i);
+                } else {
+                    unbounded.push((kind, i, shape.clone()));
+                }
+            }
+            if let Some(data) = attach_user(device, self, kind, &items, ids)? {
+                self.user._shapes.push(data);
+            }
+        }
+        Ok(unbounded)
+    }
 
+    /// Commit after every geometry is attached.
+    fn commit(&self, device: &Device) -> Result<(), EmbreeError> {
         // SAFETY: `raw` is live; every attached geometry is committed and its user data
-        // is boxed in `committed.user`, which lives as long as the scene.
-        unsafe { sys::rtcCommitScene(raw) };
-        device.check("rtcCommitScene")?;
-        Ok(committed)
+        // is boxed in `self.user` (or an object level's), which lives as long as the
+        // scene.
+        unsafe { sys::rtcCommitScene(self.raw) };
+        device.check("rtcCommitScene")
+    }
+}
+
+impl CommittedScene {
+    /// Build and commit the scene of `scene`'s primitives.
+    pub(super) fn build(
+        device: &Device,
+        scene: &crate::scene::Scene,
+    ) -> Result<CommittedScene, EmbreeError> {
+        let mut objects = Vec::with_capacity(scene.objects.len());
+        let mut object_unbounded = Vec::with_capacity(scene.objects.len());
+        for object in &scene.objects {
+            let mut level = Level::new(device)?;
+            object_unbounded.push(level.attach_geometry(device, object)?);
+            level.commit(device)?;
+            objects.push(level);
+        }
+        let mut top = Level::new(device)?;
+        let mut unbounded: Vec<Unbounded> = top
+            .attach_geometry(device, &scene.geometry)?
+            .into_iter()
+            .map(|(kind, prim, shape)| Unbounded {
+                shape,
+                kind,
+                prim,
+                inst: None,
+            })
+            .collect();
+        for (i, inst) in (0u32..).zip(&scene.instances) {
+            let object = inst.object as usize;
+            for (kind, prim, shape) in &object_unbounded[object] {
+                unbounded.push(Unbounded {
+                    shape: shape.clone(),
+                    kind: *kind,
+                    prim: *prim,
+                    inst: Some((i, inst.xform)),
+                });
+            }
+            let id = INSTANCE_BASE.checked_add(i).ok_or_else(|| {
+                EmbreeError::emray("building the instances", "too many instances")
+            })?;
+            attach_instance(device, &top, &objects[object], &inst.xform, id)?;
+        }
+        top.commit(device)?;
+        Ok(CommittedScene {
+            top,
+            _objects: objects,
+            unbounded,
+        })
+    }
+
+    /// The nearest unbounded primitive hit in `(ray.tmin, ray.tmax)`.
+    #[inline]
+    fn nearest_unbounded(&self, ray: &Ray) -> Option<Hit> {
+        let mut best: Option<Hit> = None;
+        let mut r = *ray;
+        for u in &self.unbounded {
+            let h = match &u.inst {
+                None => u.shape.intersect(&r),
+                Some((_, x)) => u.shape.intersect(&x.ray_to_object(&r)),
+            };
+            if let Some(h) = h {
+                r.tmax = h.t;
+                best = Some(Hit {
+                    t: h.t,
+                    geom_id: u.kind as u32,
+                    prim_id: u.prim,
+                    u: h.u,
+                    v: h.v,
+                    ng: h.ng,
+                    inst_id: u.inst.map_or(NO_INSTANCE, |(i, _)| i),
+                });
+            }
+        }
+        best
+    }
+
+    fn any_unbounded(&self, ray: &Ray) -> bool {
+        self.unbounded.iter().any(|u| match &u.inst {
+            None => u.shape.occluded(ray),
+            Some((_, x)) => u.shape.occluded(&x.ray_to_object(ray)),
+        })
     }
 
     /// The nearest hit with `t` in `[max(ray.tmin, 0), ray.tmax]` (Embree requires
     /// `tnear >= 0`).
     #[inline]
     pub(super) fn intersect(&self, ray: &Ray) -> Option<Hit> {
+        if self.unbounded.is_empty() {
+            return self.intersect_embree(ray);
+        }
+        let tnear = ray.tmin.max(0.0);
+        let near = self.nearest_unbounded(&Ray {
+            tmin: tnear,
+            ..*ray
+        });
+        match near {
+            None => self.intersect_embree(ray),
+            Some(h) => self
+                .intersect_embree(&Ray { tmax: h.t, ..*ray })
+                .or(Some(h)),
+        }
+    }
+
+    /// Whether anything lies in the ray's interval (any hit).
+    #[inline]
+    pub(super) fn occluded(&self, ray: &Ray) -> bool {
+        if !self.unbounded.is_empty() {
+            let tnear = ray.tmin.max(0.0);
+            if self.any_unbounded(&Ray {
+                tmin: tnear,
+                ..*ray
+            }) {
+                return true;
+            }
+        }
+        self.occluded_embree(ray)
+    }
+
+    /// The nearest hit with `t` in `[max(ray.tmin, 0), ray.tmax]` (Embree requires
+    /// `tnear >= 0`).
+    #[inline]
+    fn intersect_embree(&self, ray: &Ray) -> Option<Hit> {
         let tnear = ray.tmin.max(0.0);
         if ray.tmax.is_nan() || ray.tmax < tnear {
             return None;
@@ -141,7 +329,7 @@ impl CommittedScene {
             ray: rtc_ray(ray, tnear),
             hit: empty_hit(),
         };
-        query::intersect(self.raw, &mut rayhit);
+        query::intersect(self.top.raw, &mut rayhit);
         let hit = &rayhit.hit;
         if hit.geomID == sys::INVALID_GEOMETRY_ID {
             return None;
@@ -153,18 +341,21 @@ impl CommittedScene {
             u: hit.u,
             v: hit.v,
             ng: Vec3::new(hit.Ng_x, hit.Ng_y, hit.Ng_z),
+            inst_id: match hit.instID[0] {
+                sys::INVALID_GEOMETRY_ID => NO_INSTANCE,
+                id => id - INSTANCE_BASE,
+            },
         })
     }
 
-    /// Whether anything lies in the ray's interval (any hit).
     #[inline]
-    pub(super) fn occluded(&self, ray: &Ray) -> bool {
+    fn occluded_embree(&self, ray: &Ray) -> bool {
         let tnear = ray.tmin.max(0.0);
         if ray.tmax.is_nan() || ray.tmax < tnear {
             return false;
         }
         let mut r = rtc_ray(ray, tnear);
-        query::occluded(self.raw, &mut r);
+        query::occluded(self.top.raw, &mut r);
         r.tfar == f32::NEG_INFINITY
     }
 }
@@ -300,11 +491,7 @@ mod query {
 
 /// One native triangle mesh holding all triangles, three vertices each, so that
 /// `primID` is the index in `scene.triangles`.
-fn attach_triangles(
-    device: &Device,
-    scene: &CommittedScene,
-    tris: &[Triangle],
-) -> Result<(), EmbreeError> {
+fn attach_triangles(device: &Device, scene: &Level, tris: &[Triangle]) -> Result<(), EmbreeError> {
     let count = tris.len();
     let too_many = || {
         EmbreeError::emray(
@@ -373,16 +560,17 @@ fn attach_triangles(
         *idx = i;
     }
     device.check("filling the triangle buffers")?;
-    geometry.commit_and_attach(device, scene, Kind::Triangle)
+    geometry.commit_and_attach(device, scene, Kind::Triangle as u32, "triangles")
 }
 
 /// One user geometry holding all `prims` of `kind` (none when there are none). Returns
 /// the boxed user data Embree's callbacks read, which must outlive `scene`'s handle.
 fn attach_user<T: UserShape>(
     device: &Device,
-    scene: &CommittedScene,
+    scene: &Level,
     kind: Kind,
     prims: &[T],
+    ids: Vec<u32>,
 ) -> Result<Option<Box<UserPrims<T>>>, EmbreeError> {
     if prims.is_empty() {
         return Ok(None);
@@ -398,6 +586,7 @@ fn attach_user<T: UserShape>(
     })?;
     let data = Box::new(UserPrims {
         items: prims.to_vec().into_boxed_slice(),
+        ids: ids.into_boxed_slice(),
     });
     let geometry = Geometry::new(
         device,
@@ -420,6 +609,53 @@ fn attach_user<T: UserShape>(
         sys::rtcSetGeometryOccludedFunction(geometry.0, Some(user::occluded::<T>));
     }
     device.check(format!("setting up the {} geometry", kind.name()))?;
-    geometry.commit_and_attach(device, scene, kind)?;
+    geometry.commit_and_attach(device, scene, kind as u32, kind.name())?;
     Ok(Some(data))
+}
+
+/// An instance geometry placing `object` in `scene` under `xform`, as geometry `id`.
+fn attach_instance(
+    device: &Device,
+    scene: &Level,
+    object: &Level,
+    xform: &Xform,
+    id: u32,
+) -> Result<(), EmbreeError> {
+    let geometry = Geometry::new(
+        device,
+        sys::RTCGeometryType::RTC_GEOMETRY_TYPE_INSTANCE,
+        "instance",
+    )?;
+    let m = xform.to_world;
+    // Column-major 3×4: the three linear columns, then the translation.
+    let cols: [f32; 12] = [
+        m.matrix3.x_axis.x,
+        m.matrix3.x_axis.y,
+        m.matrix3.x_axis.z,
+        m.matrix3.y_axis.x,
+        m.matrix3.y_axis.y,
+        m.matrix3.y_axis.z,
+        m.matrix3.z_axis.x,
+        m.matrix3.z_axis.y,
+        m.matrix3.z_axis.z,
+        m.translation.x,
+        m.translation.y,
+        m.translation.z,
+    ];
+    // SAFETY: live instance geometry and committed object scene of the same device;
+    // `cols` holds the 12 floats `RTC_FORMAT_FLOAT3X4_COLUMN_MAJOR` reads, and Embree
+    // copies them before returning. The instance keeps its own reference to the object
+    // scene.
+    unsafe {
+        sys::rtcSetGeometryInstancedScene(geometry.0, object.raw);
+        sys::rtcSetGeometryTimeStepCount(geometry.0, 1);
+        sys::rtcSetGeometryTransform(
+            geometry.0,
+            0,
+            sys::RTCFormat::RTC_FORMAT_FLOAT3X4_COLUMN_MAJOR,
+            cols.as_ptr().cast(),
+        );
+    }
+    device.check("setting up an instance")?;
+    geometry.commit_and_attach(device, scene, id, "instance")
 }

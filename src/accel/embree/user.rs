@@ -21,48 +21,14 @@
 use std::ffi::c_void;
 
 use super::sys;
-use crate::geometry::{Cone, ShapeHit, Sphere};
+use crate::geometry::Intersect;
 use crate::math::{Aabb, Ray, Vec3};
 
-/// An analytic shape the user-geometry callbacks can intersect.
-pub(super) trait UserShape: Copy + Send + Sync + 'static {
-    /// Conservative bounds.
-    fn bounds(&self) -> Aabb;
-    /// Nearest hit in `(ray.tmin, ray.tmax)`.
-    fn intersect(&self, ray: &Ray) -> Option<ShapeHit>;
-    /// Any hit in `(ray.tmin, ray.tmax)`.
-    fn occluded(&self, ray: &Ray) -> bool;
-}
+/// An analytic shape the user-geometry callbacks can intersect: any
+/// [`Intersect`] implementor that can be shared across threads.
+pub(super) trait UserShape: Intersect + Clone + Send + Sync + 'static {}
 
-impl UserShape for Sphere {
-    #[inline]
-    fn bounds(&self) -> Aabb {
-        Sphere::bounds(self)
-    }
-    #[inline]
-    fn intersect(&self, ray: &Ray) -> Option<ShapeHit> {
-        Sphere::intersect(self, ray)
-    }
-    #[inline]
-    fn occluded(&self, ray: &Ray) -> bool {
-        Sphere::occluded(self, ray)
-    }
-}
-
-impl UserShape for Cone {
-    #[inline]
-    fn bounds(&self) -> Aabb {
-        Cone::bounds(self)
-    }
-    #[inline]
-    fn intersect(&self, ray: &Ray) -> Option<ShapeHit> {
-        Cone::intersect(self, ray)
-    }
-    #[inline]
-    fn occluded(&self, ray: &Ray) -> bool {
-        Cone::occluded(self, ray)
-    }
-}
+impl<T: Intersect + Clone + Send + Sync + 'static> UserShape for T {}
 
 /// The user data of one user geometry: its primitives, indexed by Embree's `primID`.
 /// Lives in a `Box` owned by the `EmbreeAccel`, so the pointer Embree holds stays valid
@@ -70,6 +36,8 @@ impl UserShape for Cone {
 #[derive(Debug)]
 pub(super) struct UserPrims<T> {
     pub(super) items: Box<[T]>,
+    /// The primitive id reported for each item (its index in the scene's list).
+    pub(super) ids: Box<[u32]>,
 }
 
 impl<T> UserPrims<T> {
@@ -257,7 +225,7 @@ pub(super) unsafe extern "C" fn bounds<T: UserShape>(args: *const sys::RTCBounds
     let prim =
         unsafe { prims::<T>(args.geometryUserPtr) }.and_then(|p| p.items.get(args.primID as usize));
     // An unknown primitive gets empty bounds, which Embree skips.
-    let b = prim.map_or(Aabb::EMPTY, UserShape::bounds);
+    let b = prim.map_or(Aabb::EMPTY, Intersect::bounds);
     // SAFETY: `bounds_o` points to the output `RTCBounds` Embree provides for this call.
     if let Some(out) = unsafe { args.bounds_o.as_mut() } {
         out.lower_x = b.min.x;
@@ -280,8 +248,12 @@ pub(super) unsafe extern "C" fn intersect<T: UserShape>(
     };
     let n = args.N as usize;
     // SAFETY: registered only with `UserPrims<T>` user data (see `bounds`).
-    let prim =
-        unsafe { prims::<T>(args.geometryUserPtr) }.and_then(|p| p.items.get(args.primID as usize));
+    let user = unsafe { prims::<T>(args.geometryUserPtr) };
+    let prim = user.and_then(|p| p.items.get(args.primID as usize));
+    let prim_id = user
+        .and_then(|p| p.ids.get(args.primID as usize))
+        .copied()
+        .unwrap_or(args.primID);
     let packet = Packet {
         base: args.rayhit.cast(),
         n,
@@ -310,7 +282,7 @@ pub(super) unsafe extern "C" fn intersect<T: UserShape>(
                     hits.set_f32(soa::NG_Z, i, h.ng.z);
                     hits.set_f32(soa::U, i, h.u);
                     hits.set_f32(soa::V, i, h.v);
-                    hits.set_u32(soa::PRIM_ID, i, args.primID);
+                    hits.set_u32(soa::PRIM_ID, i, prim_id);
                     hits.set_u32(soa::GEOM_ID, i, args.geomID);
                     for (level, id) in inst.iter().enumerate() {
                         hits.set_u32(soa::INST_ID + level, i, *id);
