@@ -5,7 +5,7 @@
 use criterion::{criterion_group, criterion_main, Criterion, Throughput};
 use emray::accel::bvh::Bvh;
 use emray::accel::Accel;
-use emray::geometry::{Cone, Kind, Sphere, Triangle};
+use emray::geometry::{Cone, Csg, CsgOp, CsgTree, Kind, Shape, Sphere, Triangle};
 use emray::math::{Ray, Vec3};
 use emray::scene::{Camera, Material, Scene};
 use std::hint::black_box;
@@ -54,6 +54,17 @@ fn scene(kind: Kind, n: usize) -> Scene {
             Kind::Cone => s
                 .cones
                 .push(Cone::new(c, 0.2 * r.f(), c + r.v(1.0), 0.2 * r.f()), 0),
+            Kind::Csg => {
+                // A lens: the intersection of two overlapping spheres.
+                let (d, rad) = (r.v(0.3), 0.1 + 0.2 * r.f());
+                let lens = CsgTree::op(
+                    CsgOp::Intersection,
+                    CsgTree::leaf(Shape::Sphere(Sphere::new(c + d, rad))),
+                    CsgTree::leaf(Shape::Sphere(Sphere::new(c - d, rad))),
+                );
+                let csg = Csg::new(&lens).expect("valid CSG");
+                s.add_shape(Shape::Csg(std::sync::Arc::new(csg)), 0);
+            }
         }
     }
     s

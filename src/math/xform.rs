@@ -135,7 +135,7 @@ impl Xform {
 #[cfg(test)]
 mod tests {
     use super::*;
-    use glam::{Quat, Vec3A};
+    use glam::Quat;
 
     fn xf() -> Xform {
         Xform::new(Affine3A::from_scale_rotation_translation(
@@ -178,7 +178,7 @@ mod tests {
         let exact = m.matrix3.x_axis.as_dvec3() * p.x as f64
             + m.matrix3.y_axis.as_dvec3() * p.y as f64
             + m.matrix3.z_axis.as_dvec3() * p.z as f64
-            + Vec3A::from(m.translation).as_dvec3();
+            + m.translation.as_dvec3();
         let d = (q.as_dvec3() - exact).abs();
         assert!(d.cmple(err.as_dvec3()).all(), "{d} vs {err}");
         assert!(err.max_element() < 1e-3);

@@ -3,7 +3,7 @@
 use super::{RayGen, RenderSettings};
 use crate::accel::Accel;
 use crate::math::{next_float_down, offset_ray_origin, Ray, Vec3};
-use crate::scene::Scene;
+use crate::scene::{Scene, Surface};
 
 /// Rays cast, by type.
 #[derive(Clone, Copy, Debug, Default, PartialEq, Eq)]
@@ -118,25 +118,69 @@ impl<'a, A: Accel> Tracer<'a, A> {
 
     fn eye(&self, ray: Ray, counts: &mut RayCounts) -> Vec3 {
         counts.eye += 1;
-        self.trace(&ray, 1, counts)
+        self.trace(&ray, 1, Media::AIR, counts)
     }
 
-    /// Radiance along `ray` at ray-tree depth `depth` (the eye ray is depth 1).
-    fn trace(&self, ray: &Ray, depth: u32, counts: &mut RayCounts) -> Vec3 {
+    /// Radiance along `ray` at ray-tree depth `depth` (the eye ray is depth 1), which
+    /// travels inside `media`.
+    fn trace(&self, ray: &Ray, depth: u32, media: Media, counts: &mut RayCounts) -> Vec3 {
         let scene = self.scene;
-        let Some(hit) = self.accel.intersect(ray) else {
-            return scene.background;
-        };
-        if depth == 1 {
-            counts.eye_hit += 1;
+        let mut ray = *ray;
+        let mut media = media;
+        // Surfaces of lower-priority media inside a higher-priority one are skipped
+        // (nested dielectrics): the ray goes on through them, at most this many times.
+        let mut skips = 0;
+        loop {
+            let Some(hit) = self.accel.intersect(&ray) else {
+                return scene.background;
+            };
+            let surf = scene.surface(&hit, &ray);
+            let m = &scene.materials[surf.material as usize];
+            let d = ray.dir.normalize();
+            let entering = surf.point.ng.dot(d) < 0.0;
+            if m.t > 0.0
+                && skips < MAX_SKIPS
+                && media.is_false_boundary(scene, surf.material, entering)
+            {
+                skips += 1;
+                media = if entering {
+                    media.enter(surf.material)
+                } else {
+                    media.leave(surf.material)
+                };
+                let ng = if entering {
+                    -surf.point.ng
+                } else {
+                    surf.point.ng
+                };
+                ray = Ray::new(
+                    offset_ray_origin(surf.point.p, surf.point.err, ng, d),
+                    ray.dir,
+                );
+                continue;
+            }
+            if depth == 1 {
+                counts.eye_hit += 1;
+            }
+            return self.shade(&surf, d, entering, depth, media, counts);
         }
-        let surf = scene.surface(&hit, ray);
+    }
+
+    /// Whitted shading of a true surface hit seen along unit direction `d`.
+    fn shade(
+        &self,
+        surf: &Surface,
+        d: Vec3,
+        entering: bool,
+        depth: u32,
+        media: Media,
+        counts: &mut RayCounts,
+    ) -> Vec3 {
+        let scene = self.scene;
         let m = &scene.materials[surf.material as usize];
-        let d = ray.dir.normalize();
         let p = surf.point.p;
         let ng_out = surf.point.ng;
         // Both sides are surfaces: face the normals towards the incoming ray.
-        let entering = ng_out.dot(d) < 0.0;
         let ng = if entering { ng_out } else { -ng_out };
         let ns = if surf.ns.dot(d) > 0.0 {
             -surf.ns
@@ -154,6 +198,10 @@ impl<'a, A: Accel> Tracer<'a, A> {
             if ns.dot(to_light) <= 0.0 {
                 continue;
             }
+            let intensity = light.intensity_at(p);
+            if intensity == Vec3::ZERO {
+                continue;
+            }
             counts.shadow += 1;
             let mut shadow = spawn(to_light);
             shadow.dir = light.pos - shadow.org;
@@ -169,7 +217,7 @@ impl<'a, A: Accel> Tracer<'a, A> {
                 let rv = r.dot(view).max(0.0);
                 c += Vec3::splat(m.ks * rv.powf(m.shine));
             }
-            color += light.color * c;
+            color += intensity * c;
         }
 
         if depth >= self.max_depth {
@@ -177,12 +225,18 @@ impl<'a, A: Accel> Tracer<'a, A> {
         }
         let mut reflect_weight = m.kr;
         if m.t > 0.0 {
-            // Snell's law; the medium is decided by the geometric normal's side.
-            let eta = if entering { 1.0 / m.ior } else { m.ior };
-            match refract(d, ns, eta) {
+            // Snell's law between the medium the ray is in and the one it goes into.
+            let (n1, n2, inside) = if entering {
+                let inside = media.enter(surf.material);
+                (media.ior(scene), m.ior, inside)
+            } else {
+                let inside = media.leave(surf.material);
+                (m.ior, inside.ior(scene), inside)
+            };
+            match refract(d, ns, n1 / n2) {
                 Some(dir) => {
                     counts.refraction += 1;
-                    color += m.t * self.trace(&spawn(dir), depth + 1, counts);
+                    color += m.t * self.trace(&spawn(dir), depth + 1, inside, counts);
                 }
                 None => {
                     // Total internal reflection: the transmitted energy is reflected.
@@ -194,9 +248,92 @@ impl<'a, A: Accel> Tracer<'a, A> {
         if reflect_weight > 0.0 {
             counts.reflection += 1;
             let dir = reflect(d, ns);
-            color += reflect_weight * self.trace(&spawn(dir), depth + 1, counts);
+            color += reflect_weight * self.trace(&spawn(dir), depth + 1, media, counts);
         }
         color
+    }
+}
+
+/// Most lower-priority surfaces one ray may pass through.
+const MAX_SKIPS: u32 = 64;
+
+/// The transmissive solids a ray is inside (material indices, innermost last), for
+/// Snell's law with the right indices when media nest (a liquid in a glass) and for
+/// Schmidt & Budge's priorities when they overlap.
+#[derive(Clone, Copy, Debug, PartialEq)]
+struct Media {
+    ids: [u32; MEDIA_DEPTH],
+    len: u8,
+}
+
+/// Nesting depth tracked; deeper entries are not recorded (the ray then sees the
+/// innermost recorded medium).
+const MEDIA_DEPTH: usize = 8;
+
+impl Media {
+    /// Outside everything.
+    const AIR: Media = Media {
+        ids: [0; MEDIA_DEPTH],
+        len: 0,
+    };
+
+    fn iter(&self) -> impl Iterator<Item = u32> + '_ {
+        self.ids[..self.len as usize].iter().copied()
+    }
+
+    /// The medium in force: the highest priority, the innermost among equals.
+    fn current(&self, scene: &Scene) -> Option<u32> {
+        let mut best: Option<u32> = None;
+        for id in self.iter() {
+            let p = scene.materials[id as usize].priority;
+            match best {
+                Some(b) if p < scene.materials[b as usize].priority => {}
+                _ => best = Some(id),
+            }
+        }
+        best
+    }
+
+    /// Index of refraction of the medium in force (1 outside everything).
+    fn ior(&self, scene: &Scene) -> f32 {
+        self.current(scene)
+            .map_or(1.0, |id| scene.materials[id as usize].ior)
+    }
+
+    /// Whether the boundary of `material` is not optically there: entering it while a
+    /// higher-priority medium is in force, or leaving it while one it is inside of is.
+    fn is_false_boundary(&self, scene: &Scene, material: u32, entering: bool) -> bool {
+        let p = scene.materials[material as usize].priority;
+        let higher = |id: u32| id != material && scene.materials[id as usize].priority > p;
+        if entering {
+            self.iter().any(higher)
+        } else {
+            self.iter().any(|id| id == material) && self.iter().any(higher)
+        }
+    }
+
+    fn enter(&self, material: u32) -> Media {
+        let mut m = *self;
+        if (m.len as usize) < MEDIA_DEPTH {
+            m.ids[m.len as usize] = material;
+            m.len += 1;
+        }
+        m
+    }
+
+    /// Without the innermost entry of `material` (unchanged if the ray was not in it:
+    /// an open transmissive surface seen from its back).
+    fn leave(&self, material: u32) -> Media {
+        let mut m = *self;
+        if let Some(k) = m.ids[..m.len as usize]
+            .iter()
+            .rposition(|&id| id == material)
+        {
+            m.ids.copy_within(k + 1..m.len as usize, k);
+            m.len -= 1;
+            m.ids[m.len as usize] = 0;
+        }
+        m
     }
 }
 
@@ -228,6 +365,75 @@ mod tests {
                 assert!((o.x - th.sin() * 1.5).abs() < 1e-5);
             }
         }
+    }
+
+    fn dielectrics(priorities: [u32; 3]) -> Scene {
+        let cam = crate::scene::Camera {
+            from: Vec3::Z,
+            at: Vec3::ZERO,
+            up: Vec3::Y,
+            angle_deg: 40.0,
+            hither: 0.0,
+            width: 1,
+            height: 1,
+        };
+        let mut s = Scene::new(cam);
+        for (k, ior) in [1.5f32, 1.31, 1.33].into_iter().enumerate() {
+            s.materials.push(crate::scene::Material {
+                t: 1.0,
+                ior,
+                priority: priorities[k],
+                ..Default::default()
+            });
+        }
+        s
+    }
+
+    #[test]
+    fn nested_media_use_the_enclosing_index() {
+        let s = dielectrics([0, 0, 0]);
+        let air = Media::AIR;
+        assert_eq!(air.ior(&s), 1.0);
+        // Into the ice (1), then into the liquid (2) inside it: the liquid is in force;
+        // leaving the liquid returns to the ice, not to air.
+        let ice = air.enter(1);
+        let liquid = ice.enter(2);
+        assert_eq!(liquid.ior(&s), 1.33);
+        assert_eq!(liquid.leave(2).ior(&s), 1.31);
+        assert_eq!(liquid.leave(2).leave(1), air);
+        // Leaving a medium the ray was never in (an open surface's back) changes nothing.
+        assert_eq!(ice.leave(0), ice);
+        // With equal priorities every boundary is real.
+        assert!(!liquid.is_false_boundary(&s, 2, false));
+        assert!(!ice.is_false_boundary(&s, 2, true));
+    }
+
+    #[test]
+    fn priorities_skip_the_lower_medium_inside_the_higher() {
+        // Ice (priority 2) overlaps the liquid (priority 1) in the cavity walls.
+        let s = dielectrics([0, 2, 1]);
+        let in_ice = Media::AIR.enter(1);
+        // Entering the liquid inside the ice: a false boundary; the ice stays in force.
+        assert!(in_ice.is_false_boundary(&s, 2, true));
+        let both = in_ice.enter(2);
+        assert_eq!(both.ior(&s), 1.31);
+        // Leaving the ice into the cavity, below the liquid level: a real boundary into
+        // the liquid (1.31 -> 1.33), not into air.
+        assert!(!both.is_false_boundary(&s, 1, false));
+        assert_eq!(both.leave(1).ior(&s), 1.33);
+        // Entering the ice from the liquid is real (higher priority).
+        assert!(!Media::AIR.enter(2).is_false_boundary(&s, 1, true));
+        // Leaving the liquid while inside the ice: false.
+        assert!(both.is_false_boundary(&s, 2, false));
+    }
+
+    #[test]
+    fn media_depth_is_bounded() {
+        let mut m = Media::AIR;
+        for i in 0..20 {
+            m = m.enter(i);
+        }
+        assert_eq!(m.len as usize, MEDIA_DEPTH);
     }
 
     #[test]

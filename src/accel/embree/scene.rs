@@ -87,6 +87,8 @@ impl Drop for Level {
 struct UserData {
     _spheres: Option<Box<UserPrims<Sphere>>>,
     _cones: Option<Box<UserPrims<Cone>>>,
+    // Boxed: Embree holds each one's address, which a growing Vec would move.
+    #[allow(clippy::vec_box)]
     _shapes: Vec<Box<UserPrims<Shape>>>,
 }
 
