@@ -90,12 +90,14 @@ pub struct RenderArgs {
     /// Image size, overriding the scene's resolution.
     #[arg(long, value_name = "WxH", value_parser = parse_res)]
     pub res: Option<(u32, u32)>,
-    /// Samples per pixel (stratified; 1 = pixel centre).
-    #[arg(long, default_value_t = 1, value_parser = clap::value_parser!(u32).range(1..=65536))]
-    pub spp: u32,
-    /// Maximum ray-tree depth, the eye ray being depth 1.
-    #[arg(long, default_value_t = 5, value_parser = clap::value_parser!(u32).range(1..=64))]
-    pub max_depth: u32,
+    /// Samples per pixel (stratified; 1 = pixel centre) [default: the scene file's
+    /// `[render] spp`, else 1].
+    #[arg(long, value_parser = clap::value_parser!(u32).range(1..=65536))]
+    pub spp: Option<u32>,
+    /// Maximum ray-tree depth, the eye ray being depth 1 [default: the scene file's
+    /// `[render] max_depth`, else 5].
+    #[arg(long, value_parser = clap::value_parser!(u32).range(1..=64))]
+    pub max_depth: Option<u32>,
     /// Worker threads (default: all cores).
     #[arg(short, long, value_name = "N", value_parser = clap::value_parser!(u32).range(1..=4096))]
     pub threads: Option<u32>,
@@ -127,8 +129,8 @@ impl RenderArgs {
             output: Some("emray.png".into()),
             backend: None,
             res: None,
-            spp: 1,
-            max_depth: 5,
+            spp: None,
+            max_depth: None,
             threads: None,
             spd: false,
             stats: false,

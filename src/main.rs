@@ -184,8 +184,8 @@ fn render_one(args: &RenderArgs, scene_path: Option<&Path>, out: &Path) -> Resul
         settings.width = w;
         settings.height = h;
     }
-    settings.spp = args.spp;
-    settings.max_depth = args.max_depth;
+    settings.spp = args.spp.or(scene.render.spp).unwrap_or(1);
+    settings.max_depth = args.max_depth.or(scene.render.max_depth).unwrap_or(5);
     if args.spd {
         // SPD testing mode: 512x512 from a 513x513 corner grid, depth 5, one sample.
         if args.res.is_none() {

@@ -227,8 +227,19 @@ pub struct Scene {
     pub objects: Vec<Geometry>,
     /// Placed objects.
     pub instances: Vec<Instance>,
+    /// Render settings the scene file asks for (the command line overrides them).
+    pub render: RenderHints,
     /// What the loader counted.
     pub load_stats: LoadStats,
+}
+
+/// Render settings a scene file may carry; `None` leaves the renderer's default.
+#[derive(Clone, Copy, Debug, Default, PartialEq, Eq)]
+pub struct RenderHints {
+    /// Samples per pixel.
+    pub spp: Option<u32>,
+    /// Maximum ray-tree depth.
+    pub max_depth: Option<u32>,
 }
 
 impl std::ops::Deref for Scene {
@@ -409,6 +420,7 @@ impl Scene {
             geometry: Geometry::default(),
             objects: Vec::new(),
             instances: Vec::new(),
+            render: RenderHints::default(),
             load_stats: LoadStats::default(),
         }
     }
