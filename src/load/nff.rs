@@ -469,6 +469,7 @@ impl<'a> Parser<'a, '_> {
             kr: ks,
             t,
             ior,
+            filter: Vec3::ONE,
             priority: 0,
         });
         self.current_material = Some(self.materials.len() as u32 - 1);

@@ -236,7 +236,8 @@ impl<'a, A: Accel> Tracer<'a, A> {
             match refract(d, ns, n1 / n2) {
                 Some(dir) => {
                     counts.refraction += 1;
-                    color += m.t * self.trace(&spawn(dir), depth + 1, inside, counts);
+                    let filter = if entering { m.filter } else { Vec3::ONE };
+                    color += m.t * filter * self.trace(&spawn(dir), depth + 1, inside, counts);
                 }
                 None => {
                     // Total internal reflection: the transmitted energy is reflected.

@@ -108,6 +108,9 @@ pub struct Material {
     pub t: f32,
     /// Index of refraction.
     pub ior: f32,
+    /// Transmission filter: the refracted light is multiplied by it when a ray enters
+    /// the medium (a tinted liquid or glass); white for NFF materials.
+    pub filter: Vec3,
     /// Nested-dielectric priority (Schmidt & Budge 2002): where transmissive solids
     /// overlap, the one with the highest priority is the medium, and the surfaces of
     /// the others inside it are skipped. Equal priorities: every surface counts.
@@ -126,6 +129,7 @@ impl Default for Material {
             kr: 0.0,
             t: 0.0,
             ior: 1.0,
+            filter: Vec3::ONE,
             priority: 0,
         }
     }
