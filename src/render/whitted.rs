@@ -236,7 +236,10 @@ impl<'a, A: Accel> Tracer<'a, A> {
             match refract(d, ns, n1 / n2) {
                 Some(dir) => {
                     counts.refraction += 1;
-                    let filter = if entering { m.filter } else { Vec3::ONE };
+                    // Light is filtered by the medium it goes into.
+                    let filter = inside
+                        .current(scene)
+                        .map_or(Vec3::ONE, |id| scene.materials[id as usize].filter);
                     color += m.t * filter * self.trace(&spawn(dir), depth + 1, inside, counts);
                 }
                 None => {

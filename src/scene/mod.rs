@@ -108,8 +108,8 @@ pub struct Material {
     pub t: f32,
     /// Index of refraction.
     pub ior: f32,
-    /// Transmission filter: the refracted light is multiplied by it when a ray enters
-    /// the medium (a tinted liquid or glass); white for NFF materials.
+    /// Transmission filter of the medium: light refracted into it is multiplied by it
+    /// (a tinted liquid or glass); white for NFF materials.
     pub filter: Vec3,
     /// Nested-dielectric priority (Schmidt & Budge 2002): where transmissive solids
     /// overlap, the one with the highest priority is the medium, and the surfaces of
