@@ -1,0 +1,1530 @@
+//! From the [`format`](super::format) structures to a [`Scene`]: names resolved,
+//! defaults applied, transforms composed and applied, everything checked, every error at
+//! the span of the value (or table) it is about.
+//!
+//! Placement rules (the scene has exactly one level of instancing):
+//! - triangles (`triangle`, `polygon`, `mesh`, included files) are transformed into
+//!   their final coordinates (baked);
+//! - an analytic primitive under a similarity (rotation, uniform scale, translation,
+//!   mirror) whose shape stays of its kind (spheres, NFF cones) is baked too;
+//! - any other analytic primitive under a non-identity transform becomes, at the top
+//!   level, an object of its own placed by an instance; inside a `define` (which is
+//!   itself an object), a closed solid is wrapped in a one-leaf CSG with a
+//!   [`CsgTree::Transform`], and an open surface is an error;
+//! - a `define` placed by a top-level `instance` is compiled once into an object that
+//!   every instance shares; an `instance` inside a `define` copies the other define's
+//!   content in place (following the same rules), which is where cycles are caught.
+
+use super::format::{
+    LightDef, MaterialDef, ObjectDef, Real, Scale, SceneFile, Spanned, TransformList,
+    TransformStep, V3,
+};
+use super::{suggest, SceneSettings, Source, MAX_SIDE};
+use crate::geometry::polygon::Triangulator;
+use crate::geometry::{Cone, Csg, CsgOp, CsgTree, Shape, Sphere, Triangle};
+use crate::load::{nff, LoadError};
+use crate::math::{Vec3, Xform};
+use crate::scene::{Camera, Geometry, Instance, Light, LoadStats, Material, Scene, Spot, INHERIT};
+use glam::{Affine3A, DAffine3, DMat3, DVec3};
+use std::collections::HashMap;
+use std::ops::Range;
+use std::path::{Path, PathBuf};
+use std::rc::Rc;
+use std::sync::Arc;
+
+type R<T> = Result<T, LoadError>;
+
+/// Deepest nesting of objects (groups, CSG, instances copied into defines).
+const MAX_NESTING: usize = 256;
+/// Largest accepted `max_depth`.
+const MAX_RAY_DEPTH: u32 = 64;
+/// Largest accepted `spp`.
+const MAX_SPP: u32 = 65_536;
+/// Ambient light when `[render]` gives none.
+const DEFAULT_AMBIENT: f32 = 0.1;
+/// Image size when `[camera]` gives none.
+const DEFAULT_RESOLUTION: [u32; 2] = [640, 480];
+/// Field of view when `[camera]` gives none.
+const DEFAULT_FOV: f64 = 45.0;
+/// Phong exponent when a material gives none.
+const DEFAULT_SHININESS: f64 = 32.0;
+/// Spot cutoff half-angle when a light gives none.
+const DEFAULT_CUTOFF: f64 = 45.0;
+
+/// The object types.
+#[derive(Clone, Copy, Debug, PartialEq, Eq)]
+enum Ty {
+    Sphere,
+    Cone,
+    Triangle,
+    Polygon,
+    Mesh,
+    Include,
+    Group,
+    Instance,
+    Union,
+    Intersection,
+    Difference,
+}
+
+/// Each type's name and the keys it takes besides `type`, `material` and `transform`.
+const TYPES: &[(&str, Ty, &[&str])] = &[
+    ("sphere", Ty::Sphere, &["center", "radius"]),
+    (
+        "cone",
+        Ty::Cone,
+        &["base", "base_radius", "apex", "apex_radius"],
+    ),
+    ("triangle", Ty::Triangle, &["vertices", "normals"]),
+    ("polygon", Ty::Polygon, &["vertices", "normals"]),
+    ("mesh", Ty::Mesh, &["vertices", "faces", "normals"]),
+    ("include", Ty::Include, &["file", "lights"]),
+    ("group", Ty::Group, &["children"]),
+    ("instance", Ty::Instance, &["of"]),
+    ("union", Ty::Union, &["children"]),
+    ("intersection", Ty::Intersection, &["children"]),
+    ("difference", Ty::Difference, &["children"]),
+];
+
+impl Ty {
+    fn name(self) -> &'static str {
+        TYPES.iter().find(|t| t.1 == self).map_or("?", |t| t.0)
+    }
+
+    fn csg_op(self) -> Option<CsgOp> {
+        match self {
+            Ty::Union => Some(CsgOp::Union),
+            Ty::Intersection => Some(CsgOp::Intersection),
+            Ty::Difference => Some(CsgOp::Difference),
+            _ => None,
+        }
+    }
+}
+
+/// Where primitives go: the scene's top level, or an object being compiled from a
+/// `define`.
+enum Sink<'g> {
+    Top,
+    Object(&'g mut Geometry),
+}
+
+impl Sink<'_> {
+    fn in_define(&self) -> bool {
+        matches!(self, Sink::Object(_))
+    }
+}
+
+/// What a node passes down to its children.
+#[derive(Clone, Copy, Debug)]
+struct Ctx {
+    /// The node's space to the space of the sink (world, or the define's object space).
+    xform: DAffine3,
+    /// The nearest material given above, if any.
+    material: Option<u32>,
+    /// Nesting depth.
+    depth: usize,
+}
+
+impl Ctx {
+    const ROOT: Ctx = Ctx {
+        xform: DAffine3::IDENTITY,
+        material: None,
+        depth: 0,
+    };
+}
+
+/// A parsed included file, its materials already appended to the scene's.
+struct Included {
+    scene: Scene,
+    material_base: u32,
+}
+
+struct Builder<'a, 's> {
+    file: &'a SceneFile,
+    src: &'s Source<'s>,
+    materials: Vec<Material>,
+    material_names: HashMap<&'a str, u32>,
+    default_material: Option<u32>,
+    lights: Vec<Light>,
+    geometry: Geometry,
+    objects: Vec<Geometry>,
+    instances: Vec<Instance>,
+    /// Compiled defines: their object, or `None` when they hold no primitive.
+    compiled: HashMap<&'a str, Option<u32>>,
+    /// Defines being expanded, outermost first, for cycle detection.
+    define_stack: Vec<&'a str>,
+    includes: HashMap<PathBuf, Rc<Included>>,
+    stats: LoadStats,
+    /// Position of the first dropped degenerate polygon.
+    first_degenerate: Option<Range<usize>>,
+    triangulator: Triangulator,
+    pts: Vec<Vec3>,
+    nrm: Vec<Vec3>,
+    tris: Vec<[usize; 3]>,
+}
+
+/// Build the scene described by `file`, read from `src`.
+pub(super) fn build(file: &SceneFile, src: &Source) -> R<(Scene, SceneSettings)> {
+    let mut b = Builder {
+        file,
+        src,
+        materials: Vec::new(),
+        material_names: HashMap::new(),
+        default_material: None,
+        lights: Vec::new(),
+        geometry: Geometry::default(),
+        objects: Vec::new(),
+        instances: Vec::new(),
+        compiled: HashMap::new(),
+        define_stack: Vec::new(),
+        includes: HashMap::new(),
+        stats: LoadStats::default(),
+        first_degenerate: None,
+        triangulator: Triangulator::new(),
+        pts: Vec::new(),
+        nrm: Vec::new(),
+        tris: Vec::new(),
+    };
+    let camera = b.camera()?;
+    let (background, ambient, settings) = b.render()?;
+    // Materials are numbered in file order (the map itself is sorted by name).
+    let mut materials: Vec<_> = file.materials.iter().collect();
+    materials.sort_by_key(|(_, d)| d.span().start);
+    for (name, def) in materials {
+        let m = b.material(def)?;
+        b.material_names.insert(name, b.materials.len() as u32);
+        b.materials.push(m);
+    }
+    for l in &file.lights {
+        let light = b.light(l)?;
+        b.lights.push(light);
+    }
+    for obj in &file.objects {
+        b.walk(obj, Ctx::ROOT, &mut Sink::Top)?;
+    }
+    // Defines no instance placed are still checked, so that an error in one does not
+    // wait until it is first used.
+    let mut defines: Vec<_> = file.define.iter().collect();
+    defines.sort_by_key(|(_, d)| d.span().start);
+    for (name, def) in defines {
+        if !b.compiled.contains_key(name.as_str()) {
+            log::warn!(
+                "{}: define `{name}` is never instanced",
+                b.at(def.span()).display_prefix()
+            );
+            let mut scratch = Geometry::default();
+            b.define_stack.push(name);
+            b.walk(def, Ctx::ROOT, &mut Sink::Object(&mut scratch))?;
+            b.define_stack.pop();
+        }
+    }
+    if let Some(span) = &b.first_degenerate {
+        log::warn!(
+            "{}: dropped {} degenerate polygon(s) (fewer than 3 distinct vertices or zero \
+             area), the first here",
+            b.at(span.clone()).display_prefix(),
+            b.stats.degenerate_dropped
+        );
+    }
+    let scene = Scene {
+        camera,
+        background,
+        lights: b.lights,
+        ambient,
+        materials: b.materials,
+        geometry: b.geometry,
+        objects: b.objects,
+        instances: b.instances,
+        render: settings,
+        load_stats: b.stats,
+    };
+    Ok((scene, settings))
+}
+
+/// `path:line:col` of an error, for log messages.
+trait DisplayPrefix {
+    fn display_prefix(&self) -> String;
+}
+
+impl DisplayPrefix for LoadError {
+    fn display_prefix(&self) -> String {
+        format!("{}:{}:{}", self.path.display(), self.line, self.col)
+    }
+}
+
+fn v3(v: &V3) -> DVec3 {
+    DVec3::new(v[0].0, v[1].0, v[2].0)
+}
+
+fn f32v(v: DVec3) -> Vec3 {
+    v.as_vec3()
+}
+
+/// `m` in single precision.
+fn affine_f32(m: &DAffine3) -> Affine3A {
+    Affine3A::from_mat3_translation(m.matrix3.as_mat3(), m.translation.as_vec3())
+}
+
+/// The uniform scale factor of `m` if its linear part is a rotation (or mirror) times
+/// that factor, to a relative 1e-6.
+fn similarity_scale(m: &DAffine3) -> Option<f64> {
+    let l = m.matrix3;
+    let g = l.transpose() * l;
+    let s2 = (g.x_axis.x + g.y_axis.y + g.z_axis.z) / 3.0;
+    if !(s2 > 0.0 && s2.is_finite()) {
+        return None;
+    }
+    let dev = g - DMat3::from_diagonal(DVec3::splat(s2));
+    let worst = [dev.x_axis, dev.y_axis, dev.z_axis]
+        .iter()
+        .map(|c| c.abs().max_element())
+        .fold(0.0f64, f64::max);
+    (worst <= 1e-6 * s2).then(|| s2.sqrt())
+}
+
+/// `shape` under `m` as a shape of the same kind, when that is exact.
+fn bake(shape: &Shape, m: &DAffine3) -> Option<Shape> {
+    match shape {
+        Shape::Sphere(s) => {
+            let k = similarity_scale(m)?;
+            let r = (s.radius as f64 * k) as f32;
+            Some(Shape::Sphere(Sphere {
+                center: f32v(m.transform_point3(s.center.as_dvec3())),
+                radius: r,
+                inside_only: s.inside_only,
+            }))
+        }
+        Shape::Cone(c) => {
+            let k = similarity_scale(m)?;
+            let sign = if c.inside_only { -1.0 } else { 1.0 };
+            Some(Shape::Cone(Cone::new(
+                f32v(m.transform_point3(c.base.as_dvec3())),
+                sign * (c.base_radius as f64 * k) as f32,
+                f32v(m.transform_point3(c.apex.as_dvec3())),
+                sign * (c.apex_radius as f64 * k) as f32,
+            )))
+        }
+        Shape::Csg(_) => None,
+    }
+}
+
+/// "a sphere", "an include".
+fn article(name: &str) -> String {
+    let vowel = name.starts_with(['a', 'e', 'i', 'o', 'u']);
+    format!("{} {name}", if vowel { "an" } else { "a" })
+}
+
+fn did_you_mean<'c>(word: &str, candidates: impl IntoIterator<Item = &'c str>) -> String {
+    match suggest(word, candidates) {
+        Some(s) => format!(" (did you mean `{s}`?)"),
+        None => String::new(),
+    }
+}
+
+impl<'a, 's> Builder<'a, 's> {
+    /// An error at the start of `span` in the scene file.
+    fn at(&self, span: Range<usize>) -> LoadError {
+        self.src.err(span, "")
+    }
+
+    fn err(&self, span: Range<usize>, message: impl Into<String>) -> LoadError {
+        self.src.err(span, message)
+    }
+
+    // ---- numbers -------------------------------------------------------------------
+
+    fn positive(&self, v: &Spanned<Real>, what: &str) -> R<f64> {
+        let x = v.get_ref().0;
+        if x > 0.0 {
+            Ok(x)
+        } else {
+            Err(self.err(v.span(), format!("{what} must be positive, found {x}")))
+        }
+    }
+
+    fn non_negative(&self, v: &Spanned<Real>, what: &str) -> R<f64> {
+        let x = v.get_ref().0;
+        if x >= 0.0 {
+            Ok(x)
+        } else {
+            Err(self.err(v.span(), format!("{what} must not be negative, found {x}")))
+        }
+    }
+
+    fn non_negative3(&self, v: &Spanned<V3>, what: &str) -> R<Vec3> {
+        let x = v3(v.get_ref());
+        if x.min_element() >= 0.0 {
+            Ok(f32v(x))
+        } else {
+            Err(self.err(
+                v.span(),
+                format!("{what} must not have negative components, found {x}"),
+            ))
+        }
+    }
+
+    /// A non-zero vector, normalised.
+    fn direction(&self, v: &Spanned<V3>, what: &str) -> R<DVec3> {
+        let x = v3(v.get_ref());
+        let scaled = x / x.abs().max_element();
+        match scaled.try_normalize() {
+            Some(u) if x != DVec3::ZERO => Ok(u),
+            _ => Err(self.err(v.span(), format!("{what} must not be zero"))),
+        }
+    }
+
+    // ---- camera, render, materials, lights ------------------------------------------
+
+    fn camera(&self) -> R<Camera> {
+        let cam = &self.file.camera;
+        let c = cam.get_ref();
+        let fov = match &c.fov {
+            Some(f) => {
+                let a = f.get_ref().0;
+                if !(a > 0.0 && a < 180.0) {
+                    return Err(self.err(
+                        f.span(),
+                        format!("`fov` must be between 0 and 180 degrees (exclusive), found {a}"),
+                    ));
+                }
+                a
+            }
+            None => DEFAULT_FOV,
+        };
+        let hither = match &c.hither {
+            Some(h) => self.non_negative(h, "`hither`")?,
+            None => 0.0,
+        };
+        let [width, height] = match &c.resolution {
+            Some(r) => {
+                let [w, h] = *r.get_ref();
+                for (n, name) in [(w, "width"), (h, "height")] {
+                    if n == 0 || n > MAX_SIDE {
+                        return Err(self.err(
+                            r.span(),
+                            format!("image {name} must be between 1 and {MAX_SIDE}, found {n}"),
+                        ));
+                    }
+                }
+                [w, h]
+            }
+            None => DEFAULT_RESOLUTION,
+        };
+        let (from, at, up, up_span) = match &c.matrix {
+            Some(m) => {
+                if let Some((k, span)) = [("from", &c.from), ("at", &c.at), ("up", &c.up)]
+                    .into_iter()
+                    .find_map(|(k, v)| v.as_ref().map(|v| (k, v.span())))
+                {
+                    return Err(self.err(
+                        span,
+                        format!("the camera has a `matrix`, so `{k}` cannot be given too"),
+                    ));
+                }
+                let x = self.matrix(m)?;
+                let from = x.translation;
+                let forward = x.matrix3 * DVec3::NEG_Z;
+                let up = x.matrix3 * DVec3::Y;
+                (from, from + forward, up, m.span())
+            }
+            None => {
+                let (Some(from), Some(at)) = (&c.from, &c.at) else {
+                    return Err(self.err(
+                        cam.span(),
+                        "the camera needs `from` and `at` (or a `matrix`)",
+                    ));
+                };
+                let up = c.up.as_ref().map_or(DVec3::Y, |u| v3(u.get_ref()));
+                let up_span = c.up.as_ref().map_or(cam.span(), |u| u.span());
+                let (f, a) = (v3(from.get_ref()), v3(at.get_ref()));
+                if f == a {
+                    return Err(self.err(at.span(), "camera `at` equals `from`"));
+                }
+                (f, a, up, up_span)
+            }
+        };
+        let fwd = at - from;
+        let fwd = (fwd / fwd.abs().max_element()).normalize();
+        let upn = if up == DVec3::ZERO {
+            up
+        } else {
+            up / up.abs().max_element()
+        };
+        if fwd.cross(upn).try_normalize().is_none() {
+            return Err(self.err(
+                up_span,
+                "the camera's up vector is zero or parallel to the viewing direction",
+            ));
+        }
+        Ok(Camera {
+            from: f32v(from),
+            at: f32v(at),
+            up: f32v(up),
+            angle_deg: fov as f32,
+            hither: hither as f32,
+            width,
+            height,
+        })
+    }
+
+    fn render(&self) -> R<(Vec3, Vec3, SceneSettings)> {
+        let mut background = Vec3::ZERO;
+        let mut ambient = Vec3::splat(DEFAULT_AMBIENT);
+        let mut settings = SceneSettings::default();
+        if let Some(r) = &self.file.render {
+            let r = r.get_ref();
+            if let Some(b) = &r.background {
+                background = self.non_negative3(b, "`background`")?;
+            }
+            if let Some(a) = &r.ambient {
+                ambient = self.non_negative3(a, "`ambient`")?;
+            }
+            if let Some(d) = &r.max_depth {
+                let n = *d.get_ref();
+                if !(1..=MAX_RAY_DEPTH).contains(&n) {
+                    return Err(self.err(
+                        d.span(),
+                        format!("`max_depth` must be between 1 and {MAX_RAY_DEPTH}, found {n}"),
+                    ));
+                }
+                settings.max_depth = Some(n);
+            }
+            if let Some(s) = &r.spp {
+                let n = *s.get_ref();
+                if !(1..=MAX_SPP).contains(&n) {
+                    return Err(self.err(
+                        s.span(),
+                        format!("`spp` must be between 1 and {MAX_SPP}, found {n}"),
+                    ));
+                }
+                settings.spp = Some(n);
+            }
+        }
+        Ok((background, ambient, settings))
+    }
+
+    fn material(&self, def: &Spanned<MaterialDef>) -> R<Material> {
+        let d = def.get_ref();
+        let weight = |v: &Option<Spanned<Real>>, name: &str, default: f64| -> R<f32> {
+            match v {
+                Some(v) => Ok(self.non_negative(v, &format!("`{name}`"))? as f32),
+                None => Ok(default as f32),
+            }
+        };
+        let color = match &d.color {
+            Some(c) => self.non_negative3(c, "`color`")?,
+            None => Vec3::ONE,
+        };
+        let kd = weight(&d.diffuse, "diffuse", 1.0)?;
+        let ior = match &d.ior {
+            Some(v) => self.positive(v, "`ior`")? as f32,
+            None => 1.0,
+        };
+        Ok(Material {
+            color,
+            ka: weight(&d.ambient, "ambient", kd as f64)?,
+            kd,
+            ks: weight(&d.specular, "specular", 0.0)?,
+            shine: weight(&d.shininess, "shininess", DEFAULT_SHININESS)?,
+            kr: weight(&d.reflectance, "reflectance", 0.0)?,
+            t: weight(&d.transmittance, "transmittance", 0.0)?,
+            ior,
+            filter: match &d.filter {
+                Some(f) => self.non_negative3(f, "`filter`")?,
+                None => Vec3::ONE,
+            },
+            priority: d.priority.as_ref().map_or(0, |p| *p.get_ref()),
+        })
+    }
+
+    fn light(&self, def: &Spanned<LightDef>) -> R<Light> {
+        let l = def.get_ref();
+        let spot = match &l.ty {
+            None => false,
+            Some(t) => match t.get_ref().as_str() {
+                "point" => false,
+                "spot" => true,
+                other => {
+                    return Err(self.err(
+                        t.span(),
+                        format!(
+                            "unknown light type `{other}`{}; light types: point, spot",
+                            did_you_mean(other, ["point", "spot"])
+                        ),
+                    ))
+                }
+            },
+        };
+        if !spot {
+            for (k, v) in [
+                ("direction", l.direction.as_ref().map(|v| v.span())),
+                ("target", l.target.as_ref().map(|v| v.span())),
+                ("cutoff", l.cutoff.as_ref().map(|v| v.span())),
+                ("exponent", l.exponent.as_ref().map(|v| v.span())),
+            ] {
+                if let Some(span) = v {
+                    return Err(self.err(
+                        span,
+                        format!("`{k}` is for spot lights (add `type = \"spot\"`)"),
+                    ));
+                }
+            }
+        }
+        let pos = v3(l.position.get_ref());
+        let color = match &l.color {
+            Some(c) => self.non_negative3(c, "light `color`")?,
+            None => Vec3::ONE,
+        };
+        let intensity = match &l.intensity {
+            Some(i) => self.non_negative(i, "light `intensity`")? as f32,
+            None => 1.0,
+        };
+        let attenuation = match &l.attenuation {
+            Some(a) => {
+                let v = self.non_negative3(a, "`attenuation`")?;
+                if v == Vec3::ZERO {
+                    return Err(self.err(a.span(), "`attenuation` must not be all zero"));
+                }
+                v
+            }
+            None => Vec3::X,
+        };
+        let spot = if spot {
+            let dir = match (&l.direction, &l.target) {
+                (Some(d), None) => self.direction(d, "spot `direction`")?,
+                (None, Some(t)) => {
+                    let d = v3(t.get_ref()) - pos;
+                    if d == DVec3::ZERO {
+                        return Err(self.err(t.span(), "spot `target` equals its `position`"));
+                    }
+                    (d / d.abs().max_element()).normalize()
+                }
+                (Some(_), Some(t)) => {
+                    return Err(self.err(
+                        t.span(),
+                        "a spot light takes `direction` or `target`, not both",
+                    ))
+                }
+                (None, None) => {
+                    return Err(self.err(def.span(), "a spot light needs `direction` or `target`"))
+                }
+            };
+            let cutoff = match &l.cutoff {
+                Some(c) => {
+                    let a = c.get_ref().0;
+                    if !(a > 0.0 && a < 180.0) {
+                        return Err(self.err(
+                            c.span(),
+                            format!(
+                                "`cutoff` must be between 0 and 180 degrees (exclusive), found {a}"
+                            ),
+                        ));
+                    }
+                    a
+                }
+                None => DEFAULT_CUTOFF,
+            };
+            let exponent = match &l.exponent {
+                Some(e) => self.non_negative(e, "`exponent`")?,
+                None => 0.0,
+            };
+            Some(Spot {
+                dir: f32v(dir),
+                cos_cutoff: cutoff.to_radians().cos() as f32,
+                exponent: exponent as f32,
+            })
+        } else {
+            None
+        };
+        Ok(Light {
+            pos: f32v(pos),
+            color: color * intensity,
+            spot,
+            attenuation,
+        })
+    }
+
+    fn material_ref(&self, name: &Spanned<String>) -> R<u32> {
+        let n = name.get_ref().as_str();
+        self.material_names.get(n).copied().ok_or_else(|| {
+            let hint = if self.material_names.is_empty() {
+                " (the file defines no `[materials.NAME]`)".to_string()
+            } else {
+                did_you_mean(n, self.material_names.keys().copied())
+            };
+            self.err(name.span(), format!("unknown material `{n}`{hint}"))
+        })
+    }
+
+    /// The material of primitives given none: inherited inside a define, else the
+    /// default material (added on first use).
+    fn fallback_material(&mut self, sink: &Sink) -> u32 {
+        if sink.in_define() {
+            return INHERIT;
+        }
+        match self.default_material {
+            Some(m) => m,
+            None => {
+                let m = self.materials.len() as u32;
+                let def = Spanned::new(0..0, MaterialDef::default());
+                let mat = self.material(&def).expect("the default material is valid");
+                self.materials.push(mat);
+                self.default_material = Some(m);
+                m
+            }
+        }
+    }
+
+    // ---- transforms ------------------------------------------------------------------
+
+    /// An affine matrix given as 4 rows of 4.
+    fn matrix(&self, m: &Spanned<[[Real; 4]; 4]>) -> R<DAffine3> {
+        let r = m.get_ref().map(|row| row.map(|x| x.0));
+        if r[3] != [0.0, 0.0, 0.0, 1.0] {
+            return Err(self.err(
+                m.span(),
+                format!(
+                    "the last row of a matrix must be [0, 0, 0, 1] (only affine transforms), \
+                     found {:?}",
+                    r[3]
+                ),
+            ));
+        }
+        let col = |i: usize| DVec3::new(r[0][i], r[1][i], r[2][i]);
+        let x = DAffine3::from_mat3_translation(DMat3::from_cols(col(0), col(1), col(2)), col(3));
+        self.check_invertible(&x, m.span())?;
+        Ok(x)
+    }
+
+    fn check_invertible(&self, m: &DAffine3, span: Range<usize>) -> R<Xform> {
+        Xform::new(affine_f32(m)).map_err(|e| self.err(span, format!("bad transform: {e}")))
+    }
+
+    fn step(&self, st: &Spanned<TransformStep>) -> R<DAffine3> {
+        let t = st.get_ref();
+        let ops: Vec<&str> = [
+            ("translate", t.translate.is_some()),
+            ("rotate", t.rotate.is_some()),
+            ("scale", t.scale.is_some()),
+            ("matrix", t.matrix.is_some()),
+        ]
+        .into_iter()
+        .filter_map(|(k, p)| p.then_some(k))
+        .collect();
+        if ops.len() != 1 {
+            let found = if ops.is_empty() {
+                "none".to_string()
+            } else {
+                ops.join(", ")
+            };
+            return Err(self.err(
+                st.span(),
+                format!(
+                    "a transform step takes exactly one of `translate`, `rotate` (with \
+                     `angle`), `scale` or `matrix`; found {found}"
+                ),
+            ));
+        }
+        if let (Some(a), None) = (&t.angle, &t.rotate) {
+            return Err(self.err(a.span(), "`angle` goes with `rotate`"));
+        }
+        if let Some(v) = &t.translate {
+            return Ok(DAffine3::from_translation(v3(v.get_ref())));
+        }
+        if let Some(axis) = &t.rotate {
+            let u = self.direction(axis, "the rotation axis")?;
+            let Some(angle) = &t.angle else {
+                return Err(self.err(st.span(), "`rotate` needs `angle` (degrees)"));
+            };
+            return Ok(DAffine3::from_axis_angle(u, angle.get_ref().0.to_radians()));
+        }
+        if let Some(s) = &t.scale {
+            let k = match s.get_ref() {
+                Scale::Uniform(k) => DVec3::splat(k.0),
+                Scale::Axes(v) => v3(v),
+            };
+            if k.min_element() * k.max_element() == 0.0 || k.abs().min_element() == 0.0 {
+                return Err(self.err(
+                    s.span(),
+                    format!("scale factors must not be zero, found {k}"),
+                ));
+            }
+            let x = DAffine3::from_scale(k);
+            self.check_invertible(&x, s.span())?;
+            return Ok(x);
+        }
+        match &t.matrix {
+            Some(m) => self.matrix(m),
+            None => unreachable!("one operation is present"),
+        }
+    }
+
+    /// The composition of a transform list: the first step applied first.
+    fn transform_list(&self, list: &Spanned<TransformList>) -> R<DAffine3> {
+        let mut m = DAffine3::IDENTITY;
+        for st in list.get_ref() {
+            m = self.step(st)? * m;
+        }
+        self.check_invertible(&m, list.span())?;
+        Ok(m)
+    }
+
+    fn local_xform(&self, o: &ObjectDef) -> R<DAffine3> {
+        match &o.transform {
+            Some(t) => self.transform_list(t),
+            None => Ok(DAffine3::IDENTITY),
+        }
+    }
+
+    // ---- objects -----------------------------------------------------------------------
+
+    /// The node's type, after checking that it takes every key it has.
+    fn ty(&self, node: &Spanned<ObjectDef>, depth: usize) -> R<Ty> {
+        let o = node.get_ref();
+        if depth > MAX_NESTING {
+            return Err(self.err(
+                node.span(),
+                format!("objects nested deeper than {MAX_NESTING} levels"),
+            ));
+        }
+        let name = o.ty.get_ref().as_str();
+        let Some(&(_, ty, keys)) = TYPES.iter().find(|t| t.0 == name) else {
+            let all: Vec<&str> = TYPES.iter().map(|t| t.0).collect();
+            return Err(self.err(
+                o.ty.span(),
+                format!(
+                    "unknown object type `{name}`{}; types: {}",
+                    did_you_mean(name, all.iter().copied()),
+                    all.join(", ")
+                ),
+            ));
+        };
+        for (key, span) in o.keys() {
+            if key != "material" && key != "transform" && !keys.contains(&key) {
+                return Err(self.err(
+                    span,
+                    format!(
+                        "`{key}` does not apply to {} (its keys: {}material, transform)",
+                        article(name),
+                        keys.iter().map(|k| format!("{k}, ")).collect::<String>()
+                    ),
+                ));
+            }
+        }
+        Ok(ty)
+    }
+
+    fn need<'o, T>(
+        &self,
+        field: &'o Option<Spanned<T>>,
+        key: &str,
+        node: &Spanned<ObjectDef>,
+        ty: Ty,
+    ) -> R<&'o Spanned<T>> {
+        field.as_ref().ok_or_else(|| {
+            self.err(
+                node.span(),
+                format!("missing key `{key}` for {}", article(ty.name())),
+            )
+        })
+    }
+
+    fn geometry<'g>(top: &'g mut Geometry, sink: &'g mut Sink<'_>) -> &'g mut Geometry {
+        match sink {
+            Sink::Top => top,
+            Sink::Object(g) => g,
+        }
+    }
+
+    /// Place one node (and everything under it) into `sink`.
+    fn walk(&mut self, node: &'a Spanned<ObjectDef>, ctx: Ctx, sink: &mut Sink) -> R<()> {
+        let o = node.get_ref();
+        let ty = self.ty(node, ctx.depth)?;
+        let x = ctx.xform * self.local_xform(o)?;
+        let explicit = o
+            .material
+            .as_ref()
+            .map(|m| self.material_ref(m))
+            .transpose()?;
+        let inherited = explicit.or(ctx.material);
+        let inner = Ctx {
+            xform: x,
+            material: inherited,
+            depth: ctx.depth + 1,
+        };
+        match ty {
+            Ty::Group => {
+                let children = self.need(&o.children, "children", node, ty)?;
+                for c in children.get_ref() {
+                    self.walk(c, inner, sink)?;
+                }
+                Ok(())
+            }
+            Ty::Instance => self.instance(node, inner, sink),
+            Ty::Union | Ty::Intersection | Ty::Difference => {
+                let m = match inherited {
+                    Some(m) => m,
+                    None => self.fallback_material(sink),
+                };
+                self.csg(node, ty, x, m, sink)
+            }
+            Ty::Include => self.include(node, x, explicit, sink),
+            Ty::Triangle | Ty::Polygon | Ty::Mesh => {
+                let m = match inherited {
+                    Some(m) => m,
+                    None => self.fallback_material(sink),
+                };
+                self.polygons(node, ty, &x, m, sink)
+            }
+            Ty::Sphere | Ty::Cone => {
+                let m = match inherited {
+                    Some(m) => m,
+                    None => self.fallback_material(sink),
+                };
+                let shape = self.analytic(node, ty)?;
+                self.place_shape(shape, &x, m, node.get_ref().ty.span(), sink)
+            }
+        }
+    }
+
+    /// An analytic primitive in its own coordinates (before its transform).
+    fn analytic(&self, node: &Spanned<ObjectDef>, ty: Ty) -> R<Shape> {
+        let o = node.get_ref();
+        match ty {
+            Ty::Sphere => {
+                let c = v3(self.need(&o.center, "center", node, ty)?.get_ref());
+                let r =
+                    self.positive(self.need(&o.radius, "radius", node, ty)?, "sphere `radius`")?;
+                Ok(Shape::Sphere(Sphere::new(f32v(c), r as f32)))
+            }
+            Ty::Cone => {
+                let base = self.need(&o.base, "base", node, ty)?;
+                let rb = self.need(&o.base_radius, "base_radius", node, ty)?;
+                let apex = self.need(&o.apex, "apex", node, ty)?;
+                let rb_v = self.non_negative(rb, "cone `base_radius`")?;
+                let ra_v = match &o.apex_radius {
+                    Some(ra) => self.non_negative(ra, "cone `apex_radius`")?,
+                    None => 0.0,
+                };
+                if rb_v == 0.0 && ra_v == 0.0 {
+                    return Err(self.err(rb.span(), "cone radii must not both be zero"));
+                }
+                let (b, a) = (v3(base.get_ref()), v3(apex.get_ref()));
+                if f32v(b) == f32v(a) {
+                    return Err(self.err(apex.span(), "cone `apex` equals its `base`"));
+                }
+                Ok(Shape::Cone(Cone::new(
+                    f32v(b),
+                    rb_v as f32,
+                    f32v(a),
+                    ra_v as f32,
+                )))
+            }
+            _ => unreachable!("{ty:?} is not an analytic primitive"),
+        }
+    }
+
+    /// Add an analytic primitive under transform `x` (see the module notes).
+    fn place_shape(
+        &mut self,
+        shape: Shape,
+        x: &DAffine3,
+        material: u32,
+        span: Range<usize>,
+        sink: &mut Sink,
+    ) -> R<()> {
+        if *x == DAffine3::IDENTITY {
+            Self::geometry(&mut self.geometry, sink).add_shape(shape, material);
+            return Ok(());
+        }
+        if let Some(baked) = bake(&shape, x) {
+            Self::geometry(&mut self.geometry, sink).add_shape(baked, material);
+            return Ok(());
+        }
+        let xform = self.check_invertible(x, span.clone())?;
+        match sink {
+            Sink::Top => {
+                let mut object = Geometry::default();
+                object.add_shape(shape, material);
+                self.objects.push(object);
+                self.instances.push(Instance {
+                    object: self.objects.len() as u32 - 1,
+                    xform,
+                    material,
+                });
+                Ok(())
+            }
+            Sink::Object(g) => {
+                if !shape.is_solid() {
+                    return Err(self.err(
+                        span,
+                        format!(
+                            "{} under a transform other than rotation, uniform scale and \
+                             translation cannot go inside a define: a define is already \
+                             an instanced object (emray has one instancing level) and an \
+                             open surface cannot be wrapped in CSG; give it its final \
+                             coordinates, or place it outside the define",
+                            article(shape.kind().singular())
+                        ),
+                    ));
+                }
+                let tree = CsgTree::Transform {
+                    xform,
+                    child: Box::new(CsgTree::leaf(shape)),
+                };
+                let csg = Csg::new(&tree).map_err(|e| self.err(span, e))?;
+                g.add_shape(Shape::Csg(Arc::new(csg)), material);
+                Ok(())
+            }
+        }
+    }
+
+    fn lookup_define(&self, of: &Spanned<String>) -> R<(&'a str, &'a Spanned<ObjectDef>)> {
+        let name = of.get_ref().as_str();
+        match self.file.define.get_key_value(name) {
+            Some((k, v)) => Ok((k.as_str(), v)),
+            None => {
+                let hint = if self.file.define.is_empty() {
+                    " (the file has no `[define.NAME]`)".to_string()
+                } else {
+                    did_you_mean(name, self.file.define.keys().map(String::as_str))
+                };
+                Err(self.err(of.span(), format!("unknown define `{name}`{hint}")))
+            }
+        }
+    }
+
+    fn enter_define(&mut self, name: &'a str, of: &Spanned<String>) -> R<()> {
+        if self.define_stack.contains(&name) {
+            let mut chain: Vec<&str> = self.define_stack.clone();
+            chain.push(name);
+            return Err(self.err(
+                of.span(),
+                format!(
+                    "define `{name}` contains an instance of itself: {}",
+                    chain.join(" → ")
+                ),
+            ));
+        }
+        self.define_stack.push(name);
+        Ok(())
+    }
+
+    /// `instance`: at the top level, the define's shared object placed under the
+    /// instance's transform; inside a define, the define's content copied in place.
+    fn instance(&mut self, node: &'a Spanned<ObjectDef>, inner: Ctx, sink: &mut Sink) -> R<()> {
+        let of = self.need(&node.get_ref().of, "of", node, Ty::Instance)?;
+        let (name, def) = self.lookup_define(of)?;
+        if sink.in_define() {
+            self.enter_define(name, of)?;
+            self.walk(def, inner, sink)?;
+            self.define_stack.pop();
+            return Ok(());
+        }
+        let object = match self.compiled.get(name) {
+            Some(&o) => o,
+            None => {
+                self.enter_define(name, of)?;
+                let mut g = Geometry::default();
+                self.walk(def, Ctx::ROOT, &mut Sink::Object(&mut g))?;
+                self.define_stack.pop();
+                let o = if g.prim_count() == 0 {
+                    log::warn!(
+                        "{}: define `{name}` holds no primitive; its instances are left out",
+                        self.at(def.span()).display_prefix()
+                    );
+                    None
+                } else {
+                    self.objects.push(g);
+                    Some(self.objects.len() as u32 - 1)
+                };
+                self.compiled.insert(name, o);
+                o
+            }
+        };
+        if let Some(object) = object {
+            let xform = self.check_invertible(&inner.xform, node.get_ref().ty.span())?;
+            let material = match inner.material {
+                Some(m) => m,
+                None => self.fallback_material(sink),
+            };
+            self.instances.push(Instance {
+                object,
+                xform,
+                material,
+            });
+        }
+        Ok(())
+    }
+
+    // ---- CSG -------------------------------------------------------------------------
+
+    fn csg(
+        &mut self,
+        node: &'a Spanned<ObjectDef>,
+        ty: Ty,
+        x: DAffine3,
+        material: u32,
+        sink: &mut Sink,
+    ) -> R<()> {
+        let span = node.get_ref().ty.span();
+        // At the top level a transformed CSG is an instance; inside a define the
+        // transform goes into the tree.
+        let instanced = !sink.in_define() && x != DAffine3::IDENTITY;
+        let rel = if instanced { DAffine3::IDENTITY } else { x };
+        let op = ty.csg_op().expect("a CSG type");
+        let tree = self.csg_operands(node, ty, op, rel, None, 0)?;
+        let csg = Csg::new(&tree).map_err(|e| self.err(span.clone(), e))?;
+        let shape = Shape::Csg(Arc::new(csg));
+        if instanced {
+            self.place_shape(shape, &x, material, span, sink)
+        } else {
+            Self::geometry(&mut self.geometry, sink).add_shape(shape, material);
+            Ok(())
+        }
+    }
+
+    /// The left fold of a CSG node's children by `op`.
+    fn csg_operands(
+        &mut self,
+        node: &'a Spanned<ObjectDef>,
+        ty: Ty,
+        op: CsgOp,
+        rel: DAffine3,
+        material: Option<u32>,
+        depth: usize,
+    ) -> R<CsgTree> {
+        let children = self.need(&node.get_ref().children, "children", node, ty)?;
+        if children.get_ref().len() < 2 {
+            return Err(self.err(
+                children.span(),
+                format!(
+                    "{} needs at least 2 children, found {}",
+                    article(ty.name()),
+                    children.get_ref().len()
+                ),
+            ));
+        }
+        let mut acc: Option<CsgTree> = None;
+        for c in children.get_ref() {
+            let t = self.csg_operand(c, rel, material, depth + 1)?;
+            acc = Some(match acc {
+                None => t,
+                Some(a) => CsgTree::op(op, a, t),
+            });
+        }
+        Ok(acc.expect("at least two children"))
+    }
+
+    /// One CSG operand. `rel` maps the parent's space to the CSG root's; `material` is
+    /// the nearest material given inside the CSG (the root's own is the primitive's).
+    fn csg_operand(
+        &mut self,
+        node: &'a Spanned<ObjectDef>,
+        parent: DAffine3,
+        material: Option<u32>,
+        depth: usize,
+    ) -> R<CsgTree> {
+        let o = node.get_ref();
+        let ty = self.ty(node, depth)?;
+        let rel = parent * self.local_xform(o)?;
+        let material = match &o.material {
+            Some(m) => Some(self.material_ref(m)?),
+            None => material,
+        };
+        match ty {
+            Ty::Union | Ty::Intersection | Ty::Difference => {
+                let op = ty.csg_op().expect("a CSG type");
+                self.csg_operands(node, ty, op, rel, material, depth)
+            }
+            Ty::Instance => {
+                let of = self.need(&o.of, "of", node, ty)?;
+                let (name, def) = self.lookup_define(of)?;
+                self.enter_define(name, of)?;
+                let t = self.csg_operand(def, rel, material, depth + 1);
+                self.define_stack.pop();
+                t
+            }
+            Ty::Sphere | Ty::Cone => {
+                let shape = self.analytic(node, ty)?;
+                if !shape.is_solid() {
+                    return Err(self.err(
+                        o.ty.span(),
+                        format!(
+                            "{} is not a closed solid and cannot be a CSG operand",
+                            article(shape.kind().singular())
+                        ),
+                    ));
+                }
+                let leaf = |shape| CsgTree::Leaf { shape, material };
+                if rel == DAffine3::IDENTITY {
+                    Ok(leaf(shape))
+                } else if let Some(baked) = bake(&shape, &rel) {
+                    Ok(leaf(baked))
+                } else {
+                    let xform = self.check_invertible(&rel, o.ty.span())?;
+                    Ok(CsgTree::Transform {
+                        xform,
+                        child: Box::new(leaf(shape)),
+                    })
+                }
+            }
+            Ty::Group => Err(self.err(
+                o.ty.span(),
+                "a group is not a solid and cannot be a CSG operand (combine solids with \
+                 `union`)",
+            )),
+            Ty::Triangle | Ty::Polygon | Ty::Mesh | Ty::Include => Err(self.err(
+                o.ty.span(),
+                format!(
+                    "{} is not a closed solid and cannot be a CSG operand",
+                    article(ty.name())
+                ),
+            )),
+        }
+    }
+
+    // ---- triangles -----------------------------------------------------------------------
+
+    /// `triangle`, `polygon` and `mesh`.
+    fn polygons(
+        &mut self,
+        node: &Spanned<ObjectDef>,
+        ty: Ty,
+        x: &DAffine3,
+        material: u32,
+        sink: &mut Sink,
+    ) -> R<()> {
+        let o = node.get_ref();
+        let vertices = self.need(&o.vertices, "vertices", node, ty)?;
+        let vs = vertices.get_ref();
+        let normals = match &o.normals {
+            Some(n) => {
+                if n.get_ref().len() != vs.len() {
+                    return Err(self.err(
+                        n.span(),
+                        format!(
+                            "`normals` must have one normal per vertex: {} vertices, {} normals",
+                            vs.len(),
+                            n.get_ref().len()
+                        ),
+                    ));
+                }
+                let mut out = Vec::with_capacity(vs.len());
+                for v in n.get_ref() {
+                    out.push(self.direction(v, "a vertex normal")?);
+                }
+                Some(out)
+            }
+            None => None,
+        };
+        let need_count = |ok: bool, what: &str| -> R<()> {
+            if ok {
+                Ok(())
+            } else {
+                Err(self.err(
+                    vertices.span(),
+                    format!("{} needs {what}, found {}", article(ty.name()), vs.len()),
+                ))
+            }
+        };
+        let pts: Vec<DVec3> = vs.iter().map(|v| v3(v.get_ref())).collect();
+        match ty {
+            Ty::Triangle => {
+                need_count(vs.len() == 3, "exactly 3 vertices")?;
+                self.emit_polygon(
+                    &pts,
+                    normals.as_deref(),
+                    None,
+                    x,
+                    material,
+                    node.span(),
+                    sink,
+                );
+            }
+            Ty::Polygon => {
+                need_count(vs.len() >= 3, "at least 3 vertices")?;
+                self.emit_polygon(
+                    &pts,
+                    normals.as_deref(),
+                    None,
+                    x,
+                    material,
+                    node.span(),
+                    sink,
+                );
+            }
+            Ty::Mesh => {
+                let faces = self.need(&o.faces, "faces", node, ty)?;
+                for f in faces.get_ref() {
+                    let idx = f.get_ref();
+                    if idx.len() < 3 {
+                        return Err(self.err(
+                            f.span(),
+                            format!(
+                                "a face needs at least 3 vertex indices, found {}",
+                                idx.len()
+                            ),
+                        ));
+                    }
+                    if let Some(&bad) = idx.iter().find(|&&i| i as usize >= pts.len()) {
+                        return Err(self.err(
+                            f.span(),
+                            format!(
+                                "vertex index {bad} is out of range: the mesh has {} vertices \
+                                 (indices start at 0)",
+                                pts.len()
+                            ),
+                        ));
+                    }
+                    self.emit_polygon(
+                        &pts,
+                        normals.as_deref(),
+                        Some(idx),
+                        x,
+                        material,
+                        f.span(),
+                        sink,
+                    );
+                }
+            }
+            _ => unreachable!("{ty:?} is not made of polygons"),
+        }
+        Ok(())
+    }
+
+    /// Transform a polygon (the points `pts[indices[i]]`, or all of `pts`) and its
+    /// vertex normals by `x`, triangulate it and add the triangles. Under a mirroring
+    /// transform the vertex order is reversed so that the front side stays the front.
+    #[allow(clippy::too_many_arguments)]
+    fn emit_polygon(
+        &mut self,
+        pts: &[DVec3],
+        normals: Option<&[DVec3]>,
+        indices: Option<&[u32]>,
+        x: &DAffine3,
+        material: u32,
+        span: Range<usize>,
+        sink: &mut Sink,
+    ) {
+        let normal_matrix = x.matrix3.inverse().transpose();
+        let mirror = x.matrix3.determinant() < 0.0;
+        self.pts.clear();
+        self.nrm.clear();
+        let n = indices.map_or(pts.len(), <[u32]>::len);
+        for k in 0..n {
+            let k = if mirror { n - 1 - k } else { k };
+            let i = indices.map_or(k, |ix| ix[k] as usize);
+            self.pts.push(f32v(x.transform_point3(pts[i])));
+            if let Some(ns) = normals {
+                self.nrm.push(f32v((normal_matrix * ns[i]).normalize()));
+            }
+        }
+        self.stats.polygons += 1;
+        if self
+            .triangulator
+            .triangulate(&self.pts, &mut self.tris)
+            .is_err()
+        {
+            self.stats.degenerate_dropped += 1;
+            if self.first_degenerate.is_none() {
+                self.first_degenerate = Some(span);
+            }
+            return;
+        }
+        let g = Self::geometry(&mut self.geometry, sink);
+        for &[a, b, c] in &self.tris {
+            let tri = Triangle {
+                p: [self.pts[a], self.pts[b], self.pts[c]],
+            };
+            if normals.is_some() {
+                g.add_smooth_triangle(tri, [self.nrm[a], self.nrm[b], self.nrm[c]], material);
+            } else {
+                g.add_triangle(tri, material);
+            }
+        }
+    }
+
+    // ---- includes ------------------------------------------------------------------------
+
+    /// The included file `file`, read once however often it is placed.
+    fn included(&mut self, file: &Spanned<String>) -> R<Rc<Included>> {
+        let rel = Path::new(file.get_ref());
+        let dir = self.src.path.parent().unwrap_or(Path::new(""));
+        let path = dir.join(rel);
+        if let Some(inc) = self.includes.get(&path) {
+            return Ok(inc.clone());
+        }
+        let ext = rel
+            .extension()
+            .and_then(|e| e.to_str())
+            .map(str::to_ascii_lowercase);
+        if matches!(ext.as_deref(), Some("toml" | "obj")) {
+            return Err(self.err(
+                file.span(),
+                format!(
+                    "cannot include `{}`: only NFF files can be included",
+                    rel.display()
+                ),
+            ));
+        }
+        let bytes = std::fs::read(&path).map_err(|e| {
+            self.err(
+                file.span(),
+                format!("cannot read included file `{}`: {e}", path.display()),
+            )
+        })?;
+        let text = String::from_utf8_lossy(&bytes);
+        let (line, col) = self.src.position(file.span().start);
+        let scene = nff::parse_str(&text, &path).map_err(|mut e| {
+            e.message = format!(
+                "{} (included from {}:{line}:{col})",
+                e.message,
+                self.src.path.display()
+            );
+            e
+        })?;
+        let material_base = self.materials.len() as u32;
+        self.materials.extend_from_slice(&scene.materials);
+        self.stats.polygons += scene.load_stats.polygons;
+        self.stats.degenerate_dropped += scene.load_stats.degenerate_dropped;
+        let inc = Rc::new(Included {
+            scene,
+            material_base,
+        });
+        self.includes.insert(path, inc.clone());
+        Ok(inc)
+    }
+
+    /// `include`: an NFF file's primitives (and optionally lights) under the node's
+    /// transform; its materials, unless the node gives one for all of them.
+    fn include(
+        &mut self,
+        node: &Spanned<ObjectDef>,
+        x: DAffine3,
+        material: Option<u32>,
+        sink: &mut Sink,
+    ) -> R<()> {
+        let o = node.get_ref();
+        let file = self.need(&o.file, "file", node, Ty::Include)?;
+        let inc = self.included(file)?;
+        let s = &inc.scene;
+        let mat = |m: u32| material.unwrap_or(inc.material_base + m);
+        if let Some(l) = &o.lights {
+            if *l.get_ref() {
+                if sink.in_define() {
+                    return Err(self.err(
+                        l.span(),
+                        "an include inside a define cannot bring lights (a define is an \
+                         object placed by instances; lights are not instanced)",
+                    ));
+                }
+                for light in &s.lights {
+                    self.lights.push(Light {
+                        pos: f32v(x.transform_point3(light.pos.as_dvec3())),
+                        ..*light
+                    });
+                }
+            }
+        }
+        let normal_matrix = x.matrix3.inverse().transpose();
+        let mirror = x.matrix3.determinant() < 0.0;
+        let identity = x == DAffine3::IDENTITY;
+        {
+            let g = Self::geometry(&mut self.geometry, sink);
+            for (i, tri) in s.triangles.items.iter().enumerate() {
+                let m = mat(s.triangles.material[i]);
+                let mut p = tri.p;
+                if !identity {
+                    p = p.map(|v| f32v(x.transform_point3(v.as_dvec3())));
+                }
+                let normals = match s.triangle_normals[i] {
+                    u32::MAX => None,
+                    k => {
+                        let mut n = s.vertex_normals[k as usize];
+                        if !identity {
+                            n = n.map(|v| f32v((normal_matrix * v.as_dvec3()).normalize()));
+                        }
+                        Some(n)
+                    }
+                };
+                let (p, normals) = if mirror {
+                    ([p[0], p[2], p[1]], normals.map(|n| [n[0], n[2], n[1]]))
+                } else {
+                    (p, normals)
+                };
+                match normals {
+                    Some(n) => g.add_smooth_triangle(Triangle { p }, n, m),
+                    None => g.add_triangle(Triangle { p }, m),
+                }
+            }
+        }
+        let span = o.ty.span();
+        for (i, sphere) in s.spheres.items.iter().enumerate() {
+            let m = mat(s.spheres.material[i]);
+            self.place_shape(Shape::Sphere(*sphere), &x, m, span.clone(), sink)?;
+        }
+        for (i, cone) in s.cones.items.iter().enumerate() {
+            let m = mat(s.cones.material[i]);
+            self.place_shape(Shape::Cone(*cone), &x, m, span.clone(), sink)?;
+        }
+        for (i, shape) in s.shapes.items.iter().enumerate() {
+            let m = mat(s.shapes.material[i]);
+            self.place_shape(shape.clone(), &x, m, span.clone(), sink)?;
+        }
+        Ok(())
+    }
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+    use std::collections::BTreeSet;
+
+    #[test]
+    fn similarity_detection() {
+        let r = DAffine3::from_axis_angle(DVec3::new(1.0, 2.0, 3.0).normalize(), 0.7);
+        assert_eq!(similarity_scale(&r).map(|s| (s * 1e9).round()), Some(1e9));
+        let s = DAffine3::from_translation(DVec3::X) * DAffine3::from_scale(DVec3::splat(-2.5)) * r;
+        assert!((similarity_scale(&s).unwrap() - 2.5).abs() < 1e-12);
+        let ns = DAffine3::from_scale(DVec3::new(1.0, 2.0, 1.0)) * r;
+        assert_eq!(similarity_scale(&ns), None);
+        let shear = DAffine3::from_mat3(DMat3::from_cols(
+            DVec3::X,
+            DVec3::new(0.1, 1.0, 0.0),
+            DVec3::Z,
+        ));
+        assert_eq!(similarity_scale(&shear), None);
+    }
+
+    #[test]
+    fn spheres_bake_under_similarities_only() {
+        let s = Shape::Sphere(Sphere::new(Vec3::new(1.0, 0.0, 0.0), 2.0));
+        let m = DAffine3::from_translation(DVec3::new(0.0, 5.0, 0.0))
+            * DAffine3::from_scale(DVec3::splat(3.0))
+            * DAffine3::from_axis_angle(DVec3::Z, std::f64::consts::FRAC_PI_2);
+        let Some(Shape::Sphere(b)) = bake(&s, &m) else {
+            panic!("not baked")
+        };
+        assert!(
+            (b.center - Vec3::new(0.0, 8.0, 0.0)).length() < 1e-5,
+            "{}",
+            b.center
+        );
+        assert!((b.radius - 6.0).abs() < 1e-5);
+        assert!(bake(&s, &DAffine3::from_scale(DVec3::new(1.0, 2.0, 3.0))).is_none());
+    }
+
+    #[test]
+    fn every_type_has_distinct_keys() {
+        for (name, _, keys) in TYPES {
+            let set: BTreeSet<_> = keys.iter().collect();
+            assert_eq!(set.len(), keys.len(), "{name}");
+            for k in *keys {
+                assert!(super::super::format::OBJECT_KEYS.contains(k), "{name}.{k}");
+            }
+        }
+        let names: BTreeSet<_> = TYPES.iter().map(|t| t.0).collect();
+        assert_eq!(names.len(), TYPES.len());
+    }
+}

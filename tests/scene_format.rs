@@ -1,0 +1,1310 @@
+//! The TOML scene format: every key round-trips, every object type builds what it says,
+//! transforms compose in the documented order, defines are shared, CSG classifies
+//! points, NFF files are included, and every malformed file is reported at the right
+//! line. Errors are checked against a `# HERE` marker on the line they must name.
+
+use emray::geometry::{Intersect, Kind, Shape};
+use emray::load::toml::{self as scene_toml, format::SceneFile, SceneSettings};
+use emray::load::LoadError;
+use emray::math::Vec3;
+use emray::scene::{Scene, INHERIT};
+use std::path::{Path, PathBuf};
+
+const CAMERA: &str = "[camera]\nfrom = [0, 0, 10]\nat = [0, 0, 0]\n";
+
+fn parse(src: &str) -> Result<Scene, LoadError> {
+    scene_toml::parse_str(src, Path::new("test.toml"))
+}
+
+/// A scene made of `CAMERA` followed by `body`.
+fn build(body: &str) -> Scene {
+    let src = format!("{CAMERA}{body}");
+    match parse(&src) {
+        Ok(s) => s,
+        Err(e) => panic!("{e}\n--- in ---\n{src}"),
+    }
+}
+
+/// The 1-based line of `src` holding the `# HERE` marker.
+fn marked_line(src: &str) -> usize {
+    let lines: Vec<usize> = src
+        .lines()
+        .enumerate()
+        .filter(|(_, l)| l.contains("# HERE"))
+        .map(|(i, _)| i + 1)
+        .collect();
+    assert_eq!(lines.len(), 1, "exactly one # HERE marker in:\n{src}");
+    lines[0]
+}
+
+/// Parse `CAMERA + body`, expect an error on the marked line whose message contains
+/// every one of `words`.
+fn error_at(body: &str, words: &[&str]) -> LoadError {
+    let src = format!("{CAMERA}{body}");
+    let e = match parse(&src) {
+        Ok(_) => panic!("expected an error in:\n{src}"),
+        Err(e) => e,
+    };
+    assert_eq!(e.path, Path::new("test.toml"), "{e}");
+    assert_eq!(e.line, marked_line(&src), "wrong line for: {e}\n{src}");
+    assert!(e.col >= 1, "{e}");
+    for w in words {
+        assert!(e.message.contains(w), "`{w}` not in: {e}");
+    }
+    e
+}
+
+fn close(a: Vec3, b: Vec3) -> bool {
+    (a - b).length() <= 1e-4 * (1.0 + b.length())
+}
+
+fn assert_close(a: Vec3, b: Vec3) {
+    assert!(close(a, b), "{a} != {b}");
+}
+
+/// A file that uses every key of the format (object keys included, whatever type they
+/// belong to).
+const EVERY_KEY: &str = r#"
+[camera]
+from = [0, 2, 8]
+at = [0, 0.5, 0]
+up = [0, 1, 0]
+fov = 40
+hither = 0.01
+resolution = [640, 480]
+
+[render]
+background = [0.1, 0.1, 0.15]
+ambient = [0.1, 0.1, 0.1]
+max_depth = 8
+spp = 4
+
+[materials.glass]
+color = [1, 1, 1]
+ambient = 0.0
+diffuse = 0.1
+specular = 0.6
+shininess = 120
+reflectance = 0.1
+transmittance = 0.9
+ior = 1.5
+filter = [0.9, 1, 0.9]
+priority = 1
+
+[materials.red]
+color = [0.8, 0.1, 0.1]
+
+[[lights]]
+type = "point"
+position = [5, 8, 5]
+color = [1, 1, 1]
+intensity = 0.8
+attenuation = [1, 0, 0.01]
+
+[[lights]]
+type = "spot"
+position = [0, 10, 0]
+direction = [0, -1, 0]
+cutoff = 25
+exponent = 10
+
+[[lights]]
+type = "spot"
+position = [0, 10, 0]
+target = [0, 0, 0]
+
+[define.chair]
+type = "group"
+material = "red"
+children = [
+  { type = "sphere", center = [0, 1, 0], radius = 0.5 },
+  { type = "instance", of = "leg" },
+]
+
+[define.leg]
+type = "cone"
+base = [0, 0, 0]
+base_radius = 0.1
+apex = [0, 1, 0]
+apex_radius = 0.05
+
+[[objects]]
+type = "sphere"
+center = [0, 1, 0]
+radius = 1
+material = "glass"
+transform = [
+  { translate = [1, 2, 3] },
+  { rotate = [0, 1, 0], angle = 30 },
+  { scale = 2 },
+  { scale = [1, 2, 3] },
+  { matrix = [[1, 0, 0, 0], [0, 1, 0, 0], [0, 0, 1, 0], [0, 0, 0, 1]] },
+]
+
+[[objects]]
+type = "cylinder"
+base = [0, 0, 0]
+axis = [0, 1, 0]
+height = 2
+radius = 0.5
+
+[[objects]]
+type = "capped_cone"
+base = [0, 0, 0]
+axis = [0, 1, 0]
+height = 2
+base_radius = 0.5
+top_radius = 0.25
+
+[[objects]]
+type = "box"
+min = [0, 0, 0]
+max = [1, 1, 1]
+
+[[objects]]
+type = "obox"
+center = [0, 0, 0]
+size = [1, 2, 3]
+rotation = [{ rotate = [0, 0, 1], angle = 45 }]
+
+[[objects]]
+type = "obox"
+center = [0, 0, 0]
+half_size = [1, 2, 3]
+axes = [[1, 0, 0], [0, 1, 0], [0, 0, 1]]
+
+[[objects]]
+type = "polyhedron"
+planes = [[1, 0, 0, 1], [-1, 0, 0, 1], [0, 1, 0, 1], [0, -1, 0, 1], [0, 0, 1, 1], [0, 0, -1, 1]]
+
+[[objects]]
+type = "polyhedron"
+preset = "icosahedron"
+center = [0, 0, 0]
+radius = 1
+
+[[objects]]
+type = "polyhedron"
+sides = 6
+radius = 1
+height = 2
+base = [0, 0, 0]
+axis = [0, 1, 0]
+
+[[objects]]
+type = "quadric"
+coefficients = [1, 1, 1, 0, 0, 0, 0, 0, 0, -1]
+clip = { min = [-1, -1, -1], max = [1, 1, 1] }
+
+[[objects]]
+type = "plane"
+point = [0, 0, 0]
+normal = [0, 1, 0]
+
+[[objects]]
+type = "torus"
+center = [0, 0, 0]
+axis = [0, 1, 0]
+major_radius = 1
+minor_radius = 0.25
+
+[[objects]]
+type = "triangle"
+vertices = [[0, 0, 0], [1, 0, 0], [0, 1, 0]]
+normals = [[0, 0, 1], [0, 0, 1], [0, 0, 1]]
+
+[[objects]]
+type = "polygon"
+vertices = [[0, 0, 0], [1, 0, 0], [1, 1, 0], [0, 1, 0]]
+
+[[objects]]
+type = "mesh"
+vertices = [[0, 0, 0], [1, 0, 0], [1, 1, 0], [0, 1, 0]]
+faces = [[0, 1, 2], [0, 2, 3]]
+normals = [[0, 0, 1], [0, 0, 1], [0, 0, 1], [0, 0, 1]]
+
+[[objects]]
+type = "bezier"
+builtin = "teapot"
+tolerance = 0.01
+
+[[objects]]
+type = "bezier"
+patches = [[
+  [0, 0, 0], [1, 0, 0], [2, 0, 0], [3, 0, 0],
+  [0, 1, 0], [1, 1, 1], [2, 1, 1], [3, 1, 0],
+  [0, 2, 0], [1, 2, 1], [2, 2, 1], [3, 2, 0],
+  [0, 3, 0], [1, 3, 0], [2, 3, 0], [3, 3, 0],
+]]
+
+[[objects]]
+type = "include"
+file = "parts/table.nff"
+lights = true
+
+[[objects]]
+type = "instance"
+of = "chair"
+material = "glass"
+
+[[objects]]
+type = "difference"
+children = [
+  { type = "union", children = [
+      { type = "sphere", center = [0, 0, 0], radius = 1 },
+      { type = "sphere", center = [1, 0, 0], radius = 1, material = "red" },
+  ] },
+  { type = "intersection", children = [
+      { type = "sphere", center = [0, 0, 0], radius = 0.5 },
+      { type = "sphere", center = [0.2, 0, 0], radius = 0.5 },
+  ] },
+]
+"#;
+
+#[test]
+fn every_key_round_trips() {
+    let file = scene_toml::parse_file(EVERY_KEY, Path::new("every.toml")).unwrap();
+    let text = file.to_toml_string().unwrap();
+    let again = scene_toml::parse_file(&text, Path::new("again.toml"))
+        .unwrap_or_else(|e| panic!("{e}\n{text}"));
+    assert_eq!(file, again, "{text}");
+    // And the written form is stable.
+    assert_eq!(again.to_toml_string().unwrap(), text);
+
+    // Every object key of the format appears in the file.
+    let mut keys = std::collections::BTreeSet::new();
+    fn collect(o: &scene_toml::format::ObjectDef, keys: &mut std::collections::BTreeSet<&str>) {
+        for (k, _) in o.keys() {
+            keys.insert(k);
+        }
+        if let Some(c) = &o.children {
+            for c in c.get_ref() {
+                collect(c.get_ref(), keys);
+            }
+        }
+    }
+    for o in &file.objects {
+        collect(o.get_ref(), &mut keys);
+    }
+    for o in file.define.values() {
+        collect(o.get_ref(), &mut keys);
+    }
+    for k in scene_toml::format::OBJECT_KEYS {
+        assert!(
+            *k == "type" || keys.contains(k),
+            "`{k}` is not used by the test file"
+        );
+    }
+    // Spot checks that values survived.
+    let lights = &again.lights;
+    assert_eq!(lights.len(), 3);
+    assert_eq!(
+        lights[1].get_ref().cutoff.as_ref().unwrap().get_ref().0,
+        25.0
+    );
+    assert_eq!(
+        again.materials["glass"]
+            .get_ref()
+            .priority
+            .as_ref()
+            .map(|p| *p.get_ref()),
+        Some(1)
+    );
+}
+
+#[test]
+fn sphere_and_materials() {
+    let s = build(
+        r#"
+[materials.glass]
+color = [0.9, 0.95, 1]
+ambient = 0.05
+diffuse = 0.1
+specular = 0.6
+shininess = 120
+reflectance = 0.1
+transmittance = 0.9
+ior = 1.5
+filter = [0.5, 0.75, 1]
+priority = 2
+
+[materials.plain]
+
+[[objects]]
+type = "sphere"
+center = [1, 2, 3]
+radius = 0.5
+material = "glass"
+
+[[objects]]
+type = "sphere"
+center = [0, 0, 0]
+radius = 2
+"#,
+    );
+    assert_eq!(s.count(Kind::Sphere), 2);
+    assert_eq!(s.prim_count(), 2);
+    let sp = &s.spheres.items[0];
+    assert_eq!(
+        (sp.center, sp.radius, sp.inside_only),
+        (Vec3::new(1.0, 2.0, 3.0), 0.5, false)
+    );
+    let glass = s.materials[s.spheres.material[0] as usize];
+    assert_eq!(glass.color, Vec3::new(0.9, 0.95, 1.0));
+    assert_eq!(glass.filter, Vec3::new(0.5, 0.75, 1.0));
+    assert_eq!(
+        (
+            glass.ka,
+            glass.kd,
+            glass.ks,
+            glass.shine,
+            glass.kr,
+            glass.t,
+            glass.ior,
+            glass.priority
+        ),
+        (0.05, 0.1, 0.6, 120.0, 0.1, 0.9, 1.5, 2)
+    );
+    // An empty material takes every default; a primitive without one gets the default
+    // material, which is the same.
+    let plain = s.materials[1];
+    let fallback = s.materials[s.spheres.material[1] as usize];
+    assert_eq!(s.materials.len(), 3);
+    for m in [plain, fallback] {
+        assert_eq!((m.color, m.filter), (Vec3::ONE, Vec3::ONE));
+        assert_eq!(
+            (m.ka, m.kd, m.ks, m.shine, m.kr, m.t, m.ior, m.priority),
+            (1.0, 1.0, 0.0, 32.0, 0.0, 0.0, 1.0, 0)
+        );
+    }
+    // Ka defaults to Kd.
+    let s = build("[materials.m]\ndiffuse = 0.3\n[[objects]]\ntype = \"sphere\"\ncenter = [0, 0, 0]\nradius = 1\nmaterial = \"m\"\n");
+    assert_eq!(s.materials[0].ka, 0.3);
+}
+
+#[test]
+fn camera_render_and_lights() {
+    let src = r#"
+[camera]
+from = [0, 2, 8]
+at = [0, 0.5, 0]
+up = [0, 0, 1]
+fov = 40
+hither = 0.5
+resolution = [320, 200]
+
+[render]
+background = [0.1, 0.2, 0.3]
+ambient = [0.05, 0.05, 0.05]
+max_depth = 8
+spp = 16
+
+[[lights]]
+position = [5, 8, 5]
+color = [1, 0.5, 0.25]
+intensity = 0.5
+attenuation = [1, 0, 0.01]
+
+[[lights]]
+type = "spot"
+position = [0, 10, 0]
+target = [0, 0, 0]
+cutoff = 30
+exponent = 4
+"#;
+    let (s, settings) = scene_toml::parse_str_with_settings(src, Path::new("c.toml")).unwrap();
+    let c = s.camera;
+    assert_eq!(
+        (c.from, c.at, c.up),
+        (Vec3::new(0.0, 2.0, 8.0), Vec3::new(0.0, 0.5, 0.0), Vec3::Z)
+    );
+    assert_eq!(
+        (c.angle_deg, c.hither, c.width, c.height),
+        (40.0, 0.5, 320, 200)
+    );
+    assert_eq!(s.background, Vec3::new(0.1, 0.2, 0.3));
+    assert_eq!(s.ambient, Vec3::splat(0.05));
+    assert_eq!(
+        settings,
+        SceneSettings {
+            max_depth: Some(8),
+            spp: Some(16)
+        }
+    );
+    assert_eq!(s.render, settings);
+
+    assert_eq!(s.lights.len(), 2);
+    let p = s.lights[0];
+    assert_eq!(
+        (p.pos, p.color, p.attenuation),
+        (
+            Vec3::new(5.0, 8.0, 5.0),
+            Vec3::new(0.5, 0.25, 0.125),
+            Vec3::new(1.0, 0.0, 0.01)
+        )
+    );
+    assert!(p.spot.is_none());
+    let spot = s.lights[1].spot.unwrap();
+    assert_close(spot.dir, Vec3::NEG_Y);
+    assert!((spot.cos_cutoff - 30f32.to_radians().cos()).abs() < 1e-6);
+    assert_eq!(spot.exponent, 4.0);
+    assert_eq!(s.lights[1].color, Vec3::ONE);
+
+    // Defaults.
+    let (s, settings) = scene_toml::parse_str_with_settings(CAMERA, Path::new("d.toml")).unwrap();
+    assert_eq!(
+        (s.camera.up, s.camera.angle_deg, s.camera.hither),
+        (Vec3::Y, 45.0, 0.0)
+    );
+    assert_eq!((s.camera.width, s.camera.height), (640, 480));
+    assert_eq!((s.background, s.ambient), (Vec3::ZERO, Vec3::splat(0.1)));
+    assert_eq!(settings, SceneSettings::default());
+    assert_eq!(s.prim_count(), 0);
+}
+
+#[test]
+fn matrix_camera() {
+    // Camera to world: a quarter turn about y, then moved to (10, 1, 0): it looks down
+    // the world's −x.
+    let s = parse(
+        "[camera]\nmatrix = [[0, 0, 1, 10], [0, 1, 0, 1], [-1, 0, 0, 0], [0, 0, 0, 1]]\nfov = 30\n",
+    )
+    .unwrap();
+    assert_eq!(s.camera.from, Vec3::new(10.0, 1.0, 0.0));
+    assert_close(s.camera.at - s.camera.from, Vec3::NEG_X);
+    assert_close(s.camera.up, Vec3::Y);
+    assert_eq!(s.camera.angle_deg, 30.0);
+}
+
+#[test]
+fn cones() {
+    let s = build(
+        r#"
+[[objects]]
+type = "cone"
+base = [0, 0, 0]
+base_radius = 1
+apex = [0, 2, 0]
+apex_radius = 0.5
+
+[[objects]]
+type = "cone"
+base = [0, 0, 0]
+base_radius = 1
+apex = [0, 0, 3]
+"#,
+    );
+    assert_eq!(s.count(Kind::Cone), 2);
+    let c = &s.cones.items[0];
+    assert_eq!(
+        (c.base, c.base_radius, c.apex, c.apex_radius),
+        (Vec3::ZERO, 1.0, Vec3::new(0.0, 2.0, 0.0), 0.5)
+    );
+    assert_eq!(s.cones.items[1].apex_radius, 0.0);
+}
+
+#[test]
+fn triangles_polygons_and_meshes() {
+    let s = build(
+        r#"
+[[objects]]
+type = "triangle"
+vertices = [[0, 0, 0], [1, 0, 0], [0, 1, 0]]
+
+[[objects]]
+type = "triangle"
+vertices = [[0, 0, 1], [1, 0, 1], [0, 1, 1]]
+normals = [[0, 0, 1], [0, 0, 2], [1, 0, 1]]
+
+# An L: concave, six corners, four triangles.
+[[objects]]
+type = "polygon"
+vertices = [[0, 0, 0], [2, 0, 0], [2, 1, 0], [1, 1, 0], [1, 2, 0], [0, 2, 0]]
+
+# A unit cube of six quads.
+[[objects]]
+type = "mesh"
+vertices = [[0, 0, 0], [1, 0, 0], [1, 1, 0], [0, 1, 0], [0, 0, 1], [1, 0, 1], [1, 1, 1], [0, 1, 1]]
+faces = [[0, 3, 2, 1], [4, 5, 6, 7], [0, 1, 5, 4], [2, 3, 7, 6], [1, 2, 6, 5], [0, 4, 7, 3]]
+
+# Degenerate: dropped and counted.
+[[objects]]
+type = "polygon"
+vertices = [[0, 0, 0], [1, 0, 0], [2, 0, 0]]
+"#,
+    );
+    assert_eq!(s.count(Kind::Triangle), 1 + 1 + 4 + 12);
+    assert_eq!(s.load_stats.polygons, 1 + 1 + 1 + 6 + 1);
+    assert_eq!(s.load_stats.degenerate_dropped, 1);
+    // Flat, then smooth with unit normals.
+    assert_eq!(s.triangle_normals[0], u32::MAX);
+    let k = s.triangle_normals[1] as usize;
+    assert_close(s.vertex_normals[k][1], Vec3::Z);
+    assert_close(s.vertex_normals[k][2], Vec3::new(1.0, 0.0, 1.0).normalize());
+    // The L's area is 3 and its triangles face +z as its winding says.
+    let l = &s.triangles.items[2..6];
+    let area: f32 = l.iter().map(|t| t.area()).sum();
+    assert!((area - 3.0).abs() < 1e-5, "{area}");
+    assert!(l.iter().all(|t| t.normal().z > 0.0));
+    // The cube's faces point outwards.
+    for t in &s.triangles.items[6..18] {
+        let c = (t.p[0] + t.p[1] + t.p[2]) / 3.0;
+        assert!(t.normal().dot(c - Vec3::splat(0.5)) > 0.0, "{t:?}");
+    }
+}
+
+#[test]
+fn transforms_apply_in_list_order() {
+    let s = build(
+        r#"
+[[objects]]
+type = "sphere"
+center = [1, 0, 0]
+radius = 1
+transform = [{ scale = 2 }, { translate = [0, 5, 0] }]
+
+[[objects]]
+type = "sphere"
+center = [1, 0, 0]
+radius = 1
+transform = [{ translate = [0, 5, 0] }, { scale = 2 }]
+
+[[objects]]
+type = "sphere"
+center = [1, 0, 0]
+radius = 1
+transform = [{ rotate = [0, 0, 1], angle = 90 }, { translate = [10, 0, 0] }]
+
+# Nesting: the child's own transform first, then the group's.
+[[objects]]
+type = "group"
+transform = [{ rotate = [0, 0, 1], angle = 90 }]
+children = [
+  { type = "sphere", center = [1, 0, 0], radius = 1, transform = [{ translate = [1, 0, 0] }] },
+]
+
+[[objects]]
+type = "triangle"
+vertices = [[1, 0, 0], [0, 1, 0], [0, 0, 1]]
+transform = [
+  { matrix = [[1, 0, 0, 3], [0, 1, 0, 0], [0, 0, 1, 0], [0, 0, 0, 1]] },
+  { rotate = [0, 1, 0], angle = 90 },
+]
+"#,
+    );
+    let centers: Vec<Vec3> = s.spheres.items.iter().map(|s| s.center).collect();
+    assert_close(centers[0], Vec3::new(2.0, 5.0, 0.0));
+    assert_close(centers[1], Vec3::new(2.0, 10.0, 0.0));
+    assert_close(centers[2], Vec3::new(10.0, 1.0, 0.0));
+    assert_close(centers[3], Vec3::new(0.0, 2.0, 0.0));
+    assert_eq!(s.spheres.items[0].radius, 2.0);
+    assert_eq!(s.spheres.items[2].radius, 1.0);
+    assert!(s.instances.is_empty(), "similarities are baked");
+    // (1,0,0) → (4,0,0) → rotated 90° about y: (0,0,−4).
+    let t = &s.triangles.items[0];
+    assert_close(t.p[0], Vec3::new(0.0, 0.0, -4.0));
+    assert_close(t.p[1], Vec3::new(0.0, 1.0, -3.0));
+    assert_close(t.p[2], Vec3::new(1.0, 0.0, -3.0));
+}
+
+#[test]
+fn non_similar_transforms_make_instances() {
+    let s = build(
+        r#"
+[materials.m]
+[[objects]]
+type = "sphere"
+center = [0, 0, 0]
+radius = 1
+material = "m"
+transform = [{ scale = [2, 1, 1] }, { translate = [0, 3, 0] }]
+"#,
+    );
+    assert_eq!(s.geometry.prim_count(), 0);
+    assert_eq!((s.objects.len(), s.instances.len()), (1, 1));
+    assert_eq!(s.count(Kind::Sphere), 1);
+    let inst = &s.instances[0];
+    assert_eq!(inst.material, 0);
+    assert_eq!(s.objects[0].spheres.material[0], 0);
+    let p = inst.xform.to_world.transform_point3(Vec3::X);
+    assert_close(p, Vec3::new(2.0, 3.0, 0.0));
+}
+
+#[test]
+fn mirrors_keep_the_front_side() {
+    let s = build(
+        r#"
+[[objects]]
+type = "polygon"
+vertices = [[0, 0, 0], [1, 0, 0], [1, 1, 0], [0, 1, 0]]
+transform = [{ scale = [1, 1, -1] }]
+"#,
+    );
+    // The square faced +z; mirrored in z it faces −z, and its winding must say so.
+    assert!(s.triangles.items.iter().all(|t| t.normal().z < 0.0));
+}
+
+#[test]
+fn instances_of_a_define_share_one_object() {
+    let s = build(
+        r#"
+[materials.red]
+color = [1, 0, 0]
+[materials.blue]
+color = [0, 0, 1]
+[materials.green]
+color = [0, 1, 0]
+
+[define.thing]
+type = "group"
+children = [
+  { type = "sphere", center = [0, 1, 0], radius = 0.5 },
+  { type = "sphere", center = [0, 2, 0], radius = 0.25, material = "green" },
+  { type = "triangle", vertices = [[0, 0, 0], [1, 0, 0], [0, 0, 1]], transform = [{ translate = [0, 7, 0] }] },
+]
+
+[[objects]]
+type = "instance"
+of = "thing"
+material = "red"
+
+[[objects]]
+type = "instance"
+of = "thing"
+material = "blue"
+transform = [{ translate = [5, 0, 0] }]
+
+[[objects]]
+type = "group"
+material = "blue"
+transform = [{ scale = 2 }]
+children = [{ type = "instance", of = "thing", transform = [{ translate = [1, 0, 0] }] }]
+"#,
+    );
+    assert_eq!(s.objects.len(), 1);
+    assert_eq!(s.instances.len(), 3);
+    assert!(s.instances.iter().all(|i| i.object == 0));
+    assert_eq!(s.count(Kind::Sphere), 6);
+    assert_eq!(s.count(Kind::Triangle), 3);
+    let obj = &s.objects[0];
+    assert_eq!(obj.spheres.material, vec![INHERIT, 2]);
+    // The triangle's own transform is baked into the object.
+    assert_close(obj.triangles.items[0].p[0], Vec3::new(0.0, 7.0, 0.0));
+    assert_eq!(s.instances[0].material, 0);
+    assert_eq!(s.instances[1].material, 1);
+    // The group's material is inherited; its transform is applied after the instance's.
+    assert_eq!(s.instances[2].material, 1);
+    let p = s.instances[2].xform.to_world.transform_point3(Vec3::ZERO);
+    assert_close(p, Vec3::new(2.0, 0.0, 0.0));
+    assert_close(
+        s.instances[1].xform.to_world.transform_point3(Vec3::ZERO),
+        Vec3::new(5.0, 0.0, 0.0),
+    );
+}
+
+#[test]
+fn defines_copy_nested_instances_and_wrap_transformed_solids() {
+    let s = build(
+        r#"
+[define.ball]
+type = "sphere"
+center = [0, 0, 0]
+radius = 1
+transform = [{ scale = [3, 1, 1] }]
+
+[define.pair]
+type = "group"
+children = [
+  { type = "instance", of = "ball" },
+  { type = "instance", of = "ball", transform = [{ translate = [0, 10, 0] }] },
+]
+
+[[objects]]
+type = "instance"
+of = "pair"
+"#,
+    );
+    // One object (`ball` is copied into `pair`, not instanced a second level deep).
+    assert_eq!(s.objects.len(), 1);
+    assert_eq!(s.instances.len(), 1);
+    let obj = &s.objects[0];
+    // The stretched spheres became one-leaf CSG solids.
+    assert_eq!(obj.count(Kind::Csg), 2);
+    assert_eq!(obj.count(Kind::Sphere), 0);
+    let a = &obj.shapes.items[0];
+    let b = &obj.shapes.items[1];
+    assert!(a.contains(Vec3::new(2.9, 0.0, 0.0)));
+    assert!(!a.contains(Vec3::new(0.0, 1.1, 0.0)));
+    assert!(b.contains(Vec3::new(-2.9, 10.0, 0.0)));
+    assert!(!b.contains(Vec3::new(0.0, 0.0, 0.0)));
+    let bb = b.bounds();
+    assert!(
+        bb.min.y > 8.9 && bb.max.y < 11.1 && bb.max.x > 2.9,
+        "{bb:?}"
+    );
+}
+
+#[test]
+fn nested_csg_classifies_points() {
+    let s = build(
+        r#"
+[materials.outer]
+[materials.cut]
+[materials.inner]
+
+# (A ∪ B) − (C rotated into place), all inside a translated group.
+[[objects]]
+type = "group"
+transform = [{ translate = [100, 0, 0] }]
+children = [{ type = "difference", material = "outer", children = [
+  { type = "union", material = "inner", children = [
+      { type = "sphere", center = [0, 0, 0], radius = 1 },
+      { type = "sphere", center = [1.5, 0, 0], radius = 1 },
+  ] },
+  { type = "sphere", center = [0, 0, 0], radius = 0.5, material = "cut",
+    transform = [{ scale = [1, 1, 4] }, { translate = [0, 1, 0] }] },
+  { type = "intersection", children = [
+      { type = "sphere", center = [1.5, 0, 0], radius = 0.3 },
+      { type = "sphere", center = [1.7, 0, 0], radius = 0.3 },
+  ] },
+] }]
+"#,
+    );
+    // Transformed at the top level: an object of its own, placed by an instance.
+    assert_eq!(s.count(Kind::Csg), 1);
+    assert_eq!((s.objects.len(), s.instances.len()), (1, 1));
+    let inst = &s.instances[0];
+    let shape = &s.objects[0].shapes.items[0];
+    let Shape::Csg(csg) = shape else { panic!() };
+    assert_eq!(csg.leaf_count(), 5);
+    assert_eq!(inst.material, 0); // outer
+    assert_eq!(s.objects[0].shapes.material[0], 0);
+    assert_eq!(csg.leaf_material(0), Some(2)); // inner, from the union
+    assert_eq!(csg.leaf_material(2), Some(1)); // cut, its own
+    assert_eq!(csg.leaf_material(3), None); // the root's (outer)
+    let o = Vec3::new(100.0, 0.0, 0.0);
+    let inside = [
+        Vec3::new(-0.8, 0.0, 0.0),
+        Vec3::new(2.3, 0.0, 0.0),
+        Vec3::new(0.0, -0.8, 0.0),
+        Vec3::new(1.5, 0.0, 0.6),
+    ];
+    let outside = [
+        Vec3::new(0.0, 0.8, 0.0),     // in the stretched cut
+        Vec3::new(0.0, 0.9, 1.5),     // in the cut, far along z
+        Vec3::new(1.6, 0.0, 0.0),     // in the intersection lens
+        Vec3::new(-1.1, 0.0, 0.0),    // outside the union
+        Vec3::new(0.0, 0.0, 0.0) - o, // the untranslated origin
+    ];
+    let world_contains = |p: Vec3| shape.contains(inst.xform.to_object.transform_point3(p));
+    for p in inside {
+        assert!(world_contains(o + p), "{p} should be inside");
+    }
+    for p in outside {
+        assert!(!world_contains(o + p), "{p} should be outside");
+    }
+
+    // Inside a define the same tree carries the transform itself.
+    let s = build(&format!(
+        "[define.d]\ntype = \"group\"\nchildren = [{{ type = \"instance\", of = \"x\", transform = [{{ translate = [100, 0, 0] }}] }}]\n\
+         [define.x]\n{}\n[[objects]]\ntype = \"instance\"\nof = \"d\"\n",
+        "type = \"difference\"\nchildren = [\n  { type = \"sphere\", center = [0, 0, 0], radius = 1 },\n  { type = \"sphere\", center = [0, 0, 0], radius = 0.5, transform = [{ scale = [1, 1, 4] }] },\n]"
+    ));
+    assert_eq!((s.objects.len(), s.instances.len()), (1, 1));
+    let shape = &s.objects[0].shapes.items[0];
+    assert!(shape.contains(Vec3::new(100.0, 0.8, 0.0)));
+    assert!(!shape.contains(Vec3::new(100.0, 0.0, 0.8)));
+    assert!(!shape.contains(Vec3::new(0.0, 0.8, 0.0)));
+
+    // A transformed CSG at the top level is an instance of its own.
+    let s = build(
+        r#"
+[[objects]]
+type = "intersection"
+transform = [{ scale = [1, 2, 1] }]
+children = [
+  { type = "sphere", center = [0, 0, 0], radius = 1 },
+  { type = "sphere", center = [0.5, 0, 0], radius = 1 },
+]
+"#,
+    );
+    assert_eq!((s.objects.len(), s.instances.len()), (1, 1));
+    assert_eq!(s.objects[0].count(Kind::Csg), 1);
+}
+
+fn temp_dir() -> tempfile::TempDir {
+    tempfile::tempdir().unwrap()
+}
+
+fn write(dir: &Path, name: &str, text: &str) -> PathBuf {
+    let p = dir.join(name);
+    std::fs::create_dir_all(p.parent().unwrap()).unwrap();
+    std::fs::write(&p, text).unwrap();
+    p
+}
+
+const TABLE_NFF: &str = "\
+v from 0 0 10 at 0 0 0 up 0 1 0 angle 45 hither 0 resolution 8 8
+l 1 2 3 0.5 0.5 0.5
+f 1 0 0 0.7 0.3 10 0 1
+s 1 0 0 0.5
+f 0 1 0 0.6 0 0 0 1
+p 3
+0 0 0
+1 0 0
+0 1 0
+c 0 0 0 0.5 0 1 0 0.25
+";
+
+#[test]
+fn includes_remap_materials_and_apply_transforms() {
+    let dir = temp_dir();
+    write(dir.path(), "parts/table.nff", TABLE_NFF);
+    let main = write(
+        dir.path(),
+        "scene.toml",
+        &format!(
+            r#"{CAMERA}
+[materials.mine]
+color = [0.5, 0.5, 0.5]
+
+[[objects]]
+type = "include"
+file = "parts/table.nff"
+lights = true
+transform = [{{ scale = 2 }}, {{ translate = [0, 0, 5] }}]
+
+[[objects]]
+type = "include"
+file = "parts/table.nff"
+material = "mine"
+"#
+        ),
+    );
+    let s = scene_toml::load(&main).unwrap();
+    // Our material, then the NFF's two (read once).
+    assert_eq!(s.materials.len(), 3);
+    assert_eq!(s.materials[1].color, Vec3::X);
+    assert_eq!(s.materials[2].color, Vec3::Y);
+    assert_eq!(s.count(Kind::Sphere), 2);
+    assert_eq!(s.count(Kind::Triangle), 2);
+    assert_eq!(s.count(Kind::Cone), 2);
+    let sp = &s.spheres.items[0];
+    assert_close(sp.center, Vec3::new(2.0, 0.0, 5.0));
+    assert_eq!(sp.radius, 1.0);
+    assert_eq!(s.spheres.material[0], 1);
+    assert_eq!(s.triangles.material[0], 2);
+    assert_close(s.triangles.items[0].p[1], Vec3::new(2.0, 0.0, 5.0));
+    assert_close(s.cones.items[0].apex, Vec3::new(0.0, 2.0, 5.0));
+    assert_eq!(s.cones.items[0].base_radius, 1.0);
+    // The second copy, untransformed, in our material.
+    assert_eq!(s.spheres.items[1].center, Vec3::X);
+    assert_eq!(s.spheres.material[1], 0);
+    assert_eq!(s.triangles.material[1], 0);
+    // The light came along once, transformed.
+    assert_eq!(s.lights.len(), 1);
+    assert_close(s.lights[0].pos, Vec3::new(2.0, 4.0, 11.0));
+    assert_eq!(s.load_stats.polygons, 1);
+
+    // Through the generic entry point, by extension.
+    let (s2, _) = scene_toml::load_with_settings(&main).unwrap();
+    assert_eq!(emray::load::load_path(&main).unwrap(), s2);
+}
+
+#[test]
+fn include_errors_name_the_right_file_and_line() {
+    let dir = temp_dir();
+    let body = "[[objects]]\ntype = \"include\"\nfile = \"missing/part.nff\" # HERE\n";
+    let main = write(dir.path(), "scene.toml", &format!("{CAMERA}{body}"));
+    let e = scene_toml::load(&main).unwrap_err();
+    assert_eq!(e.path, main);
+    assert_eq!(e.line, marked_line(&format!("{CAMERA}{body}")));
+    assert!(e.message.contains("missing/part.nff"), "{e}");
+    assert!(e.message.contains("cannot read included file"), "{e}");
+
+    // An error inside the included file: its own path and line, and where it was
+    // included from.
+    write(
+        dir.path(),
+        "bad.nff",
+        "v from 0 0 1 at 0 0 0 up 0 1 0 angle 45 hither 0 resolution 8 8\ns 0 0 0\nx\n",
+    );
+    let body = "[[objects]]\ntype = \"include\"\nfile = \"bad.nff\" # HERE\n";
+    let main = write(dir.path(), "scene2.toml", &format!("{CAMERA}{body}"));
+    let e = scene_toml::load(&main).unwrap_err();
+    assert_eq!(e.path, dir.path().join("bad.nff"));
+    assert_eq!(e.line, 3);
+    let from = format!(
+        "included from {}:{}:",
+        main.display(),
+        marked_line(&format!("{CAMERA}{body}"))
+    );
+    assert!(e.message.contains(&from), "{e}");
+
+    // Lights cannot come from an include inside a define.
+    write(dir.path(), "ok.nff", TABLE_NFF);
+    let body = "[define.d]\ntype = \"include\"\nfile = \"ok.nff\"\nlights = true # HERE\n[[objects]]\ntype = \"instance\"\nof = \"d\"\n";
+    let main = write(dir.path(), "scene3.toml", &format!("{CAMERA}{body}"));
+    let e = scene_toml::load(&main).unwrap_err();
+    assert_eq!(e.line, marked_line(&format!("{CAMERA}{body}")), "{e}");
+}
+
+#[test]
+fn settings_come_back_from_files() {
+    let dir = temp_dir();
+    let p = write(
+        dir.path(),
+        "s.toml",
+        &format!("{CAMERA}[render]\nspp = 3\n"),
+    );
+    let (_, settings) = scene_toml::load_with_settings(&p).unwrap();
+    assert_eq!(
+        settings,
+        SceneSettings {
+            max_depth: None,
+            spp: Some(3)
+        }
+    );
+    let e = scene_toml::load(&dir.path().join("none.toml")).unwrap_err();
+    assert!(e.message.contains("cannot read"), "{e}");
+}
+
+// ---- errors, each at its line ------------------------------------------------------
+
+#[test]
+fn error_unknown_key() {
+    let e = error_at(
+        "[[objects]]\ntype = \"sphere\"\ncenter = [0, 0, 0]\nradus = 1 # HERE\n",
+        &["unknown key `radus`", "did you mean `radius`"],
+    );
+    assert_eq!(e.col, 1);
+    error_at("[camera2] # HERE\n", &["unknown key `camera2`"]);
+    let src = "[camera]\nfrom = [0, 0, 1]\nat = [0, 0, 0]\nfvo = 3 # HERE\n";
+    let e = parse(src).unwrap_err();
+    assert_eq!(e.line, 4);
+    assert!(e.message.contains("did you mean `fov`"), "{e}");
+    error_at(
+        "[materials.m]\nshinyness = 3 # HERE\n",
+        &["unknown key `shinyness`", "shininess"],
+    );
+    error_at(
+        "[[objects]]\ntype = \"sphere\"\ncenter = [0, 0, 0]\nradius = 1\ntransform = [{ translate = [1, 0, 0], spin = 3 }] # HERE\n",
+        &["unknown key `spin`"],
+    );
+}
+
+#[test]
+fn error_key_of_another_type() {
+    error_at(
+        "[[objects]]\ntype = \"sphere\"\ncenter = [0, 0, 0]\nradius = 1\nfaces = [[0, 1, 2]] # HERE\n",
+        &["`faces` does not apply to a sphere", "center, radius"],
+    );
+    error_at(
+        "[[lights]]\nposition = [0, 0, 0]\ncutoff = 3 # HERE\n",
+        &["`cutoff` is for spot lights"],
+    );
+}
+
+#[test]
+fn error_wrong_type() {
+    error_at(
+        "[[objects]]\ntype = \"sphere\"\ncenter = [0, 0, 0]\nradius = \"big\" # HERE\n",
+        &["invalid type", "a number"],
+    );
+    error_at(
+        "[[objects]]\ntype = \"sphere\"\ncenter = [0, 0] # HERE\nradius = 1\n",
+        &["invalid length 2"],
+    );
+    error_at(
+        "[[objects]]\ntype = \"group\"\nchildren = { type = \"sphere\" } # HERE\n",
+        &["invalid type"],
+    );
+    error_at("[render]\nspp = -1 # HERE\n", &["invalid value"]);
+    error_at(
+        "[[objects]]\ntype = \"sphere\"\ncenter = [0, 0, 0]\nradius = 1\ntransform = [{ scale = \"x\" }] # HERE\n",
+        &["a number or an array of 3 numbers"],
+    );
+}
+
+#[test]
+fn error_missing_required_key() {
+    error_at(
+        "[[objects]] # HERE\ntype = \"sphere\"\ncenter = [0, 0, 0]\n",
+        &["missing key `radius`", "sphere"],
+    );
+    error_at("[[objects]] # HERE\nradius = 1\n", &["missing key `type`"]);
+    error_at(
+        "[[objects]]\ntype = \"group\"\nchildren = [\n  { type = \"cone\", base = [0, 0, 0] }, # HERE\n]\n",
+        &["missing key `base_radius`", "a cone"],
+    );
+    error_at(
+        "[[lights]] # HERE\ncolor = [1, 1, 1]\n",
+        &["missing key `position`"],
+    );
+    let e = parse("[[objects]]\ntype = \"sphere\"\n").unwrap_err();
+    assert_eq!(e.line, 1);
+    assert!(e.message.contains("missing key `camera`"), "{e}");
+    let e = parse("[camera] # HERE\nfov = 30\n").unwrap_err();
+    assert_eq!(e.line, 1);
+    assert!(e.message.contains("`from` and `at`"), "{e}");
+}
+
+#[test]
+fn error_unknown_names() {
+    error_at(
+        "[materials.glass]\n[[objects]]\ntype = \"sphere\"\ncenter = [0, 0, 0]\nradius = 1\nmaterial = \"glas\" # HERE\n",
+        &["unknown material `glas`", "did you mean `glass`"],
+    );
+    error_at(
+        "[[objects]]\ntype = \"sphere\"\ncenter = [0, 0, 0]\nradius = 1\nmaterial = \"glass\" # HERE\n",
+        &["unknown material `glass`", "defines no"],
+    );
+    error_at(
+        "[define.chair]\ntype = \"sphere\"\ncenter = [0, 0, 0]\nradius = 1\n[[objects]]\ntype = \"instance\"\nof = \"chiar\" # HERE\n",
+        &["unknown define `chiar`", "did you mean `chair`"],
+    );
+    error_at(
+        "[[objects]]\ntype = \"spere\" # HERE\n",
+        &["unknown object type `spere`", "did you mean `sphere`"],
+    );
+    error_at(
+        "[[lights]]\ntype = \"spto\" # HERE\nposition = [0, 0, 0]\n",
+        &["unknown light type", "did you mean `spot`"],
+    );
+}
+
+#[test]
+fn error_define_cycle() {
+    let e = error_at(
+        r#"
+[define.a]
+type = "group"
+children = [{ type = "instance", of = "b" }]
+
+[define.b]
+type = "group"
+children = [
+  { type = "sphere", center = [0, 0, 0], radius = 1 },
+  { type = "instance", of = "a" }, # HERE
+]
+
+[[objects]]
+type = "instance"
+of = "a"
+"#,
+        &["contains an instance of itself", "a → b → a"],
+    );
+    assert!(e.col > 1);
+    // A define that includes itself directly, never used: still found.
+    error_at(
+        "[define.self]\ntype = \"union\"\nchildren = [\n  { type = \"sphere\", center = [0, 0, 0], radius = 1 },\n  { type = \"instance\", of = \"self\" }, # HERE\n]\n",
+        &["self → self"],
+    );
+}
+
+#[test]
+fn error_non_finite_numbers() {
+    error_at(
+        "[[objects]]\ntype = \"sphere\"\ncenter = [0, 0, 0]\nradius = nan # HERE\n",
+        &["not a finite number"],
+    );
+    let e = error_at(
+        "[[objects]]\ntype = \"sphere\"\ncenter = [\n  0,\n  -inf, # HERE\n  0,\n]\nradius = 1\n",
+        &["not a finite number"],
+    );
+    assert_eq!(e.col, 3);
+    error_at(
+        "[render]\nbackground = [0, 1e39, 0] # HERE\n",
+        &["single-precision range"],
+    );
+}
+
+#[test]
+fn error_bad_sizes() {
+    error_at(
+        "[[objects]]\ntype = \"sphere\"\ncenter = [0, 0, 0]\nradius = 0 # HERE\n",
+        &["sphere `radius` must be positive, found 0"],
+    );
+    error_at(
+        "[[objects]]\ntype = \"sphere\"\ncenter = [0, 0, 0]\nradius = -2 # HERE\n",
+        &["must be positive"],
+    );
+    error_at(
+        "[[objects]]\ntype = \"cone\"\nbase = [0, 0, 0]\nbase_radius = 0 # HERE\napex = [0, 1, 0]\n",
+        &["both be zero"],
+    );
+    let bad_res = "[camera]\nfrom = [0, 0, 1]\nat = [0, 0, 0]\nresolution = [20000, 10] # HERE\n";
+    let e = parse(bad_res).unwrap_err();
+    assert_eq!(e.line, 4);
+    assert!(e.message.contains("between 1 and 16384"), "{e}");
+    let e =
+        parse("[camera]\nfrom = [0, 0, 1]\nat = [0, 0, 0]\nresolution = [0, 10]\n").unwrap_err();
+    assert_eq!(e.line, 4);
+    error_at(
+        "[materials.m]\nior = 0 # HERE\n",
+        &["`ior` must be positive"],
+    );
+    error_at(
+        "[materials.m]\ndiffuse = -0.5 # HERE\n",
+        &["must not be negative"],
+    );
+    error_at("[render]\nmax_depth = 0 # HERE\n", &["between 1 and"]);
+    error_at(
+        "[[objects]]\ntype = \"mesh\"\nvertices = [[0, 0, 0], [1, 0, 0], [0, 1, 0]]\nfaces = [\n  [0, 1, 2],\n  [0, 1, 3], # HERE\n]\n",
+        &["vertex index 3 is out of range"],
+    );
+    error_at(
+        "[[objects]]\ntype = \"triangle\"\nvertices = [[0, 0, 0], [1, 0, 0]] # HERE\n",
+        &["exactly 3 vertices"],
+    );
+    error_at(
+        "[[objects]]\ntype = \"union\"\nchildren = [{ type = \"sphere\", center = [0, 0, 0], radius = 1 }] # HERE\n",
+        &["at least 2 children"],
+    );
+}
+
+#[test]
+fn error_bad_transforms() {
+    error_at(
+        "[[objects]]\ntype = \"sphere\"\ncenter = [0, 0, 0]\nradius = 1\ntransform = [\n  { translate = [1, 0, 0] },\n  { matrix = [[1, 0, 0, 0], [0, 1, 0, 0], [1, 1, 0, 0], [0, 0, 0, 1]] }, # HERE\n]\n",
+        &["bad transform", "singular"],
+    );
+    error_at(
+        "[[objects]]\ntype = \"sphere\"\ncenter = [0, 0, 0]\nradius = 1\ntransform = [{ scale = [1, 0, 1] }] # HERE\n",
+        &["must not be zero"],
+    );
+    error_at(
+        "[[objects]]\ntype = \"sphere\"\ncenter = [0, 0, 0]\nradius = 1\ntransform = [{ rotate = [0, 1, 0] }] # HERE\n",
+        &["`rotate` needs `angle`"],
+    );
+    error_at(
+        "[[objects]]\ntype = \"sphere\"\ncenter = [0, 0, 0]\nradius = 1\ntransform = [{ translate = [1, 0, 0], scale = 2 }] # HERE\n",
+        &["exactly one of", "translate, scale"],
+    );
+    error_at(
+        "[[objects]]\ntype = \"sphere\"\ncenter = [0, 0, 0]\nradius = 1\ntransform = [{ matrix = [[1, 0, 0, 0], [0, 1, 0, 0], [0, 0, 1, 0], [0, 0, 1, 1]] }] # HERE\n",
+        &["last row"],
+    );
+    error_at(
+        "[[objects]]\ntype = \"sphere\"\ncenter = [0, 0, 0]\nradius = 1\ntransform = [{ rotate = [0, 0, 0], angle = 3 }] # HERE\n",
+        &["rotation axis must not be zero"],
+    );
+}
+
+#[test]
+fn error_csg_of_open_surfaces() {
+    error_at(
+        "[[objects]]\ntype = \"union\"\nchildren = [\n  { type = \"sphere\", center = [0, 0, 0], radius = 1 },\n  { type = \"cone\", base = [0, 0, 0], base_radius = 1, apex = [0, 1, 0] }, # HERE\n]\n",
+        &["open cone is not a closed solid", "CSG operand"],
+    );
+    error_at(
+        "[[objects]]\ntype = \"difference\"\nchildren = [\n  { type = \"sphere\", center = [0, 0, 0], radius = 1 },\n  { type = \"triangle\", vertices = [[0, 0, 0], [1, 0, 0], [0, 1, 0]] }, # HERE\n]\n",
+        &["a triangle is not a closed solid"],
+    );
+    error_at(
+        "[[objects]]\ntype = \"intersection\"\nchildren = [\n  { type = \"sphere\", center = [0, 0, 0], radius = 1 },\n  { type = \"group\", children = [] }, # HERE\n]\n",
+        &["a group is not a solid"],
+    );
+    // An open surface under a non-similar transform inside a define: one instancing
+    // level.
+    error_at(
+        "[define.d]\ntype = \"group\"\nchildren = [\n  { type = \"cone\", base = [0, 0, 0], base_radius = 1, apex = [0, 1, 0], transform = [{ scale = [1, 2, 1] }] }, # HERE\n]\n[[objects]]\ntype = \"instance\"\nof = \"d\"\n",
+        &["one instancing level"],
+    );
+}
+
+#[test]
+fn error_toml_syntax() {
+    error_at(
+        "[[objects]]\ntype = \"sphere\"\ncenter = [0, 0, 0\nradius = 1 # HERE\n",
+        &[],
+    );
+    error_at("[render]\nspp = 1\nspp = 2 # HERE\n", &["duplicate key"]);
+}
+
+#[test]
+fn valid_but_surprising_inputs() {
+    // Integers and floats are both numbers; a define used by nothing is still checked
+    // (and fine); an empty group is fine.
+    let s = build(
+        "[define.unused]\ntype = \"sphere\"\ncenter = [0, 0, 0]\nradius = 1\n[[objects]]\ntype = \"group\"\nchildren = []\n",
+    );
+    assert_eq!(s.prim_count(), 0);
+    error_at(
+        "[define.unused]\ntype = \"sphere\"\ncenter = [0, 0, 0]\nradius = 0 # HERE\n",
+        &["must be positive"],
+    );
+}
+
+/// Every ```toml block of the format's reference builds (blocks without `[camera]`
+/// get one, and the materials the examples use).
+#[test]
+fn documentation_examples_build() {
+    let doc =
+        std::fs::read_to_string(Path::new(env!("CARGO_MANIFEST_DIR")).join("docs/scene-format.md"))
+            .unwrap();
+    let dir = temp_dir();
+    write(dir.path(), "parts/table.nff", TABLE_NFF);
+    write(dir.path(), "table.nff", TABLE_NFF);
+    let prelude = format!(
+        "{CAMERA}[materials.red]\ncolor = [0.8, 0.1, 0.1]\n[materials.white]\n[materials.glass]\ntransmittance = 0.9\nior = 1.5\n"
+    );
+    let mut blocks = 0;
+    let mut rest = doc.as_str();
+    while let Some(start) = rest.find("```toml\n") {
+        let body = &rest[start + 8..];
+        let end = body.find("```").expect("closed block");
+        let block = &body[..end];
+        rest = &body[end + 3..];
+        blocks += 1;
+        let src = if block.contains("[camera]") {
+            block.to_string()
+        } else {
+            format!("{prelude}{block}")
+        };
+        let path = write(dir.path(), &format!("doc{blocks}.toml"), &src);
+        if let Err(e) = scene_toml::load(&path) {
+            panic!("docs example {blocks} fails: {e}\n{src}");
+        }
+    }
+    assert!(blocks >= 10, "only {blocks} examples found");
+    for ty in [
+        "sphere",
+        "cone",
+        "triangle",
+        "polygon",
+        "mesh",
+        "include",
+        "group",
+        "instance",
+        "union",
+        "intersection",
+        "difference",
+    ] {
+        assert!(doc.contains(&format!("`{ty}`")), "`{ty}` undocumented");
+    }
+}
+
+#[test]
+fn round_trip_of_a_built_scene_file_is_stable() {
+    // Scene file → structures → text → structures → scene: the same scene.
+    let src = format!(
+        "{CAMERA}{}",
+        r#"
+[materials.a]
+color = [0.25, 0.5, 1]
+[[objects]]
+type = "group"
+transform = [{ rotate = [1, 1, 0], angle = 33 }]
+children = [
+  { type = "sphere", center = [0.1, 0.2, 0.3], radius = 0.7, material = "a" },
+  { type = "polygon", vertices = [[0, 0, 0], [2, 0, 0], [2, 1, 0], [1, 1, 0], [1, 2, 0], [0, 2, 0]] },
+]
+"#
+    );
+    let file: SceneFile = scene_toml::parse_file(&src, Path::new("a.toml")).unwrap();
+    let text = file.to_toml_string().unwrap();
+    let a = parse(&src).unwrap();
+    let b = parse(&text).unwrap();
+    assert_eq!(a, b);
+}
