@@ -1308,3 +1308,47 @@ children = [
     let b = parse(&text).unwrap();
     assert_eq!(a, b);
 }
+
+#[test]
+fn children_as_arrays_of_tables() {
+    let s = build(
+        r#"
+[[objects]]
+type = "group"
+material = "m"
+
+[[objects.children]]
+type = "sphere"
+center = [1, 0, 0]
+radius = 1
+
+[[objects.children]]
+type = "union"
+
+[[objects.children.children]]
+type = "sphere"
+center = [0, 5, 0]
+radius = 1
+
+[[objects.children.children]]
+type = "sphere"
+center = [0, 6, 0]
+radius = 1
+transform = [{ translate = [0, 0, 1] }]
+
+[materials.m]
+color = [0, 0, 1]
+"#,
+    );
+    assert_eq!(s.count(Kind::Sphere), 1);
+    assert_eq!(s.count(Kind::Csg), 1);
+    assert_eq!(s.spheres.material[0], 0);
+    assert_eq!(s.shapes.material[0], 0);
+    assert!(s.shapes.items[0].contains(Vec3::new(0.0, 6.0, 1.0)));
+    assert!(!s.shapes.items[0].contains(Vec3::new(0.0, 6.9, 0.0)));
+    // An error in such a table points into it.
+    error_at(
+        "[[objects]]\ntype = \"group\"\n[[objects.children]]\ntype = \"sphere\"\ncenter = [1, 0, 0]\nradius = 0 # HERE\n",
+        &["must be positive"],
+    );
+}
