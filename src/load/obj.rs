@@ -29,7 +29,8 @@
 //! A file that cannot be read is an error naming it. A malformed file is an error
 //! `path:line:col: message` at the first problem found: a coordinate that is not a
 //! number, too few or too many numbers in a `v`, `vt` or `vn`, a non-finite coordinate
-//! or normal (`nan`, `inf`, or a number too large for `f32`), a vertex weight `w` of 0,
+//! or normal that a face uses (`nan`, `inf`, or a number too large for `f32`; unused
+//! elements are not looked at once they parse as numbers), a vertex weight `w` of 0,
 //! a face index that is 0, not an integer, or beyond the elements the file defines
 //! (relative, negative indices count back from the last element defined before the
 //! face), a vertex with more than three indices, a face without vertices, or a
