@@ -258,8 +258,8 @@ f 5//1 6//2 7
     .into_iter()
     .collect();
     let tn = &data.geometry.triangle_normals;
-    for i in 0..2 {
-        assert_ne!(tn[i], u32::MAX, "quad triangle {i} lost its normals");
+    for (i, &n) in tn.iter().enumerate().take(2) {
+        assert_ne!(n, u32::MAX, "quad triangle {i} lost its normals");
         let t = data.geometry.triangles.items[i];
         // At each corner the interpolated normal is the file's (made unit length).
         for (k, (u, v)) in [(0.0, 0.0), (1.0, 0.0), (0.0, 1.0)].into_iter().enumerate() {
@@ -724,4 +724,41 @@ fn a_large_grid_loads_every_triangle() {
         data.bounds,
         Aabb::from_points(Vec3::ZERO, Vec3::new(n as f32, n as f32, 0.0))
     );
+}
+
+#[test]
+fn several_libraries_on_one_line_and_usemtl_before_mtllib() {
+    let obj = "usemtl late\nmtllib a.mtl b.mtl\nv 0 0 0\nv 1 0 0\nv 0 1 0\n\
+               f 1 2 3\nusemtl early\nf 1 3 2\n";
+    let a = "newmtl early\nKd 0 1 0\n";
+    let b = "newmtl late\nKd 1 0 0\n";
+    let (_dir, _path, r) = load_text(obj, &[("a.mtl", a), ("b.mtl", b)]);
+    let data = r.unwrap();
+    assert!(data.warnings.is_empty(), "{:?}", data.warnings);
+    let colours: Vec<Vec3> = data
+        .geometry
+        .triangles
+        .material
+        .iter()
+        .map(|&m| data.materials[m as usize].color)
+        .collect();
+    assert_eq!(colours, [Vec3::X, Vec3::Y]);
+}
+
+#[test]
+fn crlf_line_endings_and_latin1_comments() {
+    let crlf = CUBE_OBJ.replace('\n', "\r\n");
+    let dir = dir_with(&[("cube.obj", &crlf), ("cube.mtl", CUBE_MTL)]);
+    let mut bytes = std::fs::read(dir.path().join("cube.obj")).unwrap();
+    bytes.extend_from_slice(b"# caf\xe9\r\nv 0 0 x\r\n");
+    std::fs::write(dir.path().join("cube.obj"), &bytes).unwrap();
+    let e = load_geometry(&dir.path().join("cube.obj")).unwrap_err();
+    // Line numbers survive both: the bad vertex is on the last line.
+    let last = CUBE_OBJ.lines().count() + 2;
+    assert_eq!((e.line, e.col), (last, 7), "{e}");
+    bytes.truncate(bytes.len() - b"v 0 0 x\r\n".len());
+    std::fs::write(dir.path().join("cube.obj"), &bytes).unwrap();
+    let data = ok(&dir.path().join("cube.obj"));
+    assert_eq!(data.geometry.triangles.len(), 12);
+    assert!(data.warnings.is_empty(), "{:?}", data.warnings);
 }

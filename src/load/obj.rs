@@ -767,7 +767,7 @@ fn find_bad_number(text: &str, limit: usize) -> Option<Located> {
             continue;
         };
         match w_tok.parse::<f32>() {
-            Ok(w) if w == 0.0 => return err(Some(w_tok), "vertex weight w is 0".into()),
+            Ok(0.0) => return err(Some(w_tok), "vertex weight w is 0".into()),
             Ok(w) if w.is_finite() => {
                 if xyz.iter().any(|c| !(c / w).is_finite()) {
                     return err(
@@ -976,9 +976,10 @@ fn sanitize_mtl(text: &str, path: &Path, warnings: &mut Vec<String>) -> String {
                     [Some(r), Some(g), Some(b)] if finite(r) && finite(g) && finite(b) => {}
                     _ => {
                         let bad = v.iter().flatten().find(|t| !finite(t)).copied();
-                        let found = match bad {
-                            Some(t) => format!("found {}", show(t)),
-                            None => format!("found {} number(s)", v.iter().flatten().count()),
+                        let found = match (bad, v.iter().flatten().count()) {
+                            (Some(t), _) => format!("found {}", show(t)),
+                            (None, 0) => "found nothing".to_string(),
+                            (None, n) => format!("found {n} numbers"),
                         };
                         warn(
                             bad,
@@ -1338,5 +1339,229 @@ fn unit(n: Vec3) -> Option<Vec3> {
         (n / m).try_normalize()
     } else {
         None
+    }
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+
+    fn mtl(name: &str, f: impl FnOnce(&mut tobj::Material)) -> tobj::Material {
+        let mut m = tobj::Material {
+            name: name.into(),
+            diffuse: Some([0.2, 0.4, 0.6]),
+            specular: Some([0.3, 0.6, 0.9]),
+            shininess: Some(20.0),
+            ..Default::default()
+        };
+        f(&mut m);
+        m
+    }
+
+    #[test]
+    fn illumination_models() {
+        // (illum, ka, ks, kr) with Kd = (0.2 0.4 0.6), Ks mean 0.6, no Ka.
+        let ks = 0.6;
+        let table: [(Option<u8>, f32, f32, f32); 12] = [
+            (Some(0), 0.0, 0.0, 0.0),
+            (Some(1), 1.0, 0.0, 0.0),
+            (Some(2), 1.0, ks, 0.0),
+            (Some(3), 1.0, ks, ks),
+            (Some(4), 1.0, ks, 0.0),
+            (Some(5), 1.0, ks, ks),
+            (Some(6), 1.0, ks, 0.0),
+            (Some(7), 1.0, ks, ks),
+            (Some(8), 1.0, ks, 0.0),
+            (Some(9), 1.0, ks, 0.0),
+            (Some(10), 1.0, ks, 0.0),
+            (None, 1.0, ks, 0.0),
+        ];
+        for (illum, ka, ks, kr) in table {
+            let (m, w) = convert_material(&mtl("m", |m| m.illumination_model = illum));
+            assert!(w.is_none());
+            let got = (m.ka, m.ks, m.kr);
+            assert!(
+                (got.0 - ka).abs() < 1e-6 && (got.1 - ks).abs() < 1e-6 && (got.2 - kr).abs() < 1e-6,
+                "illum {illum:?}: {got:?}"
+            );
+            assert_eq!(
+                (m.color, m.kd, m.shine),
+                (Vec3::new(0.2, 0.4, 0.6), 1.0, 20.0)
+            );
+            assert_eq!(
+                (m.t, m.ior),
+                (0.0, 1.0),
+                "illum {illum:?}: opaque without d"
+            );
+        }
+    }
+
+    #[test]
+    fn ambient_transparency_and_defaults() {
+        // Ka relative to Kd.
+        let (m, _) = convert_material(&mtl("m", |m| m.ambient = Some([0.1, 0.2, 0.3])));
+        assert!((m.ka - 0.5).abs() < 1e-6, "{}", m.ka);
+        // No Kd: the colour carries Ka, no diffuse term.
+        let (m, _) = convert_material(&mtl("m", |m| {
+            m.diffuse = None;
+            m.ambient = Some([0.1, 0.2, 0.3]);
+        }));
+        assert_eq!((m.color, m.kd, m.ka), (Vec3::new(0.1, 0.2, 0.3), 0.0, 1.0));
+        // Nothing at all: black, Ns 1.
+        let (m, _) = convert_material(&tobj::Material::default());
+        assert_eq!((m.color, m.kd, m.ks, m.shine), (Vec3::ZERO, 0.0, 0.0, 1.0));
+        // d wins over Tr, transmittance for any illum; negative colours clamped.
+        let (m, w) = convert_material(&mtl("glass", |m| {
+            m.dissolve = Some(0.3);
+            m.unknown_param.insert("Tr".into(), "0.9".into());
+            m.optical_density = Some(1.33);
+            m.illumination_model = Some(2);
+            m.diffuse = Some([-1.0, 0.5, 0.5]);
+        }));
+        assert!(w.is_none());
+        assert!((m.t - 0.7).abs() < 1e-6 && m.ior == 1.33 && m.kr == 0.0);
+        assert_eq!(m.color, Vec3::new(0.0, 0.5, 0.5));
+        let (m, w) = convert_material(&mtl("tr", |m| {
+            m.unknown_param.insert("Tr".into(), "0.25".into());
+        }));
+        assert_eq!((m.t, m.ior), (0.25, 1.0));
+        assert!(w.unwrap().contains("no 'Ni'"));
+        // An opaque material's unusable Ni is no concern.
+        let (m, w) = convert_material(&mtl("m", |m| m.optical_density = Some(0.0)));
+        assert!(w.is_none() && m.ior == 1.0);
+    }
+
+    #[test]
+    fn mtl_statements_tobj_would_reject_or_panic_on_are_removed() {
+        let src = "\
+newmtl a
+Kd 0.5
+Ka
+Ks 1 1
+Ke spectral x.rfl
+Ns
+d -halo 0.5
+illum two
+map_Kd tex.png
+bump b.png
+newmtl
+Kd 1 0 0
+newmtl b
+Kd 0 1 0
+Ni 1.5
+";
+        let mut warnings = Vec::new();
+        let out = sanitize_mtl(src, Path::new("x.mtl"), &mut warnings);
+        let (mats, names) = tobj::load_mtl_buf(&mut Cursor::new(out.as_bytes())).unwrap();
+        assert_eq!(mats.len(), 2);
+        assert_eq!(mats[names["a"]].diffuse, Some([0.5; 3]));
+        assert_eq!(mats[names["a"]].ambient, None);
+        assert_eq!(mats[names["a"]].specular, None);
+        assert_eq!(mats[names["a"]].dissolve, None);
+        // The nameless material's Kd did not leak into `a`.
+        assert_eq!(mats[names["b"]].diffuse, Some([0.0, 1.0, 0.0]));
+        assert_eq!(mats[names["b"]].optical_density, Some(1.5));
+        let lines: Vec<&str> = warnings
+            .iter()
+            .filter_map(|w| w.strip_prefix("x.mtl:"))
+            .filter(|w| w.starts_with(|c: char| c.is_ascii_digit()))
+            .collect();
+        let at: Vec<&str> = lines.iter().map(|w| &w[..w.find(':').unwrap()]).collect();
+        assert_eq!(at, ["3", "4", "5", "6", "7", "8", "11"], "{warnings:?}");
+        assert!(warnings.iter().any(|w| w.contains("2 texture map")));
+        assert!(lines[1].starts_with("4:7:"), "{}", lines[1]); // `Ks 1 1`: at its end
+        assert!(lines[3].starts_with("6:3:"), "{}", lines[3]);
+    }
+
+    #[test]
+    fn scan_records_faces_materials_and_libraries() {
+        let src = "\
+mtllib a.mtl
+v 0 0 0
+v 1 0 0
+v 0 1 0
+vt 0 0
+vn 0 0 1
+f 1 2 3
+usemtl m1
+f 1//1 2//1 3//1
+f 1/1/1 2/1/1 3/1
+l 1 2
+mtllib b.mtl
+usemtl m 2
+f -3/-1/-1 -2/1/1 -1//1
+";
+        let s = scan(src).unwrap();
+        assert_eq!(
+            s.faces,
+            [0, FACE_ALL_NORMALS, 0, FACE_IS_LINE, FACE_ALL_NORMALS]
+        );
+        assert_eq!(s.lines, 1);
+        assert_eq!(s.mtllib_lines, [1, 12]);
+        let u: Vec<(usize, &str, usize)> = s
+            .usemtl
+            .iter()
+            .map(|u| (u.first_face, u.name.as_str(), u.line))
+            .collect();
+        assert_eq!(u, [(1, "m1", 8), (4, "m 2", 13)]);
+        assert!(s.colour_mismatch.is_none());
+    }
+
+    #[test]
+    fn scan_errors() {
+        let err = |src: &str| scan(src).unwrap_err();
+        // Texture and normal indices are checked too (tobj overflows on index 0).
+        let e = err("v 0 0 0\nvt 0 0\nf 1/0 1/1 1/1\n");
+        assert_eq!((e.line, e.col), (3, 3));
+        assert!(
+            e.message.contains("texture coordinate index 0"),
+            "{}",
+            e.message
+        );
+        let e = err("v 0 0 0\nvn 0 0 1\nf 1//1 1//-2 1//1\n");
+        assert_eq!((e.line, e.col), (3, 8));
+        assert!(
+            e.message.contains("relative normal index -2"),
+            "{}",
+            e.message
+        );
+        let e = err("v 0 0 0\nf /1 1 1\n");
+        assert!(e.message.contains("missing vertex index"), "{}", e.message);
+        let e = err("v 0 0 0\nf 1 1 99999999999999999999999\n");
+        assert!(
+            e.message.contains("expected a vertex index"),
+            "{}",
+            e.message
+        );
+        // The earliest of several forward references beyond the end.
+        let e = err("f 1/1 1/1 1/1\nf 7 1 1\nf 1 1 1/9\nv 0 0 0\nvt 0 0\n");
+        assert_eq!((e.line, e.col), (2, 3));
+        // Columns count characters.
+        let e = err("g é\nv 0 0 0\nf 1 1 é\n");
+        assert_eq!((e.line, e.col), (3, 7));
+        // Mixed vertex colours are noted (an error only when tobj refuses them).
+        let s = scan("v 0 0 0 1 0 0\nv 1 0 0\n").unwrap();
+        let m = s.colour_mismatch.unwrap();
+        assert_eq!((m.line, m.col), (2, 1));
+    }
+
+    #[test]
+    fn bad_numbers() {
+        let find = |src: &str| find_bad_number(src, usize::MAX).unwrap();
+        let e = find("v 1e30 0 0 1e-30\n");
+        assert!(e.message.contains("divided by the weight"), "{}", e.message);
+        let e = find("v 1 2 3 w\n");
+        assert_eq!((e.line, e.col), (1, 9));
+        // vt only needs numbers; the limit stops the search.
+        assert!(find_bad_number("vt inf 0\n", usize::MAX).is_none());
+        assert!(find_bad_number("v 0 0 0\nv x 0 0\n", 2).is_none());
+        // Colours are not looked at (tobj ignores bad ones).
+        assert!(find_bad_number("v 0 0 0 red green blue\n", usize::MAX).is_none());
+    }
+
+    #[test]
+    fn face_lines() {
+        let src = "v 0 0 0\nf 1 1 1\n# c\n  l 1 1\nf 1 1 1\n";
+        assert_eq!([0, 1, 2, 3].map(|k| face_line(src, k)), [2, 4, 5, 0]);
     }
 }
