@@ -1,6 +1,7 @@
 //! Scene loaders. They build a [`crate::Scene`] and never render.
 
 pub mod nff;
+pub mod obj;
 
 use std::fmt;
 use std::path::{Path, PathBuf};
@@ -38,8 +39,17 @@ impl fmt::Display for LoadError {
 
 impl std::error::Error for LoadError {}
 
-/// Load a scene file, choosing the format by extension (`.nff`; anything else is read
-/// as NFF too, the classic benchmark files have no fixed extension).
+/// Load a scene file, choosing the format by extension: `.obj` (any case) is a
+/// Wavefront OBJ model, framed by an automatic camera and light ([`obj::load`]);
+/// anything else is read as NFF (`.nff`, and the classic benchmark files have no fixed
+/// extension).
 pub fn load_path(path: &Path) -> Result<crate::Scene, LoadError> {
-    nff::load(path)
+    let is_obj = path
+        .extension()
+        .is_some_and(|e| e.eq_ignore_ascii_case("obj"));
+    if is_obj {
+        obj::load(path)
+    } else {
+        nff::load(path)
+    }
 }
