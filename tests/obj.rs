@@ -151,6 +151,7 @@ fn cube_of_quads_is_twelve_outward_triangles_with_its_materials() {
         kr: 0.0,
         t: 0.0,
         ior: 1.0,
+        filter: Vec3::ONE,
         priority: 0,
     };
     let m = &data.materials;

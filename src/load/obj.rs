@@ -128,6 +128,7 @@ pub const DEFAULT_MATERIAL: Material = Material {
     kr: 0.0,
     t: 0.0,
     ior: 1.0,
+    filter: Vec3::ONE,
     priority: 0,
 };
 
@@ -1096,6 +1097,7 @@ fn convert_material(m: &tobj::Material) -> (Material, Option<String>) {
         kr,
         t,
         ior: ni.unwrap_or(1.0),
+        filter: Vec3::ONE,
         priority: 0,
     };
     (material, warning)
