@@ -1,6 +1,7 @@
 //! Scene loaders. They build a [`crate::Scene`] and never render.
 
 pub mod nff;
+pub mod obj;
 pub mod toml;
 
 use std::fmt;
@@ -39,15 +40,16 @@ impl fmt::Display for LoadError {
 
 impl std::error::Error for LoadError {}
 
-/// Load a scene file, choosing the format by extension: `.toml` is the scene format
-/// ([`toml`]); anything else is read as NFF (the classic benchmark files have no fixed
-/// extension).
+/// Load a scene file, choosing the format by extension (any case): `.toml` is the
+/// scene format ([`toml`]), `.obj` a Wavefront OBJ model framed by an automatic camera
+/// and light ([`obj::load`]); anything else is read as NFF (`.nff`, and the classic
+/// benchmark files have no fixed extension).
 pub fn load_path(path: &Path) -> Result<crate::Scene, LoadError> {
-    let is_toml = path
-        .extension()
-        .is_some_and(|e| e.eq_ignore_ascii_case("toml"));
-    if is_toml {
+    let ext = |e: &str| path.extension().is_some_and(|x| x.eq_ignore_ascii_case(e));
+    if ext("toml") {
         self::toml::load(path)
+    } else if ext("obj") {
+        obj::load(path)
     } else {
         nff::load(path)
     }
