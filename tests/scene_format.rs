@@ -911,6 +911,84 @@ material = "mine"
     assert_eq!(emray::load::load_path(&main).unwrap(), s2);
 }
 
+const QUAD_OBJ: &str = "\
+mtllib quad.mtl
+v 0 0 0
+v 1 0 0
+v 1 1 0
+v 0 1 0
+vn 0 0 1
+usemtl blue
+f 1//1 2//1 3//1 4//1
+";
+
+const QUAD_MTL: &str = "newmtl blue\nKd 0 0 1\n";
+
+#[test]
+fn obj_includes_bring_their_materials_and_bake_transforms() {
+    let dir = temp_dir();
+    write(dir.path(), "models/quad.obj", QUAD_OBJ);
+    write(dir.path(), "models/quad.mtl", QUAD_MTL);
+    let body = r#"
+[materials.mine]
+color = [1, 0, 0]
+
+[[objects]]
+type = "include"
+file = "models/quad.obj"
+transform = [{ rotate = [1, 0, 0], angle = -90 }, { translate = [0, 2, 0] }]
+
+[define.q]
+type = "include"
+file = "models/QUAD.OBJ"
+
+[[objects]]
+type = "instance"
+of = "q"
+material = "mine"
+"#;
+    let main = write(dir.path(), "scene.toml", &format!("{CAMERA}{body}"));
+    // Case of the extension does not matter; the file system's case does, so give the
+    // define a copy under that name.
+    write(dir.path(), "models/QUAD.OBJ", QUAD_OBJ);
+    let s = scene_toml::load(&main).unwrap();
+    assert_eq!(s.count(Kind::Triangle), 4);
+    assert_eq!(s.geometry.count(Kind::Triangle), 2);
+    // `mine`, then the OBJ's `blue` (the two names are two files, read once each).
+    assert_eq!(s.materials[0].color, Vec3::X);
+    let blue = s.materials[s.triangles.material[0] as usize];
+    assert_eq!(blue.color, Vec3::Z);
+    // The quad in the z = 0 plane facing +z, turned to face +y, lifted by 2.
+    for t in &s.triangles.items {
+        assert!(t.p.iter().all(|p| (p.y - 2.0).abs() < 1e-5), "{t:?}");
+        assert!(t.normal().y > 0.0);
+    }
+    let k = s.triangle_normals[0] as usize;
+    assert_close(s.vertex_normals[k][0], Vec3::Y);
+    // Inside the define the OBJ keeps its own material (an instance's material only
+    // fills primitives that have none).
+    let obj = &s.objects[s.instances[0].object as usize];
+    assert_eq!(s.materials[obj.triangles.material[0] as usize].color, Vec3::Z);
+
+    // `lights` makes no sense for OBJ; errors inside the OBJ name it.
+    let body = "[[objects]]\ntype = \"include\"\nfile = \"models/quad.obj\"\nlights = true # HERE\n";
+    let bad = write(dir.path(), "bad.toml", &format!("{CAMERA}{body}"));
+    let e = scene_toml::load(&bad).unwrap_err();
+    assert_eq!(e.line, marked_line(&format!("{CAMERA}{body}")), "{e}");
+    write(dir.path(), "broken.obj", "v 0 0 0\nv 1 0 0\nv 0 1 nan\nf 1 2 3\n");
+    let body = "[[objects]]\ntype = \"include\"\nfile = \"broken.obj\" # HERE\n";
+    let bad = write(dir.path(), "bad2.toml", &format!("{CAMERA}{body}"));
+    let e = scene_toml::load(&bad).unwrap_err();
+    assert_eq!(e.path, dir.path().join("broken.obj"), "{e}");
+    assert_eq!(e.line, 3, "{e}");
+    assert!(e.message.contains("included from"), "{e}");
+    let body = "[[objects]]\ntype = \"include\"\nfile = \"gone.obj\" # HERE\n";
+    let bad = write(dir.path(), "bad3.toml", &format!("{CAMERA}{body}"));
+    let e = scene_toml::load(&bad).unwrap_err();
+    assert_eq!((e.path.clone(), e.line), (bad, marked_line(&format!("{CAMERA}{body}"))), "{e}");
+    assert!(e.message.contains("gone.obj"), "{e}");
+}
+
 #[test]
 fn include_errors_name_the_right_file_and_line() {
     let dir = temp_dir();

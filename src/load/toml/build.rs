@@ -22,7 +22,7 @@ use super::format::{
 use super::{suggest, SceneSettings, Source, MAX_SIDE};
 use crate::geometry::polygon::Triangulator;
 use crate::geometry::{Cone, Csg, CsgOp, CsgTree, Shape, Sphere, Triangle};
-use crate::load::{nff, LoadError};
+use crate::load::{nff, obj, LoadError};
 use crate::math::{Vec3, Xform};
 use crate::scene::{Camera, Geometry, Instance, Light, LoadStats, Material, Scene, Spot, INHERIT};
 use glam::{Affine3A, DAffine3, DMat3, DVec3};
@@ -133,10 +133,22 @@ impl Ctx {
     };
 }
 
+/// The formats an `include` reads.
+#[derive(Clone, Copy, Debug, PartialEq, Eq)]
+enum Format {
+    Nff,
+    Obj,
+}
+
 /// A parsed included file, its materials already appended to the scene's.
 struct Included {
-    scene: Scene,
+    /// Its primitives, material indices local to the file.
+    geometry: Geometry,
+    /// Its lights (NFF).
+    lights: Vec<Light>,
+    /// Where its materials start in the scene's list.
     material_base: u32,
+    format: Format,
 }
 
 struct Builder<'a, 's> {
@@ -1355,48 +1367,73 @@ impl<'a, 's> Builder<'a, 's> {
         if let Some(inc) = self.includes.get(&path) {
             return Ok(inc.clone());
         }
-        let ext = rel
-            .extension()
-            .and_then(|e| e.to_str())
-            .map(str::to_ascii_lowercase);
-        if matches!(ext.as_deref(), Some("toml" | "obj")) {
+        let is = |e: &str| rel.extension().is_some_and(|x| x.eq_ignore_ascii_case(e));
+        if is("toml") {
             return Err(self.err(
                 file.span(),
                 format!(
-                    "cannot include `{}`: only NFF files can be included",
+                    "cannot include `{}`: only NFF and OBJ files can be included",
                     rel.display()
                 ),
             ));
         }
-        let bytes = std::fs::read(&path).map_err(|e| {
+        let unreadable = |e: std::io::Error| {
             self.err(
                 file.span(),
                 format!("cannot read included file `{}`: {e}", path.display()),
             )
-        })?;
-        let text = String::from_utf8_lossy(&bytes);
+        };
         let (line, col) = self.src.position(file.span().start);
-        let scene = nff::parse_str(&text, &path).map_err(|mut e| {
+        let located = |mut e: LoadError| {
             e.message = format!(
                 "{} (included from {}:{line}:{col})",
                 e.message,
                 self.src.path.display()
             );
             e
-        })?;
+        };
+        let (geometry, materials, lights, stats, format) = if is("obj") {
+            std::fs::File::open(&path).map_err(unreadable)?;
+            let data = obj::load_geometry(&path).map_err(located)?;
+            for w in &data.warnings {
+                log::warn!(
+                    "{w} (included from {}:{line}:{col})",
+                    self.src.path.display()
+                );
+            }
+            (
+                data.geometry,
+                data.materials,
+                Vec::new(),
+                data.stats,
+                Format::Obj,
+            )
+        } else {
+            let bytes = std::fs::read(&path).map_err(unreadable)?;
+            let scene = nff::parse_str(&String::from_utf8_lossy(&bytes), &path).map_err(located)?;
+            (
+                scene.geometry,
+                scene.materials,
+                scene.lights,
+                scene.load_stats,
+                Format::Nff,
+            )
+        };
         let material_base = self.materials.len() as u32;
-        self.materials.extend_from_slice(&scene.materials);
-        self.stats.polygons += scene.load_stats.polygons;
-        self.stats.degenerate_dropped += scene.load_stats.degenerate_dropped;
+        self.materials.extend_from_slice(&materials);
+        self.stats.polygons += stats.polygons;
+        self.stats.degenerate_dropped += stats.degenerate_dropped;
         let inc = Rc::new(Included {
-            scene,
+            geometry,
+            lights,
             material_base,
+            format,
         });
         self.includes.insert(path, inc.clone());
         Ok(inc)
     }
 
-    /// `include`: an NFF file's primitives (and optionally lights) under the node's
+    /// `include`: an NFF or OBJ file's primitives (and optionally lights) under the node's
     /// transform; its materials, unless the node gives one for all of them.
     fn include(
         &mut self,
@@ -1408,10 +1445,16 @@ impl<'a, 's> Builder<'a, 's> {
         let o = node.get_ref();
         let file = self.need(&o.file, "file", node, Ty::Include)?;
         let inc = self.included(file)?;
-        let s = &inc.scene;
+        let s = &inc.geometry;
         let mat = |m: u32| material.unwrap_or(inc.material_base + m);
         if let Some(l) = &o.lights {
             if *l.get_ref() {
+                if inc.format == Format::Obj {
+                    return Err(self.err(
+                        l.span(),
+                        "`lights` is for NFF includes (an OBJ file has no lights)",
+                    ));
+                }
                 if sink.in_define() {
                     return Err(self.err(
                         l.span(),
@@ -1419,9 +1462,13 @@ impl<'a, 's> Builder<'a, 's> {
                          object placed by instances; lights are not instanced)",
                     ));
                 }
-                for light in &s.lights {
+                for light in &inc.lights {
                     self.lights.push(Light {
                         pos: f32v(x.transform_point3(light.pos.as_dvec3())),
+                        spot: light.spot.map(|sp| Spot {
+                            dir: f32v((x.matrix3 * sp.dir.as_dvec3()).normalize()),
+                            ..sp
+                        }),
                         ..*light
                     });
                 }
