@@ -5,15 +5,19 @@
 //!   degree elevation, flatness.
 //! * [`BezierPatch`]: bicubic; evaluation, partial derivatives, normals (with the
 //!   limit taken where an edge collapses to a point), subdivision in `u` and `v`.
+//! * [`tessellate`]: patches to a [`TriMesh`] within a distance tolerance, refined
+//!   where the surface curves, without cracks between patches refined differently.
 //! * [`teapot_patches`]: the 32 patches of the Utah teapot.
 //!
 //! The mathematics is in `f64`; only the mesh is `f32`.
 
 mod curve;
 mod patch;
+mod tessellate;
 
 pub use curve::BezierCurve;
 pub use patch::BezierPatch;
+pub use tessellate::{tessellate, TriMesh, MAX_LEVEL};
 
 /// Newell's teapot (the data of the `teapot` database in [`crate::gen`]) as 32
 /// bicubic patches: rim 0–3, body 4–11, handle 12–15, spout 16–19, lid 20–27, bottom
