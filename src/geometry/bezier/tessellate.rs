@@ -60,8 +60,10 @@ pub const MAX_LEVEL: u32 = 8;
 ///
 /// Vertices are not shared between patches: a vertex on a seam appears once per
 /// patch, with the same position bit for bit and that patch's normal (so creases keep
-/// their two normals). Triangles are counterclockwise seen from the side the normals
-/// point to: `(p1 − p0) × (p2 − p0)` follows the patch normal `∂P/∂u × ∂P/∂v`.
+/// their two normals). Triangles are counterclockwise in the patch's `(u, v)` plane, so
+/// `(p1 − p0) × (p2 − p0)` points the way of the patch normal `∂P/∂u × ∂P/∂v` (up to
+/// the error the tolerance allows: only where a triangle spans a fold tighter than
+/// the tolerance can a vertex normal be more than 90° from its face).
 #[derive(Clone, Debug, Default, PartialEq)]
 pub struct TriMesh {
     /// Vertex positions: points of the patches, rounded to `f32`.
@@ -633,6 +635,46 @@ mod tests {
                 }
             }
         }
+    }
+
+    /// The teapot exercises what the crack tests rely on: edges stitched to a finer
+    /// grid, and shared edges between patches whose grids differ along them.
+    #[test]
+    fn the_teapot_needs_stitching_and_shared_edge_levels() {
+        let patches = super::super::teapot_patches();
+        let tol = 0.01;
+        let mut plans: Vec<Plan> = patches.iter().map(|p| plan(p, tol)).collect();
+        let own = plans.clone();
+        reconcile(&patches, &mut plans);
+        let grid_along = |plan: &Plan, side: Side| match side {
+            Side::Bottom | Side::Top => plan.a,
+            Side::Left | Side::Right => plan.b,
+        };
+        let mut stitched = 0;
+        let mut raised = 0;
+        let mut by_edge: HashMap<EdgeKey, Vec<u32>> = HashMap::new();
+        for ((p, plan), before) in patches.iter().zip(&plans).zip(&own) {
+            assert!(plan.bound <= tol, "{plan:?}");
+            for side in SIDES {
+                let e = plan.edges[side as usize];
+                assert!(e <= grid_along(plan, side));
+                stitched += usize::from(e < grid_along(plan, side));
+                raised += usize::from(e > before.edges[side as usize]);
+                by_edge
+                    .entry(edge_key(edge_points(p, side)))
+                    .or_default()
+                    .push(grid_along(plan, side));
+            }
+        }
+        assert!(stitched > 10, "{stitched} stitched edges");
+        assert!(raised > 0, "no edge raised by its neighbour");
+        let differing = by_edge
+            .values()
+            .filter(|g| g.len() == 2 && g[0] != g[1])
+            .count();
+        assert!(differing > 0, "no shared edge between different grids");
+        // An empty input is an empty mesh.
+        assert_eq!(tessellate(&[], tol), TriMesh::default());
     }
 
     #[test]
