@@ -1,48 +1,5 @@
-//! Adaptive, crack-free tessellation of bicubic patches into smooth triangles.
-//!
-//! # The scheme
-//!
-//! Each patch gets a grid of `2ᵃ × 2ᵇ` parameter cells, and each boundary edge a
-//! number `2ᵉ` of segments that is the same for every patch sharing the edge. An edge
-//! is identified by its four control points in a canonical orientation (the point
-//! sequence or its reverse, whichever sorts first), and its vertices are evaluated on
-//! that canonical polygon at dyadic parameters: two patches sharing an edge, in either
-//! direction, get bitwise the same vertices.
-//!
-//! Along its boundary a patch uses exactly the edge's vertices and no others, so the
-//! mesh is conforming: no T-junctions, every interior edge is shared by exactly two
-//! triangles with identical end points (opposite directions), and a watertight
-//! ray/triangle test lets no ray through a seam. The grid is at least as fine as each
-//! of its edges, and the ring of cells next to the boundary is stitched: the boundary
-//! polyline (coarse) and the first interior grid line (fine) are joined by fans, one
-//! polygon per coarse segment, which keeps every triangle inside the parameter
-//! rectangle spanned by that segment and the ring's width. The four stitched strips
-//! meet on the diagonals from the corners to the first interior grid point; inside,
-//! the grid cells are split along their shorter diagonal. A patch one cell wide in `v`
-//! (`b = 0`) is a single strip joining its two `u` edges directly (likewise for
-//! `a = 0`), so an exactly flat patch becomes two triangles.
-//!
-//! # Adaptivity and the error bound
-//!
-//! The refinement is driven by the flatness of the control nets of the patch
-//! subdivided by de Casteljau's algorithm: over a parameter rectangle whose sub-patch
-//! has control-net second differences `D_uu`, `D_vv`, `D_uv`, every triangle with
-//! vertices on the surface inside it is within `¾(D_uu + D_vv) + 9/4·D_uv` of the
-//! surface at the same parameters ([`BezierPatch::triangle_error_bound`]).
-//!
-//! 1. Each patch on its own: the grid is refined, in the direction that dominates the
-//!    failing bound, until every cell is within the tolerance; each edge takes the
-//!    coarsest level, at least what the edge's own control polygon needs
-//!    (`¾ max|Δ²p| ≤ tolerance` on every piece), at which the stitched strip along it
-//!    is within the tolerance. The strip's rectangles are as long as the edge's
-//!    segments, so an edge that is straight but borders a surface curving along it
-//!    still gets the segments that surface needs.
-//! 2. Shared edges: every edge takes the finest level any of its patches asked for
-//!    (a table keyed by the canonical control points), and each grid grows to be at
-//!    least as fine as its edges. Both only shrink the rectangles the bound was taken
-//!    over, so the tolerance still holds.
-//!
-//! Levels are capped at [`MAX_LEVEL`] per direction.
+//! Adaptive, crack-free tessellation of bicubic patches into smooth triangles; the
+//! scheme is described in the documentation of the parent module.
 
 use super::curve::{canonical, cubic_chord_error_bound, cubic_eval, cubic_split};
 use super::patch::BezierPatch;
@@ -95,7 +52,7 @@ impl TriMesh {
 
 /// Tessellate `patches` into one mesh whose distance from the surface, measured
 /// between points at the same patch parameters, is at most `tolerance` (a distance in
-/// scene units); see the [module documentation](self) for the scheme. Patches that
+/// scene units); see the [module documentation](crate::geometry::bezier) for the scheme. Patches that
 /// share a boundary edge with bitwise equal control points (in either order) meet
 /// without cracks. Triangles that collapse to a segment because two of their vertices
 /// coincide (at an edge collapsed to a point) are left out.
