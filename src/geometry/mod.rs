@@ -6,6 +6,7 @@
 //! Every intersector has a double-precision reference in [`reference`] used by the
 //! tests to bound the f32 error.
 
+pub mod bezier;
 mod cone;
 pub mod csg;
 pub mod polygon;
