@@ -6,12 +6,14 @@
 //! Every intersector has a double-precision reference in [`reference`] used by the
 //! tests to bound the f32 error.
 
+mod boxes;
 mod cone;
 pub mod polygon;
 pub mod reference;
 mod sphere;
 mod triangle;
 
+pub use boxes::{AaBox, OBox};
 pub use cone::Cone;
 pub use sphere::Sphere;
 pub use triangle::{Triangle, WatertightRay};
