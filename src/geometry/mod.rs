@@ -7,6 +7,7 @@
 //! tests to bound the f32 error.
 
 mod boxes;
+mod capped;
 mod cone;
 pub mod polygon;
 pub mod reference;
@@ -14,6 +15,7 @@ mod sphere;
 mod triangle;
 
 pub use boxes::{AaBox, OBox};
+pub use capped::CappedCone;
 pub use cone::Cone;
 pub use sphere::Sphere;
 pub use triangle::{Triangle, WatertightRay};
