@@ -10,6 +10,7 @@ mod boxes;
 mod capped;
 mod cone;
 pub mod polygon;
+mod polyhedron;
 pub mod reference;
 mod sphere;
 mod triangle;
@@ -17,6 +18,7 @@ mod triangle;
 pub use boxes::{AaBox, OBox};
 pub use capped::CappedCone;
 pub use cone::Cone;
+pub use polyhedron::Polyhedron;
 pub use sphere::Sphere;
 pub use triangle::{Triangle, WatertightRay};
 
