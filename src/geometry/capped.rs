@@ -67,6 +67,10 @@ struct Quadratic {
 /// from the rims, so that a ray spawned from it is still seen inside the other part.
 const RIM_MARGIN: f64 = 4.0;
 
+/// The farthest `surface` moves a point along the surface off a rim, in units of its
+/// error bound.
+const MAX_SHIFT: f64 = 64.0;
+
 /// A closed cone, truncated cone or cylinder: the solid between the base disk (centre
 /// `base`, radius `base_radius`) and the top disk (centre `base + height·axis`, radius
 /// `top_radius`), bounded by the lateral surface between their rims.
@@ -539,14 +543,27 @@ impl Intersect for CappedCone {
             Frame::from_z(self.axis).x.as_dvec3()
         };
         let part = self.part_of(hit.ng, s, rho);
-        let e = self.err_scale(q);
-        let margin = RIM_MARGIN * (e + gamma(2) as f64 * (base + q).abs().max_element());
+        // The point's error bound (as `err` below); a spawned ray starts about that far
+        // off the surface and the intersector cannot resolve much less.
+        let e_max = self.err_scale(q) + gamma(2) as f64 * (base + q).abs().max_element();
+        let noise = RIM_MARGIN * e_max;
+        let offset = 2.0 * e_max;
+        let sq = (1.0 + k * k).sqrt();
+        // How far along the surface a point may be moved off a rim: enough for ordinary
+        // rims; a knife edge (side and cap meeting at a few degrees) would need more and
+        // gets only this much, so as not to move the point visibly.
+        let max_shift = MAX_SHIFT * e_max;
         let (s1, rho1, n) = match part {
             Part::Side => {
                 // Foot of the perpendicular onto the line ρ = rb + k s.
                 let delta = (rho - rb - k * s) / (1.0 + k * k);
-                let s1 = if h > 2.0 * margin {
-                    (s + k * delta).max(margin).min(h - margin)
+                // Moving inwards off the side by `offset` changes s by offset·k/√(1+k²):
+                // keep that much more from the cap plane it moves towards.
+                let towards = offset * k.abs() / sq;
+                let lo = (noise + if k < 0.0 { towards } else { 0.0 }).min(max_shift / sq);
+                let hi = (noise + if k > 0.0 { towards } else { 0.0 }).min(max_shift / sq);
+                let s1 = if h > lo + hi {
+                    (s + k * delta).max(lo).min(h - hi)
                 } else {
                     0.5 * h
                 };
@@ -558,7 +575,11 @@ impl Intersect for CappedCone {
                 } else {
                     (h, rt, w)
                 };
-                (s1, rho.min((r - margin).max(0.5 * r)), n)
+                // Moving inwards off the cap by `offset` shrinks the radius by |k|·offset
+                // when the cone narrows away from this cap.
+                let narrows = (part == Part::Base) == (k < 0.0);
+                let m = (noise + if narrows { offset * k.abs() } else { 0.0 }).min(max_shift);
+                (s1, rho.min((r - m).max(0.5 * r)), n)
             }
         };
         let local = w * s1 + radial * rho1;
