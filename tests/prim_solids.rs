@@ -212,6 +212,20 @@ impl Geo {
         }
     }
 
+    /// Whether `p` is on a knife edge: within `tol` plus a few error bounds `e` (times the
+    /// slope) of the rim of a cone so flat that its side meets a cap at a few degrees.
+    /// Points there are moved off the rim by a bounded amount, too little for a ray
+    /// spawned inwards to be seen inside the cap's slab.
+    fn near_knife_edge(&self, p: DVec3, tol: f64, e: f64) -> bool {
+        match self {
+            Geo::Cone { h, rb, rt, .. } => {
+                let k = (rt - rb).abs() / h;
+                k > 8.0 && self.near_edge(p, tol + 8.0 * e * (1.0 + k))
+            }
+            _ => false,
+        }
+    }
+
     /// Whether `p` is within `tol` of an edge, a rim or an apex.
     fn near_edge(&self, p: DVec3, tol: f64) -> bool {
         match self {
@@ -353,13 +367,27 @@ fn make_dir(org: Vec3, target: Vec3, (len, mode, random, zero): (f32, u8, Vec3, 
 fn cone_case() -> impl Strategy<Value = Case> {
     (
         placement(),
-        (v3(), unit(), 0.2f32..2.0, 0.05f32..1.0, 0.0f32..1.0, 0u8..4),
+        (
+            v3(),
+            unit(),
+            0.2f32..2.0,
+            0.05f32..1.0,
+            0.0f32..1.0,
+            0u8..4,
+            // Ordinary, coin-like (flat) and needle-like proportions.
+            prop_oneof![6 => Just((1.0f32, 1.0f32)), 1 => Just((3e-3, 1.0)), 1 => Just((1.0, 3e-3))],
+        ),
         (any::<bool>(), v3(), 0.05f32..0.95, 0.0f32..0.95, unit()),
         (0u8..3, 0.0f32..1.0, unit(), 0.9f32..1.1),
         direction(),
     )
-        .prop_map(
-            |((scale, off), (b, axis, h, r1, r2, kind), orig, aim, dir)| {
+        .prop_filter_map(
+            "flat or thin beyond the resolution of its offset",
+            |((scale, off), (b, axis, h, r1, r2, kind, (hf, rf)), orig, aim, dir)| {
+                let (h, r1, r2) = (h * hf, r1 * rf, r2 * rf);
+                if h.min(r1) * scale < off.abs().max_element() * 1e-3 {
+                    return None;
+                }
                 let (rb, rt) = match kind {
                     0 => (r1, r2),
                     1 => (r1, r1),
@@ -387,7 +415,7 @@ fn cone_case() -> impl Strategy<Value = Case> {
                         base + w * (h * scale) + perp(around) * (radius(1.0) * factor * s_t.sqrt())
                     }
                 };
-                Case::new(AnySolid::Cone(c), org, make_dir(org, target, dir), off)
+                Some(Case::new(AnySolid::Cone(c), org, make_dir(org, target, dir), off))
             },
         )
 }
@@ -720,7 +748,10 @@ fn check_hit(case: &Case, g: &ShapeHit, w: &Crossing, worst: &mut Worst) -> Resu
     // The refined point is the hit, not another point of the surface.
     if !graze {
         let gap = (p - p_ref).length();
-        let allowed = tol_at(scale_d, cos, case.off, dlen) * dlen + 1e-5 * magnitude;
+        // Plus the shift off a rim (at most 64 error bounds along the surface).
+        let allowed = tol_at(scale_d, cos, case.off, dlen) * dlen
+            + 1e-5 * magnitude
+            + 80.0 * sp.err.max_element() as f64;
         if gap > allowed {
             return Err(format!(
                 "surface point {} is {gap} from the hit {p_ref}",
@@ -755,7 +786,12 @@ fn check_spawn(case: &Case, w: Vec3) -> Result<(), String> {
     let inw = -out;
     let pi = offset_ray_origin(sp.p, sp.err, n, inw);
     // At the apex of a pointed cone most of the inward hemisphere is outside the solid.
-    let apex = case.geo.near_apex(sp.p.as_dvec3(), case.edge_tol());
+    let apex = case.geo.near_apex(sp.p.as_dvec3(), case.edge_tol())
+        || case.geo.near_knife_edge(
+            sp.p.as_dvec3(),
+            case.edge_tol(),
+            sp.err.max_element() as f64,
+        );
     match s.intersect(&Ray::new(pi, inw)) {
         _ if apex => Ok(()),
         None => Err(format!("inward ray from {} missed the solid", sp.p)),
@@ -1075,6 +1111,35 @@ fn tangent_rays_to_the_side() {
         t1 > t0 && n1.dot(Vec3::new(-1.0, 0.0, 1.0)) > 0.0,
         "{t1} {n1}"
     );
+}
+
+#[test]
+fn ultra_flat_cone_tells_side_from_base_by_the_point() {
+    // Slope 1e5: the side's normal is within 1e-5 of the axis, as the cap's is.
+    let c = CappedCone::new(Vec3::ZERO, Vec3::Z, 1e-5, 1.0, 0.0).unwrap();
+    let params = |s: &CappedCone| {
+        (
+            s.base().as_dvec3(),
+            s.axis().as_dvec3(),
+            s.height() as f64,
+            s.base_radius() as f64,
+            s.top_radius() as f64,
+        )
+    };
+    let (b, w, h, rb, rt) = params(&c);
+    for (org, dir, up) in [
+        (Vec3::new(0.5, 0.1, 1.0), -Vec3::Z, true),
+        (Vec3::new(-0.3, 0.4, -1.0), Vec3::Z * 3.0, false),
+        (Vec3::new(0.9, 0.0, 0.5), Vec3::new(-0.2, 0.1, -1.0), true),
+    ] {
+        let ray = Ray::new(org, dir);
+        let hit = c.intersect(&ray).expect("the coin is hit");
+        let sp = c.surface(&ray, &hit);
+        let d = refs::capped_cone_distance(sp.p.as_dvec3(), b, w, h, rb, rt);
+        assert!(d <= sp.ng.abs().dot(sp.err) as f64, "{sp:?} is {d} off");
+        assert_eq!(sp.ng.z > 0.0, up, "{sp:?}");
+        assert!((sp.p - ray.at(hit.t)).length() < 1e-5, "{sp:?}");
+    }
 }
 
 #[test]
