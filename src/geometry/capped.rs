@@ -106,34 +106,38 @@ impl CappedCone {
         top_radius: f32,
     ) -> Result<Self, String> {
         if !base_center.is_finite() {
-            return Err(format!("cone: base centre {base_center} is not finite"));
+            return Err(format!(
+                "capped cone: base centre {base_center} is not finite"
+            ));
         }
         if !axis_dir.is_finite() {
-            return Err(format!("cone: axis {axis_dir} is not finite"));
+            return Err(format!("capped cone: axis {axis_dir} is not finite"));
         }
         let a = axis_dir.as_dvec3();
         let len = a.length();
         if !(len.is_finite() && len > 0.0) {
-            return Err("cone: the axis direction is zero".to_string());
+            return Err("capped cone: the axis direction is zero".to_string());
         }
         let axis = (a / len).as_vec3();
         if !(height > 0.0 && height.is_finite()) {
-            return Err(format!("cone: height {height} must be positive and finite"));
+            return Err(format!(
+                "capped cone: height {height} must be positive and finite"
+            ));
         }
         for (name, r) in [("base", base_radius), ("top", top_radius)] {
             if !(r >= 0.0 && r.is_finite()) {
                 return Err(format!(
-                    "cone: {name} radius {r} must be zero or positive and finite"
+                    "capped cone: {name} radius {r} must be zero or positive and finite"
                 ));
             }
         }
         if base_radius == 0.0 && top_radius == 0.0 {
-            return Err("cone: both radii are zero (no volume)".to_string());
+            return Err("capped cone: both radii are zero (no volume)".to_string());
         }
         let slope = ((top_radius as f64 - base_radius as f64) / height as f64) as f32;
         if !slope.is_finite() {
             return Err(format!(
-                "cone: height {height} is too small for radii {base_radius} and {top_radius}"
+                "capped cone: height {height} is too small for radii {base_radius} and {top_radius}"
             ));
         }
         let c = CappedCone {
@@ -146,7 +150,7 @@ impl CappedCone {
         };
         if !c.bounds().is_finite() {
             return Err(format!(
-                "cone: base {base_center}, height {height} and radii overflow"
+                "capped cone: base {base_center}, height {height} and radii overflow"
             ));
         }
         Ok(c)
@@ -155,14 +159,21 @@ impl CappedCone {
     /// A closed cylinder of radius `radius` > 0.
     ///
     /// # Errors
-    /// As [`CappedCone::new`].
+    /// As [`CappedCone::new`], and for a radius that is not positive; the messages say
+    /// "cylinder".
     pub fn cylinder(
         base_center: Vec3,
         axis_dir: Vec3,
         height: f32,
         radius: f32,
     ) -> Result<Self, String> {
+        if !(radius > 0.0 && radius.is_finite()) {
+            return Err(format!(
+                "cylinder: radius {radius} must be positive and finite"
+            ));
+        }
         Self::new(base_center, axis_dir, height, radius, radius)
+            .map_err(|e| e.replacen("capped cone", "cylinder", 1))
     }
 
     /// Centre of the base disk.
