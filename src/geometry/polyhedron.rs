@@ -21,6 +21,10 @@ pub const MAX_PLANES: usize = 256;
 /// the other faces' planes, so that a ray spawned from it is still seen inside them.
 const EDGE_MARGIN: f64 = 4.0;
 
+/// The farthest `surface` moves a point along its face off an edge, in units of its
+/// error bound.
+const MAX_SHIFT: f64 = 64.0;
+
 /// One bounding plane: `n·(x − o) ≤ d`, `n` unit (to f32 rounding).
 #[derive(Clone, Copy, Debug, PartialEq)]
 struct Plane {
@@ -510,6 +514,10 @@ impl Intersect for Polyhedron {
         let e = gamma(8) as f64 * (y.abs().element_sum() + di.abs());
         let err_max = e + gamma(2) as f64 * (c + y).abs().max_element();
         let margin = |dj: f64| EDGE_MARGIN * err_max + gamma(8) as f64 * dj.abs();
+        // Moving the point more than this along the face (to get off a knife edge, where
+        // two faces meet at a few degrees) would move it visibly: it then stays.
+        let max_shift = MAX_SHIFT * err_max;
+        let y_face = y;
         let mut edge: Option<(DVec3, f64)> = None;
         for _ in 0..2 {
             // The most violated other plane (shrunk by the margin), not parallel to ni.
@@ -532,7 +540,11 @@ impl Intersect for Polyhedron {
                 None => {
                     // Along the face, onto the edge line with plane j.
                     let u = nj - ni * ni.dot(nj);
-                    y -= u * (viol / u.length_squared());
+                    let step = u * (viol / u.length_squared());
+                    if step.length() > max_shift {
+                        break;
+                    }
+                    y -= step;
                     edge = Some((nj, dj));
                 }
                 Some((nk, dk)) => {
@@ -541,7 +553,7 @@ impl Intersect for Polyhedron {
                     let det = ni.dot(nkj);
                     if det.abs() > 1e-12 {
                         let v = (nk.cross(nj) * di + nj.cross(ni) * dk + ni.cross(nk) * dj) / det;
-                        if v.is_finite() {
+                        if v.is_finite() && (v - y_face).length() <= max_shift {
                             y = v;
                         }
                     }
