@@ -338,10 +338,10 @@ impl CappedCone {
         let r = q.r0 + k * q.ds * dt;
         let n = qp - w * (k * r);
         // Rounding of the terms (a few ulps of each). At the apex of a pointed end the
-        // gradient vanishes and the root itself is only known to √ε (a double root for a
-        // line through the apex): a radius within rounding of zero or below it (past
-        // the apex, on the other nappe) or a gradient within rounding of zero has no
-        // reliable direction, and the apex's axis direction is an outward normal there.
+        // gradient vanishes: a radius within rounding of zero or below it (a root just
+        // past the apex, on the other nappe), or a gradient within rounding of zero, has
+        // no reliable direction, and the apex's axis direction is an outward normal
+        // there.
         let noise_r = gamma(8) * (q.r0.abs() + (k * q.ds * dt).abs());
         // (fp and dp are differences of vectors as long as f and dir.)
         let noise_q =
