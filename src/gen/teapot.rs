@@ -520,6 +520,21 @@ const PATCHES: [[[usize; 4]; 4]; 32] = [
     ],
 ];
 
+/// Read access to the patch data for [`crate::geometry::bezier::teapot_patches`].
+///
+/// An associated function of the patch type rather than a free function because this
+/// module is private to `gen`: an inherent impl is reachable wherever the type is.
+impl crate::geometry::bezier::BezierPatch {
+    /// The control points of the 32 patches in the order of [`PATCHES`], each as it is
+    /// stored: `[row][column]`, rows along `s`, columns along `t`.
+    pub(crate) fn newell_teapot_control_points() -> Vec<[[DVec3; 4]; 4]> {
+        PATCHES
+            .iter()
+            .map(|patch| patch.map(|row| row.map(|k| DVec3::from_array(VERTS[k]))))
+            .collect()
+    }
+}
+
 /// The teapot surface's colour and the floor's two colours.
 const TEAPOT_COLOR: DVec3 = DVec3::new(1.0, 0.5, 0.1);
 const LIGHT_SQUARES: DVec3 = DVec3::new(1.0, 1.0, 1.0);

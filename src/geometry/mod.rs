@@ -6,15 +6,22 @@
 //! Every intersector has a double-precision reference in [`reference`] used by the
 //! tests to bound the f32 error.
 
+pub mod bezier;
+mod boxes;
+mod capped;
 mod cone;
 pub mod csg;
 pub mod polygon;
+mod polyhedron;
 pub mod reference;
 mod sphere;
 mod triangle;
 
+pub use boxes::{AaBox, OBox};
+pub use capped::CappedCone;
 pub use cone::Cone;
 pub use csg::{Csg, CsgOp, CsgTree};
+pub use polyhedron::Polyhedron;
 pub use sphere::Sphere;
 pub use triangle::{Triangle, WatertightRay};
 

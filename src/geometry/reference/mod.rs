@@ -1,6 +1,8 @@
 //! Straightforward double-precision intersectors: the independent references the f32
 //! intersectors are tested against. Clarity over speed; not used for rendering.
 
+pub mod solids;
+
 use crate::math::{DRay, DVec3};
 
 /// Nearest root `> tmin` of `a t² + 2 b t + c = 0` among those passing `accept`,

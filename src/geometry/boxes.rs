@@ -1,0 +1,482 @@
+//! Boxes: axis-aligned ([`AaBox`]) and oriented ([`OBox`]), both closed solids.
+//!
+//! Both use the slab test (Kay and Kajiya): the line's entry is the latest of the three
+//! slabs' near distances and its exit the earliest of their far distances, and the slab
+//! that decides an end gives its normal. A ray parallel to a slab is inside it for every
+//! `t` or for none, decided by its origin, so no `0 · ∞` ever forms. The distances are
+//! divided, not multiplied by a reciprocal, so each is correctly rounded from the
+//! (exact, for a nearby origin) difference of coordinates.
+//!
+//! The oriented box takes the ray into its own frame (a rotation, so `t` is unchanged)
+//! and runs the same test against `[−h, h]`.
+
+use super::{Intersect, ShapeHit, Solid, Span, Spans, SurfacePoint};
+use crate::math::{gamma, Aabb, Ray, Vec3};
+use glam::{DMat3, DQuat, Mat3, Quat};
+
+/// One end of a line's stretch through a box: its parameter, the axis whose slab decided
+/// it and the sign of the outward normal along that axis.
+#[derive(Clone, Copy, Debug)]
+struct End {
+    t: f32,
+    axis: usize,
+    sign: f32,
+}
+
+/// The stretch of the line `org + t·dir`, `t ∈ (−∞, ∞)`, inside the closed box
+/// `[lo, hi]`, or `None`. Inputs must be finite.
+#[inline]
+fn slab(org: Vec3, dir: Vec3, lo: Vec3, hi: Vec3) -> Option<(End, End)> {
+    let mut t_in = f32::NEG_INFINITY;
+    let mut t_out = f32::INFINITY;
+    let (mut a_in, mut a_out) = (3, 3);
+    let (mut s_in, mut s_out) = (0.0f32, 0.0f32);
+    for i in 0..3 {
+        let (o, d) = (org[i], dir[i]);
+        if d == 0.0 {
+            // Parallel: the origin decides for the whole line (the slab is closed).
+            if !(o >= lo[i] && o <= hi[i]) {
+                return None;
+            }
+            continue;
+        }
+        let ta = (lo[i] - o) / d;
+        let tb = (hi[i] - o) / d;
+        // Moving up the axis the line enters through `lo` (normal −e_i) and leaves
+        // through `hi` (+e_i); moving down, the other way round.
+        let (near, far, sign) = if d > 0.0 {
+            (ta, tb, 1.0)
+        } else {
+            (tb, ta, -1.0)
+        };
+        if near > t_in {
+            t_in = near;
+            a_in = i;
+            s_in = -sign;
+        }
+        if far < t_out {
+            t_out = far;
+            a_out = i;
+            s_out = sign;
+        }
+    }
+    // `a_in == 3` only for a zero direction (or distances overflowing to −∞).
+    if a_in < 3 && a_out < 3 && t_in <= t_out {
+        Some((
+            End {
+                t: t_in,
+                axis: a_in,
+                sign: s_in,
+            },
+            End {
+                t: t_out,
+                axis: a_out,
+                sign: s_out,
+            },
+        ))
+    } else {
+        None
+    }
+}
+
+/// The end to report for a ray: the entry if it lies in `(tmin, tmax)`, else the exit.
+#[inline]
+fn pick(ray: &Ray, (a, b): (End, End)) -> Option<End> {
+    if a.t > ray.tmin && a.t < ray.tmax {
+        Some(a)
+    } else if b.t > ray.tmin && b.t < ray.tmax {
+        Some(b)
+    } else {
+        None
+    }
+}
+
+/// `x` moved into `[lo + m, hi − m]`, or the middle of `[lo, hi]` when that is narrower
+/// than `2m`. Never panics, whatever the inputs.
+#[inline]
+fn clamp_inside(x: f64, lo: f64, hi: f64, m: f64) -> f64 {
+    if hi - lo > 2.0 * m {
+        x.max(lo + m).min(hi - m)
+    } else {
+        0.5 * (lo + hi)
+    }
+}
+
+/// Face-local coordinates in `[0, 1]` of point `p` on the face normal to `axis` of the
+/// box `[lo, hi]`: along the next axis and the one after (cyclically).
+#[inline]
+fn face_uv(p: Vec3, lo: Vec3, hi: Vec3, axis: usize) -> (f32, f32) {
+    let (j, k) = ((axis + 1) % 3, (axis + 2) % 3);
+    let u = (p[j] - lo[j]) / (hi[j] - lo[j]);
+    let v = (p[k] - lo[k]) / (hi[k] - lo[k]);
+    (u.clamp(0.0, 1.0), v.clamp(0.0, 1.0))
+}
+
+/// The unit vector along `axis` with sign `sign`.
+#[inline]
+fn axis_vec(axis: usize, sign: f32) -> Vec3 {
+    let mut n = Vec3::ZERO;
+    n[axis] = sign;
+    n
+}
+
+/// Relative margin (in units of the point's error bound) by which a surface point is
+/// kept away from its face's edges: a ray spawned from it, offset along this face's
+/// normal, must still be seen inside the neighbouring faces' slabs.
+const EDGE_MARGIN: f64 = 4.0;
+
+/// An axis-aligned box `[min, max]`: a closed solid.
+///
+/// `u`, `v` of a hit are its face-local coordinates in `[0, 1]`, along the two other
+/// axes in cyclic order (face normal to x: y then z; to y: z then x; to z: x then y).
+#[derive(Clone, Copy, Debug, PartialEq)]
+pub struct AaBox {
+    min: Vec3,
+    max: Vec3,
+}
+
+impl AaBox {
+    /// The box between corners `min` and `max`.
+    ///
+    /// # Errors
+    /// When a coordinate is not finite or `min` is not below `max` on every axis.
+    pub fn new(min: Vec3, max: Vec3) -> Result<Self, String> {
+        if !min.is_finite() || !max.is_finite() {
+            return Err(format!("box: corners {min} and {max} must be finite"));
+        }
+        if !min.cmplt(max).all() {
+            return Err(format!(
+                "box: min {min} must be below max {max} on every axis (size {})",
+                max - min
+            ));
+        }
+        Ok(AaBox { min, max })
+    }
+
+    /// Lower corner.
+    pub fn min(&self) -> Vec3 {
+        self.min
+    }
+
+    /// Upper corner.
+    pub fn max(&self) -> Vec3 {
+        self.max
+    }
+
+    #[inline]
+    fn ends(&self, ray: &Ray) -> Option<(End, End)> {
+        if !ray.org.is_finite() || !ray.dir.is_finite() {
+            return None;
+        }
+        slab(ray.org, ray.dir, self.min, self.max)
+    }
+}
+
+impl Intersect for AaBox {
+    /// Exact: the box itself (its corners are f32 values).
+    fn bounds(&self) -> Aabb {
+        Aabb {
+            min: self.min,
+            max: self.max,
+        }
+    }
+
+    #[inline]
+    fn intersect(&self, ray: &Ray) -> Option<ShapeHit> {
+        let e = pick(ray, self.ends(ray)?)?;
+        let (u, v) = face_uv(ray.at(e.t), self.min, self.max, e.axis);
+        Some(ShapeHit {
+            t: e.t,
+            u,
+            v,
+            ng: axis_vec(e.axis, e.sign),
+        })
+    }
+
+    #[inline]
+    fn occluded(&self, ray: &Ray) -> bool {
+        self.ends(ray).and_then(|e| pick(ray, e)).is_some()
+    }
+
+    /// The hit point snapped onto the face plane (the axis of `ng`'s largest component)
+    /// and clamped into the face, a few ulps away from its edges. The point is then on
+    /// the box exactly; `err` is an ulp-level bound that also covers what a spawned ray's
+    /// slab test sees.
+    fn surface(&self, ray: &Ray, hit: &ShapeHit) -> SurfacePoint {
+        let i = hit.ng.abs().max_position();
+        let top = hit.ng[i] > 0.0;
+        let mut p = ray.at(hit.t);
+        p[i] = if top { self.max[i] } else { self.min[i] };
+        let err = p.abs() * gamma(2);
+        let m = EDGE_MARGIN * err.max_element() as f64;
+        for j in [(i + 1) % 3, (i + 2) % 3] {
+            p[j] = clamp_inside(p[j] as f64, self.min[j] as f64, self.max[j] as f64, m) as f32;
+        }
+        SurfacePoint {
+            p,
+            err: p.abs() * gamma(2),
+            ng: axis_vec(i, if top { 1.0 } else { -1.0 }),
+        }
+    }
+}
+
+impl Solid for AaBox {
+    fn spans(&self, ray: &Ray, out: &mut Spans) {
+        if let Some((a, b)) = self.ends(ray) {
+            out.push(Span {
+                t_in: a.t,
+                n_in: axis_vec(a.axis, a.sign),
+                t_out: b.t,
+                n_out: axis_vec(b.axis, b.sign),
+            });
+        }
+    }
+
+    fn contains(&self, p: Vec3) -> bool {
+        p.cmpge(self.min).all() && p.cmple(self.max).all()
+    }
+}
+
+/// An oriented box: centre, half extents along its own three axes, and the rotation
+/// taking the world axes to the box's (its axes are the columns of
+/// `Mat3::from_quat(rotation)`). A closed solid.
+///
+/// The rotation is a unit quaternion, normalised by the constructor; [`OBox::from_axes`]
+/// builds it from three orthonormal axes instead. `u`, `v` of a hit are face-local
+/// coordinates in `[0, 1]` as for [`AaBox`], in the box's frame.
+#[derive(Clone, Copy, Debug, PartialEq)]
+pub struct OBox {
+    center: Vec3,
+    half: Vec3,
+    /// The unit quaternion as `[x, y, z, w]`: a plain array keeps the type at 40 bytes
+    /// (a `Quat` is 16-byte aligned).
+    rotation: [f32; 4],
+}
+
+impl OBox {
+    /// The box with centre `center`, half extents `half_extents` (all positive) along the
+    /// box's axes, and orientation `rotation` (any nonzero length; normalised).
+    ///
+    /// # Errors
+    /// When a number is not finite, a half extent is not positive, or the quaternion is
+    /// zero.
+    pub fn new(center: Vec3, half_extents: Vec3, rotation: Quat) -> Result<Self, String> {
+        if !center.is_finite() {
+            return Err(format!("oriented box: centre {center} is not finite"));
+        }
+        if !half_extents.is_finite() || !half_extents.cmpgt(Vec3::ZERO).all() {
+            return Err(format!(
+                "oriented box: half extents {half_extents} must be positive and finite"
+            ));
+        }
+        if !rotation.is_finite() {
+            return Err(format!("oriented box: rotation {rotation} is not finite"));
+        }
+        let q = rotation.as_dquat();
+        let len = q.length();
+        if !(len.is_finite() && len > 0.0) {
+            return Err(format!("oriented box: rotation {rotation} is zero"));
+        }
+        let rotation = (q / len).as_quat();
+        let b = OBox {
+            center,
+            half: half_extents,
+            rotation: rotation.to_array(),
+        };
+        if !b.bounds().is_finite() {
+            return Err(format!(
+                "oriented box: centre {center} and half extents {half_extents} overflow"
+            ));
+        }
+        Ok(b)
+    }
+
+    /// The box whose axes are the three orthonormal vectors `axes` (to within 1e-4: they
+    /// are re-orthonormalised), with half extent `half_extents[i]` along `axes[i]`. A
+    /// left-handed triple describes the same box: its third axis is flipped.
+    ///
+    /// # Errors
+    /// As [`OBox::new`], and when the axes are not orthonormal.
+    pub fn from_axes(center: Vec3, half_extents: Vec3, axes: [Vec3; 3]) -> Result<Self, String> {
+        let a = axes.map(|v| v.as_dvec3());
+        if !a.iter().all(|v| v.is_finite()) {
+            return Err(format!("oriented box: axes {axes:?} are not finite"));
+        }
+        let ortho = (0..3)
+            .all(|i| (a[i].length() - 1.0).abs() < 1e-4 && a[i].dot(a[(i + 1) % 3]).abs() < 1e-4);
+        if !ortho {
+            return Err(format!("oriented box: axes {axes:?} are not orthonormal"));
+        }
+        // Gram–Schmidt in f64, then a right-handed third axis.
+        let x = a[0].normalize();
+        let y = (a[1] - x * x.dot(a[1])).normalize();
+        let z = x.cross(y);
+        let q = DQuat::from_mat3(&DMat3::from_cols(x, y, z));
+        OBox::new(center, half_extents, q.as_quat())
+    }
+
+    /// Centre.
+    pub fn center(&self) -> Vec3 {
+        self.center
+    }
+
+    /// Half extents along the box's axes.
+    pub fn half_extents(&self) -> Vec3 {
+        self.half
+    }
+
+    /// The unit rotation quaternion.
+    pub fn rotation(&self) -> Quat {
+        Quat::from_array(self.rotation)
+    }
+
+    /// The box's axes (the columns of the rotation matrix the intersector uses).
+    pub fn axes(&self) -> [Vec3; 3] {
+        let m = self.matrix();
+        [m.x_axis, m.y_axis, m.z_axis]
+    }
+
+    /// The rotation matrix (columns: the box's axes in world space).
+    #[inline]
+    fn matrix(&self) -> Mat3 {
+        Mat3::from_quat(Quat::from_array(self.rotation))
+    }
+
+    /// World vector `v` in the box's frame (`Rᵀ v`).
+    #[inline]
+    fn to_local(m: &Mat3, v: Vec3) -> Vec3 {
+        Vec3::new(m.x_axis.dot(v), m.y_axis.dot(v), m.z_axis.dot(v))
+    }
+
+    #[inline]
+    fn ends(&self, ray: &Ray) -> Option<(Mat3, End, End)> {
+        if !ray.org.is_finite() || !ray.dir.is_finite() {
+            return None;
+        }
+        let m = self.matrix();
+        let o = Self::to_local(&m, ray.org - self.center);
+        let d = Self::to_local(&m, ray.dir);
+        let (a, b) = slab(o, d, -self.half, self.half)?;
+        Some((m, a, b))
+    }
+}
+
+impl Intersect for OBox {
+    fn bounds(&self) -> Aabb {
+        let m = self.matrix();
+        // Half extent along world axis k: Σ_i |R_ki| h_i.
+        let ext = m.x_axis.abs() * self.half.x
+            + m.y_axis.abs() * self.half.y
+            + m.z_axis.abs() * self.half.z;
+        let ext = ext * (1.0 + gamma(4)) + self.center.abs() * gamma(2);
+        Aabb {
+            min: self.center - ext,
+            max: self.center + ext,
+        }
+    }
+
+    #[inline]
+    fn intersect(&self, ray: &Ray) -> Option<ShapeHit> {
+        let (m, a, b) = self.ends(ray)?;
+        let e = pick(ray, (a, b))?;
+        let local = Self::to_local(&m, ray.at(e.t) - self.center);
+        let (u, v) = face_uv(local, -self.half, self.half, e.axis);
+        Some(ShapeHit {
+            t: e.t,
+            u,
+            v,
+            ng: m.col(e.axis) * e.sign,
+        })
+    }
+
+    #[inline]
+    fn occluded(&self, ray: &Ray) -> bool {
+        self.ends(ray)
+            .and_then(|(_, a, b)| pick(ray, (a, b)))
+            .is_some()
+    }
+
+    /// In double precision: the hit point taken into the box's frame, snapped onto the
+    /// face of `ng` (the box axis closest to it) and clamped into the face away from its
+    /// edges, then back to world space. `err` bounds the final rounding and what a
+    /// spawned ray's f32 transform into the box's frame can see.
+    fn surface(&self, ray: &Ray, hit: &ShapeHit) -> SurfacePoint {
+        let m = self.matrix();
+        let md = m.as_dmat3();
+        let c = self.center.as_dvec3();
+        let nl = Self::to_local(&m, hit.ng);
+        let i = nl.abs().max_position();
+        let top = nl[i] > 0.0;
+        let h = self.half.as_dvec3();
+        let mut y = md.transpose() * (ray.at(hit.t).as_dvec3() - c);
+        y[i] = if top { h[i] } else { -h[i] };
+        let p = (c + md * y).as_vec3();
+        // What the intersector's `Rᵀ (o − c)` and the rotation's rounding can hide.
+        let e = gamma(8) as f64 * (y.abs().element_sum() + h.element_sum());
+        let err = Vec3::splat(e as f32) + p.abs() * gamma(2);
+        let margin = EDGE_MARGIN * err.max_element() as f64;
+        for j in [(i + 1) % 3, (i + 2) % 3] {
+            y[j] = clamp_inside(y[j], -h[j], h[j], margin);
+        }
+        let p = (c + md * y).as_vec3();
+        let sign = if top { 1.0 } else { -1.0 };
+        SurfacePoint {
+            p,
+            err: Vec3::splat(e as f32) + p.abs() * gamma(2),
+            ng: (md.col(i) * sign).normalize().as_vec3(),
+        }
+    }
+}
+
+impl Solid for OBox {
+    fn spans(&self, ray: &Ray, out: &mut Spans) {
+        if let Some((m, a, b)) = self.ends(ray) {
+            out.push(Span {
+                t_in: a.t,
+                n_in: m.col(a.axis) * a.sign,
+                t_out: b.t,
+                n_out: m.col(b.axis) * b.sign,
+            });
+        }
+    }
+
+    fn contains(&self, p: Vec3) -> bool {
+        let y = Self::to_local(&self.matrix(), p - self.center);
+        y.abs().cmple(self.half).all()
+    }
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+
+    #[test]
+    fn slab_handles_parallel_rays_and_origins_on_planes() {
+        let (lo, hi) = (Vec3::ZERO, Vec3::ONE);
+        // Parallel to x and y, inside both slabs: only z decides.
+        let (a, b) = slab(Vec3::new(0.5, 0.5, -1.0), Vec3::Z, lo, hi).unwrap();
+        assert_eq!(
+            (a.t, a.axis, a.sign, b.t, b.axis, b.sign),
+            (1.0, 2, -1.0, 2.0, 2, 1.0)
+        );
+        // Parallel, origin exactly on a slab plane: inside (closed slab), no NaN.
+        let (a, b) = slab(Vec3::new(0.0, 0.5, -1.0), Vec3::Z, lo, hi).unwrap();
+        assert_eq!((a.t, b.t), (1.0, 2.0));
+        // Parallel and outside: no stretch at all.
+        assert!(slab(Vec3::new(-0.1, 0.5, -1.0), Vec3::Z, lo, hi).is_none());
+        // A zero direction has no stretch either (no slab decides).
+        assert!(slab(Vec3::splat(0.5), Vec3::ZERO, lo, hi).is_none());
+        // Moving down an axis: enters through the upper plane (normal +e).
+        let (a, b) = slab(Vec3::new(0.5, 3.0, 0.5), -Vec3::Y * 2.0, lo, hi).unwrap();
+        assert_eq!((a.t, a.axis, a.sign, b.t, b.sign), (1.0, 1, 1.0, 1.5, -1.0));
+    }
+
+    #[test]
+    fn clamp_inside_keeps_a_margin_or_takes_the_middle() {
+        assert_eq!(clamp_inside(-1.0, 0.0, 1.0, 0.1), 0.1);
+        assert_eq!(clamp_inside(0.5, 0.0, 1.0, 0.1), 0.5);
+        assert_eq!(clamp_inside(2.0, 0.0, 1.0, 0.1), 0.9);
+        assert_eq!(clamp_inside(2.0, 0.0, 1.0, 0.6), 0.5);
+        assert!(clamp_inside(f64::NAN, 0.0, 1.0, 0.1).is_finite());
+    }
+}
