@@ -832,6 +832,88 @@ children = [
     assert_eq!(s.objects[0].count(Kind::Csg), 1);
 }
 
+const FLAT_PATCH: &str = r#"
+[[objects]]
+type = "bezier"
+patches = [[
+  [0, 0, 0], [1, 0, 0], [2, 0, 0], [3, 0, 0],
+  [0, 1, 0], [1, 1, 0], [2, 1, 0], [3, 1, 0],
+  [0, 2, 0], [1, 2, 0], [2, 2, 0], [3, 2, 0],
+  [0, 3, 0], [1, 3, 0], [2, 3, 0], [3, 3, 0],
+]]
+"#;
+
+#[test]
+fn bezier_patches_tessellate_in_final_coordinates() {
+    // A flat patch, rows along x stacked along y: front +z, two triangles.
+    let s = build(FLAT_PATCH);
+    assert_eq!(s.count(Kind::Triangle), 2);
+    for (i, t) in s.triangles.items.iter().enumerate() {
+        assert!(t.normal().z > 0.0);
+        let k = s.triangle_normals[i] as usize;
+        assert!(s.vertex_normals[k].iter().all(|n| close(*n, Vec3::Z)));
+    }
+    let area: f32 = s.triangles.items.iter().map(|t| t.area()).sum();
+    assert!((area - 9.0).abs() < 1e-4);
+    // Mirrored, it faces the other way, geometry and shading alike.
+    let s = build(&format!(
+        "{FLAT_PATCH}transform = [{{ scale = [1, 1, -1] }}, {{ translate = [0, 0, 2] }}]\n"
+    ));
+    for (i, t) in s.triangles.items.iter().enumerate() {
+        assert!(t.normal().z < 0.0 && t.p.iter().all(|p| p.z == 2.0));
+        let k = s.triangle_normals[i] as usize;
+        assert!(s.vertex_normals[k].iter().all(|n| close(*n, Vec3::NEG_Z)));
+    }
+
+    // The teapot: z up in its data; a finer tolerance gives more triangles.
+    let coarse = build("[[objects]]\ntype = \"bezier\"\nbuiltin = \"teapot\"\ntolerance = 0.05\n");
+    let fine = build("[[objects]]\ntype = \"bezier\"\nbuiltin = \"teapot\"\ntolerance = 0.005\n");
+    let default = build("[[objects]]\ntype = \"bezier\"\nbuiltin = \"teapot\"\n");
+    let n = |s: &Scene| s.count(Kind::Triangle);
+    assert!(
+        n(&coarse) > 100 && n(&fine) > n(&coarse),
+        "{} {}",
+        n(&coarse),
+        n(&fine)
+    );
+    assert!(n(&default) >= n(&coarse));
+    assert_eq!(coarse.vertex_normals.len(), n(&coarse));
+    let b = coarse.bounds();
+    assert!(b.max.z > 3.0 && b.min.z > -0.01 && b.min.z < 0.01, "{b:?}");
+    // Turned to y up and scaled: the tessellation is of the transformed patches.
+    let turned = build(
+        "[[objects]]\ntype = \"bezier\"\nbuiltin = \"teapot\"\ntolerance = 0.05\n\
+         transform = [{ rotate = [1, 0, 0], angle = -90 }, { scale = 0.5 }]\n",
+    );
+    let bt = turned.bounds();
+    assert!((bt.max.y - b.max.z * 0.5).abs() < 1e-3, "{bt:?} vs {b:?}");
+    assert!(
+        n(&turned) < n(&coarse),
+        "a smaller teapot needs fewer triangles for the same tolerance"
+    );
+
+    error_at(
+        "[[objects]]\ntype = \"bezier\"\nbuiltin = \"teapots\" # HERE\n",
+        &["unknown built-in", "did you mean `teapot`"],
+    );
+    error_at(
+        "[[objects]]\ntype = \"bezier\"\npatches = [\n  [[0, 0, 0], [1, 0, 0]], # HERE\n]\n",
+        &["invalid length 2", "16"],
+    );
+    error_at(
+        "[[objects]]\ntype = \"bezier\"\nbuiltin = \"teapot\"\ntolerance = 0 # HERE\n",
+        &["must be positive"],
+    );
+    error_at(
+        "[[objects]] # HERE\ntype = \"bezier\"\n",
+        &["missing key `patches`"],
+    );
+    error_at(
+        "[[objects]]\ntype = \"union\"\nchildren = [\n  { type = \"sphere\", center = [0, 0, 0], radius = 1 },\n  { type = \"bezier\", builtin = \"teapot\" }, # HERE\n]\n",
+        &["a bezier is not a closed solid"],
+    );
+}
+
 fn temp_dir() -> tempfile::TempDir {
     tempfile::tempdir().unwrap()
 }
@@ -968,14 +1050,22 @@ material = "mine"
     // Inside the define the OBJ keeps its own material (an instance's material only
     // fills primitives that have none).
     let obj = &s.objects[s.instances[0].object as usize];
-    assert_eq!(s.materials[obj.triangles.material[0] as usize].color, Vec3::Z);
+    assert_eq!(
+        s.materials[obj.triangles.material[0] as usize].color,
+        Vec3::Z
+    );
 
     // `lights` makes no sense for OBJ; errors inside the OBJ name it.
-    let body = "[[objects]]\ntype = \"include\"\nfile = \"models/quad.obj\"\nlights = true # HERE\n";
+    let body =
+        "[[objects]]\ntype = \"include\"\nfile = \"models/quad.obj\"\nlights = true # HERE\n";
     let bad = write(dir.path(), "bad.toml", &format!("{CAMERA}{body}"));
     let e = scene_toml::load(&bad).unwrap_err();
     assert_eq!(e.line, marked_line(&format!("{CAMERA}{body}")), "{e}");
-    write(dir.path(), "broken.obj", "v 0 0 0\nv 1 0 0\nv 0 1 nan\nf 1 2 3\n");
+    write(
+        dir.path(),
+        "broken.obj",
+        "v 0 0 0\nv 1 0 0\nv 0 1 nan\nf 1 2 3\n",
+    );
     let body = "[[objects]]\ntype = \"include\"\nfile = \"broken.obj\" # HERE\n";
     let bad = write(dir.path(), "bad2.toml", &format!("{CAMERA}{body}"));
     let e = scene_toml::load(&bad).unwrap_err();
@@ -985,7 +1075,11 @@ material = "mine"
     let body = "[[objects]]\ntype = \"include\"\nfile = \"gone.obj\" # HERE\n";
     let bad = write(dir.path(), "bad3.toml", &format!("{CAMERA}{body}"));
     let e = scene_toml::load(&bad).unwrap_err();
-    assert_eq!((e.path.clone(), e.line), (bad, marked_line(&format!("{CAMERA}{body}"))), "{e}");
+    assert_eq!(
+        (e.path.clone(), e.line),
+        (bad, marked_line(&format!("{CAMERA}{body}"))),
+        "{e}"
+    );
     assert!(e.message.contains("gone.obj"), "{e}");
 }
 

@@ -20,6 +20,7 @@ use super::format::{
     TransformStep, V3,
 };
 use super::{suggest, SceneSettings, Source, MAX_SIDE};
+use crate::geometry::bezier::{teapot_patches, tessellate, BezierPatch};
 use crate::geometry::polygon::Triangulator;
 use crate::geometry::{Cone, Csg, CsgOp, CsgTree, Shape, Sphere, Triangle};
 use crate::load::{nff, obj, LoadError};
@@ -48,6 +49,9 @@ const DEFAULT_RESOLUTION: [u32; 2] = [640, 480];
 const DEFAULT_FOV: f64 = 45.0;
 /// Phong exponent when a material gives none.
 const DEFAULT_SHININESS: f64 = 32.0;
+/// A bezier's default tessellation tolerance, relative to the diagonal of its control
+/// points' bounding box.
+const BEZIER_RELATIVE_TOLERANCE: f64 = 1e-3;
 /// Spot cutoff half-angle when a light gives none.
 const DEFAULT_CUTOFF: f64 = 45.0;
 
@@ -59,6 +63,7 @@ enum Ty {
     Triangle,
     Polygon,
     Mesh,
+    Bezier,
     Include,
     Group,
     Instance,
@@ -78,6 +83,7 @@ const TYPES: &[(&str, Ty, &[&str])] = &[
     ("triangle", Ty::Triangle, &["vertices", "normals"]),
     ("polygon", Ty::Polygon, &["vertices", "normals"]),
     ("mesh", Ty::Mesh, &["vertices", "faces", "normals"]),
+    ("bezier", Ty::Bezier, &["patches", "builtin", "tolerance"]),
     ("include", Ty::Include, &["file", "lights"]),
     ("group", Ty::Group, &["children"]),
     ("instance", Ty::Instance, &["of"]),
@@ -888,6 +894,13 @@ impl<'a, 's> Builder<'a, 's> {
                 };
                 self.polygons(node, ty, &x, m, sink)
             }
+            Ty::Bezier => {
+                let m = match inherited {
+                    Some(m) => m,
+                    None => self.fallback_material(sink),
+                };
+                self.bezier(node, &x, m, sink)
+            }
             Ty::Sphere | Ty::Cone => {
                 let m = match inherited {
                     Some(m) => m,
@@ -1186,7 +1199,7 @@ impl<'a, 's> Builder<'a, 's> {
                 "a group is not a solid and cannot be a CSG operand (combine solids with \
                  `union`)",
             )),
-            Ty::Triangle | Ty::Polygon | Ty::Mesh | Ty::Include => Err(self.err(
+            Ty::Triangle | Ty::Polygon | Ty::Mesh | Ty::Bezier | Ty::Include => Err(self.err(
                 o.ty.span(),
                 format!(
                     "{} is not a closed solid and cannot be a CSG operand",
@@ -1355,6 +1368,85 @@ impl<'a, 's> Builder<'a, 's> {
                 g.add_triangle(tri, material);
             }
         }
+    }
+
+    /// `bezier`: bicubic patches, transformed (a Bézier patch's control points
+    /// transform with it) and then tessellated, so the tolerance is in final units.
+    fn bezier(
+        &mut self,
+        node: &Spanned<ObjectDef>,
+        x: &DAffine3,
+        material: u32,
+        sink: &mut Sink,
+    ) -> R<()> {
+        let o = node.get_ref();
+        let mut patches = match (&o.patches, &o.builtin) {
+            (Some(p), None) => p
+                .get_ref()
+                .iter()
+                .map(|q| {
+                    let q = q.get_ref();
+                    // Row by row: point 4·j + i is p[i][j], i along u.
+                    BezierPatch::new(std::array::from_fn(|i| {
+                        std::array::from_fn(|j| v3(&q[4 * j + i]))
+                    }))
+                })
+                .collect::<Vec<_>>(),
+            (None, Some(b)) => match b.get_ref().as_str() {
+                "teapot" => teapot_patches(),
+                other => {
+                    return Err(self.err(
+                        b.span(),
+                        format!(
+                            "unknown built-in patch set `{other}`{}; built-ins: teapot",
+                            did_you_mean(other, ["teapot"])
+                        ),
+                    ))
+                }
+            },
+            (Some(_), Some(b)) => {
+                return Err(self.err(b.span(), "a bezier takes `patches` or `builtin`, not both"))
+            }
+            (None, None) => {
+                return Err(self.err(
+                    node.span(),
+                    "missing key `patches` (or `builtin`) for a bezier",
+                ))
+            }
+        };
+        let mirror = x.matrix3.determinant() < 0.0;
+        for p in &mut patches {
+            let mut q = *p;
+            for row in &mut q.p {
+                for c in row.iter_mut() {
+                    *c = x.transform_point3(*c);
+                }
+            }
+            // A mirror turns the patch inside out; swapping u and v turns it back.
+            *p = if mirror { q.transposed() } else { q };
+        }
+        let tolerance = match &o.tolerance {
+            Some(t) => self.positive(t, "bezier `tolerance`")?,
+            None => {
+                let (lo, hi) = patches.iter().flat_map(|p| p.p.iter().flatten()).fold(
+                    (DVec3::splat(f64::INFINITY), DVec3::splat(f64::NEG_INFINITY)),
+                    |(lo, hi), &c| (lo.min(c), hi.max(c)),
+                );
+                let size = (hi - lo).length();
+                if size > 0.0 {
+                    size * BEZIER_RELATIVE_TOLERANCE
+                } else {
+                    1.0
+                }
+            }
+        };
+        let mesh = tessellate(&patches, tolerance);
+        let g = Self::geometry(&mut self.geometry, sink);
+        for (i, tri) in mesh.triangles.iter().enumerate() {
+            let n = tri.map(|k| mesh.normals[k as usize]);
+            g.add_smooth_triangle(mesh.triangle(i), n, material);
+        }
+        Ok(())
     }
 
     // ---- includes ------------------------------------------------------------------------
