@@ -914,6 +914,66 @@ fn bezier_patches_tessellate_in_final_coordinates() {
     );
 }
 
+#[test]
+fn the_nff_equivalent_builds_the_same_scene() {
+    let nff = "\
+v from 1 2 10 at 0 0 0 up 0 1 0 angle 40 hither 0.5 resolution 64 48
+b 0.1 0.2 0.3
+l 5 5 5 1 0.5 0.5
+f 1 0 0 0.7 0.3 12 0.2 1.4
+s 0 1 0 0.5
+c 0 0 0 1 0 2 0 0.25
+pp 3
+0 0 0 0 0 1
+1 0 0 0 0 1
+0 1 0 0 0 1
+";
+    let toml = r#"
+[camera]
+from = [1, 2, 10]
+at = [0, 0, 0]
+up = [0, 1, 0]
+fov = 40
+hither = 0.5
+resolution = [64, 48]
+
+[render]
+background = [0.1, 0.2, 0.3]
+ambient = [0.5, 0.5, 0.5]
+
+[materials.f]
+color = [1, 0, 0]
+diffuse = 0.7
+specular = 0.3
+reflectance = 0.3
+shininess = 12
+transmittance = 0.2
+ior = 1.4
+
+[[lights]]
+position = [5, 5, 5]
+color = [1, 0.5, 0.5]
+
+[[objects]]
+type = "group"
+material = "f"
+children = [
+  { type = "sphere", center = [0, 1, 0], radius = 0.5 },
+  { type = "cone", base = [0, 0, 0], base_radius = 1, apex = [0, 2, 0], apex_radius = 0.25 },
+  { type = "polygon", vertices = [[0, 0, 0], [1, 0, 0], [0, 1, 0]], normals = [[0, 0, 1], [0, 0, 1], [0, 0, 1]] },
+]
+"#;
+    let a = emray::load::nff::parse_str(nff, Path::new("a.nff")).unwrap();
+    let b = parse(toml).unwrap();
+    assert_eq!(a.camera, b.camera);
+    assert_eq!(a.background, b.background);
+    assert_eq!(a.ambient, b.ambient);
+    assert_eq!(a.lights, b.lights);
+    assert_eq!(a.materials, b.materials);
+    assert_eq!(a.geometry, b.geometry);
+    assert_eq!(a.load_stats, b.load_stats);
+}
+
 fn temp_dir() -> tempfile::TempDir {
     tempfile::tempdir().unwrap()
 }
