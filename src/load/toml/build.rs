@@ -668,7 +668,7 @@ impl<'a, 's> Builder<'a, 's> {
             let hint = if self.material_names.is_empty() {
                 " (the file defines no `[materials.NAME]`)".to_string()
             } else {
-                did_you_mean(n, self.material_names.keys().copied())
+                did_you_mean(n, self.file.materials.keys().map(String::as_str))
             };
             self.err(name.span(), format!("unknown material `{n}`{hint}"))
         })
