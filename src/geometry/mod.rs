@@ -7,13 +7,19 @@
 //! tests to bound the f32 error.
 
 mod cone;
+mod plane;
 pub mod polygon;
+mod quadric;
 pub mod reference;
 mod sphere;
+mod torus;
 mod triangle;
 
 pub use cone::Cone;
+pub use plane::Plane;
+pub use quadric::Quadric;
 pub use sphere::Sphere;
+pub use torus::Torus;
 pub use triangle::{Triangle, WatertightRay};
 
 use crate::math::{Aabb, Ray, Vec3};
