@@ -278,6 +278,10 @@ pub struct Quadric {
     m_abs: DMat3,
     /// Frobenius norm of `m`, bounding its eigenvalues.
     m_norm: f64,
+    /// Largest positive eigenvalue of `m` (0 if none).
+    lam_pos: f64,
+    /// Largest magnitude of a negative eigenvalue of `m` (0 if none).
+    lam_neg: f64,
     /// The local origin in world coordinates.
     origin: DVec3,
     /// The point, in local coordinates, rays are re-based to.
@@ -341,7 +345,7 @@ impl Quadric {
         check_positive("cylinder radius", radius)?;
         let w = unit_axis("cylinder axis", axis)?;
         let r = radius as f64;
-        Self::about(point, axial(w, 1.0, -1.0, 0.0, -r * r), None)
+        Self::about(point, axial(w, 1.0, 0.0, 0.0, -r * r), None)
     }
 
     /// The infinite double cone with its apex at `apex`, around `axis`, whose radius
@@ -350,7 +354,7 @@ impl Quadric {
         check_positive("cone slope", slope)?;
         let w = unit_axis("cone axis", axis)?;
         let k = slope as f64;
-        Self::about(apex, axial(w, 1.0, -1.0 - k * k, 0.0, 0.0), None)
+        Self::about(apex, axial(w, 1.0, -k * k, 0.0, 0.0), None)
     }
 
     /// The paraboloid of revolution with its vertex at `vertex`, opening along `axis`,
@@ -358,7 +362,7 @@ impl Quadric {
     pub fn paraboloid(vertex: Vec3, axis: Vec3, focal: f32) -> Result<Self, String> {
         check_positive("paraboloid focal length", focal)?;
         let w = unit_axis("paraboloid axis", axis)?;
-        Self::about(vertex, axial(w, 1.0, -1.0, -2.0 * focal as f64, 0.0), None)
+        Self::about(vertex, axial(w, 1.0, 0.0, -2.0 * focal as f64, 0.0), None)
     }
 
     /// The hyperboloid of one sheet around `axis` through `center`:
@@ -374,7 +378,7 @@ impl Quadric {
         check_positive("hyperboloid slope", slope)?;
         let w = unit_axis("hyperboloid axis", axis)?;
         let (r, k) = (waist as f64, slope as f64);
-        Self::about(center, axial(w, 1.0, -1.0 - k * k, 0.0, -r * r), None)
+        Self::about(center, axial(w, 1.0, -k * k, 0.0, -r * r), None)
     }
 
     /// The hyperboloid of two sheets around `axis` through `center`, with its vertices at
@@ -390,11 +394,7 @@ impl Quadric {
         check_positive("hyperboloid slope", slope)?;
         let w = unit_axis("hyperboloid axis", axis)?;
         let (a, k) = (vertex as f64, slope as f64);
-        Self::about(
-            center,
-            axial(w, 1.0, -1.0 - k * k, 0.0, k * k * a * a),
-            None,
-        )
+        Self::about(center, axial(w, 1.0, -k * k, 0.0, k * k * a * a), None)
     }
 
     /// The same quadric clipped by `clip` (replacing any previous clip box).
@@ -524,17 +524,24 @@ impl Quadric {
         let mut bounded = false;
         let lam_min = lam.iter().fold(f64::INFINITY, |a, &x| a.min(x));
         if lam_min > tol {
-            // The tangent planes x_k = const satisfy πᵀ adj(Q) π = 0 (the dual quadric);
-            // with M⁻¹ = adj(M)/det M they are centre_k ± √(−F(centre)·(M⁻¹)_kk).
-            let inv = m.inverse();
-            let c = -(inv * l);
+            // The tangent planes x_k = const satisfy πᵀ adj(Q) π = 0 (the dual quadric),
+            // which for F = (p − c)ᵀM(p − c) + k reduces to c_k ± √(−k·(M⁻¹)_kk). The
+            // diagonal of M⁻¹ = Σᵢ vᵢvᵢᵀ/λᵢ is a sum of positive terms, so it is formed
+            // from the eigen-decomposition instead of the adjugate: no cancellation, and
+            // an axis-aligned ellipsoid gets its exact box.
+            let mut diag = DVec3::ZERO;
+            let mut c = DVec3::ZERO;
+            for i in 0..3 {
+                diag += vecs[i] * vecs[i] / lam[i];
+                c -= vecs[i] * (vecs[i].dot(l) / lam[i]);
+            }
             let k = j + l.dot(c);
-            if k < 0.0 && inv.is_finite() {
-                let diag = DVec3::new(inv.x_axis.x, inv.y_axis.y, inv.z_axis.z);
-                let half = (diag * -k).max(DVec3::ZERO);
+            if k < 0.0 && diag.is_finite() {
+                let half = diag * -k;
                 let half = DVec3::new(half.x.sqrt(), half.y.sqrt(), half.z.sqrt());
-                // Relative error of the f64 inverse grows with the condition number.
-                let rel = 1e-14 * (lam_max / lam_min);
+                // The eigenvalues' relative error (Jacobi on a definite matrix) is a
+                // small multiple of ε, degrading at worst with the condition number.
+                let rel = 1e-13 + 4.0 * f64::EPSILON * (lam_max / lam_min);
                 let slack = (half + c.abs() + origin.abs()) * rel;
                 let centre_w = origin + c;
                 bounds = aabb_out(centre_w - half - slack, centre_w + half + slack);
@@ -558,12 +565,16 @@ impl Quadric {
         let m_norm =
             (m.x_axis.length_squared() + m.y_axis.length_squared() + m.z_axis.length_squared())
                 .sqrt();
+        let lam_pos = lam.iter().fold(0.0f64, |a, &x| a.max(x));
+        let lam_neg = lam.iter().fold(0.0f64, |a, &x| a.max(-x));
         Ok(Quadric {
             m,
             l,
             j,
             m_abs,
             m_norm,
+            lam_pos,
+            lam_neg,
             origin,
             rebase,
             clip,
@@ -712,7 +723,14 @@ impl Quadric {
     /// The hit point projected onto the surface in f64 (along the gradient line, where
     /// `F` is an exact quadratic), rounded to f32, with the bound of that rounding plus
     /// the f64 point's proven distance from the surface.
+    ///
+    /// For a clipped quadric's span end on a box face (normal `±x`, `±y` or `±z`, as
+    /// [`Quadric::spans`] reports them, and the point within the rounding of `t` of that
+    /// face) the point is put on the face exactly instead.
     pub fn surface(&self, ray: &Ray, hit: &ShapeHit) -> SurfacePoint {
+        if let Some(sp) = self.cap_point(ray, hit.t, hit.ng) {
+            return sp;
+        }
         let d = ray.dir.as_dvec3();
         let mut p = ray.org.as_dvec3() - self.origin + d * hit.t as f64;
         let p0 = p;
@@ -743,18 +761,31 @@ impl Quadric {
         if !p.is_finite() {
             p = p0;
         }
-        // A surface point lies within 2φ/|∇F| of p along the gradient when
-        // |∇F|² ≥ 8λφ (λ ≥ |eigenvalues|, φ ≥ |F(p)|): F changes sign on that segment.
-        let phi = self.f_local(p).abs() + self.f_err(p);
+        // Proven distance from p to the surface, with φ ≥ |F(p)| (rounding included):
+        // * 2φ/|∇F| along the gradient when |∇F|² ≥ 8λφ (λ ≥ |eigenvalues|): the
+        //   exact quadratic F(p + s·u) = F + s∇F·u + s²uᵀMu changes sign on that segment;
+        // * √(φ/|μ|) along an eigenvector whose eigenvalue μ has the opposite sign to F
+        //   (the bound that survives at a cone's apex, where ∇F vanishes).
+        let f = self.f_local(p);
+        let phi = f.abs() + self.f_err(p);
         let grad = 2.0 * self.half_grad(p).length();
         let lam = 2.0 * self.m_norm;
-        let delta = if grad * grad >= 8.0 * lam * phi {
+        let along_grad = if grad * grad >= 8.0 * lam * phi {
             2.0 * phi / grad
         } else {
-            // Near a singular point (a cone's apex): the quadratic growth bound.
-            2.0 * (phi / lam.max(f64::MIN_POSITIVE)).sqrt()
-                + d.length() * (hit.t as f64).abs() * 1e-6
+            f64::INFINITY
         };
+        let mu = if f > 0.0 { self.lam_neg } else { self.lam_pos };
+        let along_eigen = if mu > 0.0 {
+            (phi / (0.99 * mu)).sqrt()
+        } else {
+            f64::INFINITY
+        };
+        let mut delta = along_grad.min(along_eigen);
+        if !delta.is_finite() {
+            // Not near the surface at all (a t this quadric never reported).
+            delta = 1e-6 * (d.length() * (hit.t as f64).abs() + p.length());
+        }
         let pw = self.origin + p;
         let delta = delta + gamma64(4) * (pw.abs().max_element() + p.abs().max_element());
         let p32 = pw.as_vec3();
@@ -767,6 +798,37 @@ impl Quadric {
             err: rounding_err(p32, delta),
             ng,
         }
+    }
+
+    /// The surface point for a span end on a face of the clip box: `ng` is that face's
+    /// normal (exactly `±x`, `±y` or `±z`, as [`Quadric::spans`] reports it) and the
+    /// point `o + t·d` is within the rounding of `t` of the face's plane.
+    fn cap_point(&self, ray: &Ray, t: f32, ng: Vec3) -> Option<SurfacePoint> {
+        let b = self.clip?;
+        let axis = (0..3).find(|&i| ng[i].abs() == 1.0)?;
+        if ng.length_squared() != 1.0 {
+            return None;
+        }
+        let face = if ng[axis] > 0.0 {
+            b.max[axis]
+        } else {
+            b.min[axis]
+        };
+        let pw = ray.org.as_dvec3() + ray.dir.as_dvec3() * t as f64;
+        let slack = (t.abs() * f32::EPSILON) as f64 * (ray.dir[axis] as f64).abs()
+            + gamma64(4) * (pw.abs().max_element() + ray.org.abs().max_element() as f64);
+        if !pw.is_finite() || (pw[axis] - face as f64).abs() > slack {
+            return None;
+        }
+        // On the face's plane exactly (its coordinate is an f32); the other coordinates
+        // are rounded once, and along the face that is all the error there is.
+        let mut p32 = pw.as_vec3();
+        p32[axis] = face;
+        Some(SurfacePoint {
+            p: p32,
+            err: rounding_err(p32, gamma64(4) * pw.abs().max_element()),
+            ng,
+        })
     }
 
     /// The solid's spans along the whole line of `ray`.

@@ -311,34 +311,45 @@ impl Torus {
         self.first(ray).is_some()
     }
 
-    /// The hit point projected onto the torus in f64 (nearest point of the tube circle
-    /// through it, then out to the tube's radius), rounded to f32, with the bound of that
-    /// rounding plus the f64 error.
+    /// The hit point projected onto the torus in f64 (the nearest point of the tube's
+    /// circle in the point's meridian plane, or for a spindle torus whose projection
+    /// would cross the axis the cusp where the surface meets it), rounded to f32, with
+    /// the bound of that rounding plus the f64 error.
     pub fn surface(&self, ray: &Ray, hit: &ShapeHit) -> SurfacePoint {
         let p0 = ray.org.as_dvec3() + ray.dir.as_dvec3() * hit.t as f64;
+        let p0 = if p0.is_finite() { p0 } else { self.center };
         let q = self.local(p0 - self.center);
+        let (rr, r) = (self.major, self.minor);
         let rho = q.x.hypot(q.y);
-        let core = DVec3::new(q.x, q.y, 0.0) * (self.major / rho);
-        let off = q - core;
-        let dist = off.length();
-        let scale = self.center.abs().max_element() + self.major + self.minor;
-        let (p, delta, ng) = if rho > 0.0 && dist > 0.0 && p0.is_finite() {
-            let pl = core + off * (self.minor / dist);
-            let p = self.center + self.world(pl);
-            let n = unit_f32(self.world(off)).unwrap_or(Vec3::Z);
-            (p, gamma64(16) * (scale + p.abs().max_element()), n)
+        // The meridian half-plane through q (any one on the axis).
+        let radial = if rho > 0.0 {
+            DVec3::new(q.x / rho, q.y / rho, 0.0)
         } else {
-            // On the axis of a spindle torus (or a non-finite point): keep the ray's
-            // point with a bound of a few ulps of the ray parameter.
-            let p = if p0.is_finite() { p0 } else { self.center };
-            let err = 1e-6 * (ray.dir.length() as f64 * (hit.t as f64).abs() + scale);
-            let n = hit
-                .ng
-                .try_normalize()
-                .or_else(|| (-ray.dir).try_normalize())
-                .unwrap_or(Vec3::Z);
-            (p, err, n)
+            DVec3::X
         };
+        // Meridian coordinates relative to the tube's centre circle.
+        let (a, z) = (rho - rr, q.z);
+        let dist = a.hypot(z);
+        let (pa, pz, na, nz) = if dist > 0.0 {
+            let (na, nz) = (a / dist, z / dist);
+            if rr + r * na >= 0.0 {
+                (r * na, r * nz, na, nz)
+            } else {
+                // A spindle torus's tube circle crosses the axis: its end is the cusp,
+                // where the outside is the dimple along the axis.
+                let zc = (r * r - rr * rr).max(0.0).sqrt().copysign(z);
+                (-rr, zc, 0.0, 1.0f64.copysign(z))
+            }
+        } else {
+            (r, 0.0, 1.0, 0.0)
+        };
+        let local = radial * (rr + pa) + DVec3::new(0.0, 0.0, pz);
+        let p = self.center + self.world(local);
+        let scale = self.center.abs().max_element() + rr + r;
+        let delta = gamma64(16) * (scale + p.abs().max_element());
+        let ng = unit_f32(self.world(radial * na + DVec3::new(0.0, 0.0, nz)))
+            .or_else(|| hit.ng.try_normalize())
+            .unwrap_or(Vec3::Z);
         let p32 = p.as_vec3();
         SurfacePoint {
             p: p32,

@@ -3,8 +3,8 @@
 //! With `Q` the symmetric 4×4 matrix of the coefficients `[a, b, c, d, e, f, g, h, i, j]`
 //! (see [`crate::geometry::Quadric`]), `P = (o, 1)` and `D = (d, 0)`, the line meets
 //! `F = 0` where `(DᵀQD) t² + 2 (DᵀQP) t + PᵀQP = 0`. No re-basing, no local origin, no
-//! root labelling: the roots are `(−b ± √(b² − ac)) / a`, and inside/outside comes from
-//! evaluating `F` between them.
+//! root labelling: the roots are `(−b ± √(b² − ac)) / a`, polished by Newton steps on
+//! `F(o + t·d)`, and inside/outside comes from evaluating `F` between them.
 
 use crate::math::{DRay, DVec3};
 
@@ -64,6 +64,22 @@ pub fn quadric_roots(ray: &DRay, c: &[f64; 10]) -> Vec<f64> {
             let s = disc.sqrt();
             roots.push((-b - s) / a);
             roots.push((-b + s) / a);
+        }
+    }
+    // Newton steps on F evaluated at the point o + t·d (small coordinates near the
+    // surface, unlike a·t² + 2b·t + c for a far origin) repair the textbook formula's
+    // cancellation, keeping a step only when it reduces |F|.
+    let at = |t: f64| quadric_value(c, ray.org + ray.dir * t);
+    for t in &mut roots {
+        for _ in 0..4 {
+            let slope = quadric_gradient(c, ray.org + ray.dir * *t).dot(ray.dir);
+            let step = at(*t) / slope;
+            let next = *t - step;
+            if step.is_finite() && at(next).abs() < at(*t).abs() {
+                *t = next;
+            } else {
+                break;
+            }
         }
     }
     roots.sort_by(f64::total_cmp);

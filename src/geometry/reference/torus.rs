@@ -37,8 +37,9 @@ pub fn torus_gradient(center: DVec3, axis: DVec3, major: f64, p: DVec3) -> DVec3
 /// alternate, starting with an entry).
 pub fn torus_crossings(ray: &DRay, center: DVec3, axis: DVec3, major: f64, minor: f64) -> Vec<f64> {
     let g = |t: f64| torus_value(center, axis, major, minor, ray.org + ray.dir * t);
-    // The stretch of the line inside a slightly larger bounding sphere.
-    let big = (major + minor) * (1.0 + 1e-6);
+    // The stretch of the line inside a larger bounding sphere (larger by far more than
+    // the f64 error of this direct quadratic for origins far away).
+    let big = (major + minor) * 1.01;
     let f = ray.org - center;
     let a = ray.dir.dot(ray.dir);
     let b = f.dot(ray.dir);
