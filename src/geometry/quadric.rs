@@ -205,8 +205,8 @@ fn eigen_sym3(m: DMat3) -> ([f64; 3], [DVec3; 3]) {
                 row[p] = c * x - s * y;
                 row[q] = s * x + c * y;
             }
-            for k in 0..3 {
-                let (x, y) = (a[p][k], a[q][k]);
+            let (row_p, row_q) = (a[p], a[q]);
+            for (k, (&x, &y)) in row_p.iter().zip(&row_q).enumerate() {
                 a[p][k] = c * x - s * y;
                 a[q][k] = s * x + c * y;
             }
@@ -282,6 +282,10 @@ pub struct Quadric {
     lam_pos: f64,
     /// Largest magnitude of a negative eigenvalue of `m` (0 if none).
     lam_neg: f64,
+    /// Unit eigenvector of `lam_pos`.
+    v_pos: DVec3,
+    /// Unit eigenvector of `-lam_neg`.
+    v_neg: DVec3,
     /// The local origin in world coordinates.
     origin: DVec3,
     /// The point, in local coordinates, rays are re-based to.
@@ -565,8 +569,16 @@ impl Quadric {
         let m_norm =
             (m.x_axis.length_squared() + m.y_axis.length_squared() + m.z_axis.length_squared())
                 .sqrt();
-        let lam_pos = lam.iter().fold(0.0f64, |a, &x| a.max(x));
-        let lam_neg = lam.iter().fold(0.0f64, |a, &x| a.max(-x));
+        let (mut lam_pos, mut lam_neg) = (0.0f64, 0.0f64);
+        let (mut v_pos, mut v_neg) = (DVec3::ZERO, DVec3::ZERO);
+        for k in 0..3 {
+            if lam[k] > lam_pos {
+                (lam_pos, v_pos) = (lam[k], vecs[k]);
+            }
+            if -lam[k] > lam_neg {
+                (lam_neg, v_neg) = (-lam[k], vecs[k]);
+            }
+        }
         Ok(Quadric {
             m,
             l,
@@ -575,6 +587,8 @@ impl Quadric {
             m_norm,
             lam_pos,
             lam_neg,
+            v_pos,
+            v_neg,
             origin,
             rebase,
             clip,
@@ -655,7 +669,7 @@ impl Quadric {
         let ac = a * c;
         let disc = b.mul_add(b, -ac) + (-a).mul_add(c, ac);
         out.inside_start = a < 0.0;
-        if !(disc >= 0.0) || !disc.is_finite() {
+        if !disc.is_finite() || disc < 0.0 {
             return Some(out);
         }
         let qq = -(b + disc.sqrt().copysign(b));
@@ -720,9 +734,10 @@ impl Quadric {
         self.first(ray).is_some()
     }
 
-    /// The hit point projected onto the surface in f64 (along the gradient line, where
-    /// `F` is an exact quadratic), rounded to f32, with the bound of that rounding plus
-    /// the f64 point's proven distance from the surface.
+    /// The hit point put back onto the surface in f64 (re-solved along the ray within
+    /// the rounding of `t`, then projected along the gradient line, where `F` is an
+    /// exact quadratic), rounded to f32, with the bound of that rounding plus the f64
+    /// point's proven distance from the surface.
     ///
     /// For a clipped quadric's span end on a box face (normal `±x`, `±y` or `±z`, as
     /// [`Quadric::spans`] reports them, and the point within the rounding of `t` of that
@@ -734,26 +749,62 @@ impl Quadric {
         let d = ray.dir.as_dvec3();
         let mut p = ray.org.as_dvec3() - self.origin + d * hit.t as f64;
         let p0 = p;
-        for _ in 0..3 {
+        // First back onto the ray's own crossing: the root of F(p + s·d̂) nearest 0, if
+        // it is within the rounding of t (then it is the f64 root intersect() found).
+        let dl = d.length();
+        if dl > 0.0 {
+            let u = d / dl;
+            let (a, b, c) = (u.dot(self.m * u), self.half_grad(p).dot(u), self.f_local(p));
+            let disc = b * b - a * c;
+            let s = if a == 0.0 || disc >= 0.0 {
+                let qq = -(b + disc.max(0.0).sqrt().copysign(b));
+                c / qq
+            } else {
+                f64::NAN
+            };
+            let t_ulp = (hit.t.abs() * f32::EPSILON) as f64 * dl;
+            if s.abs() <= 4.0 * t_ulp {
+                p += u * s;
+            }
+        }
+        // Then along the normal (usually nothing is left to do): one step, more only when
+        // t was far off (a ray from millions of sizes away, whose f32 t is coarse) and the
+        // gradient turns along the way. more only when t was far off (a ray from millions of sizes
+        // away, whose f32 t is coarse) and the gradient turns along the way.
+        for _ in 0..16 {
             let g = self.half_grad(p);
-            let gl = g.length();
             let f = self.f_local(p);
-            if !(gl > 0.0 && gl.is_finite() && f.is_finite()) || f == 0.0 {
+            if f == 0.0 || !f.is_finite() || !g.is_finite() {
                 break;
             }
-            // F(p + s·ĝ) = f + 2|g|·s + κ·s², κ = ĝᵀMĝ: take its root nearest 0.
+            // Along a unit direction u, F(p + s·u) = f + 2(g·u)·s + (uᵀMu)·s² exactly:
+            // step to its root nearest 0. The gradient's direction first; where that line
+            // misses the surface (near a cone's apex), an eigenvector whose eigenvalue has
+            // the sign opposite to f, along which a root always exists.
+            let gl = g.length();
             let gh = g / gl;
             let kappa = gh.dot(self.m * gh);
             let disc = gl * gl - kappa * f;
-            if !(disc >= 0.0) {
+            let (u, b, a, disc) = if gl > 0.0 && disc >= 0.0 {
+                (gh, gl, kappa, disc)
+            } else {
+                let (u, mu) = if f > 0.0 {
+                    (self.v_neg, -self.lam_neg)
+                } else {
+                    (self.v_pos, self.lam_pos)
+                };
+                let b = g.dot(u);
+                (u, b, mu, b * b - mu * f)
+            };
+            if disc.is_nan() || disc < 0.0 || (a == 0.0 && b == 0.0) {
                 break;
             }
-            let qq = -(gl + disc.sqrt());
+            let qq = -(b + disc.sqrt().copysign(b));
             let s = f / qq;
             if !s.is_finite() {
                 break;
             }
-            p += gh * s;
+            p += u * s;
             if s.abs() <= 1e-17 * p.abs().max_element() {
                 break;
             }

@@ -311,15 +311,47 @@ impl Torus {
         self.first(ray).is_some()
     }
 
-    /// The hit point projected onto the torus in f64 (the nearest point of the tube's
-    /// circle in the point's meridian plane, or for a spindle torus whose projection
-    /// would cross the axis the cusp where the surface meets it), rounded to f32, with
-    /// the bound of that rounding plus the f64 error.
+    /// The hit point put back onto the torus in f64 (re-solved along the ray within the
+    /// rounding of `t`, then projected to the nearest point of the tube's circle in the
+    /// point's meridian plane, or for a spindle torus whose projection would cross the
+    /// axis to the cusp where the surface meets it), rounded to f32, with the bound of
+    /// that rounding plus the f64 error.
     pub fn surface(&self, ray: &Ray, hit: &ShapeHit) -> SurfacePoint {
-        let p0 = ray.org.as_dvec3() + ray.dir.as_dvec3() * hit.t as f64;
+        let d = ray.dir.as_dvec3();
+        let p0 = ray.org.as_dvec3() + d * hit.t as f64;
         let p0 = if p0.is_finite() { p0 } else { self.center };
-        let q = self.local(p0 - self.center);
         let (rr, r) = (self.major, self.minor);
+        // First back onto the ray's own crossing, if it is within the rounding of t:
+        // Newton on the signed distance along the ray (its gradient is the unit normal).
+        let mut q = self.local(p0 - self.center);
+        let dl = d.length();
+        if dl > 0.0 {
+            let u = self.local(d / dl);
+            let t_ulp = (hit.t.abs() * f32::EPSILON) as f64 * dl;
+            let mut x = q;
+            let mut moved = 0.0f64;
+            for _ in 0..4 {
+                let rho = x.x.hypot(x.y);
+                let (a, z) = (rho - rr, x.z);
+                let dist = a.hypot(z);
+                if rho == 0.0 || dist == 0.0 {
+                    break;
+                }
+                let n = DVec3::new(a * x.x / (rho * dist), a * x.y / (rho * dist), z / dist);
+                let step = (dist - r) / n.dot(u);
+                if !step.is_finite() {
+                    break;
+                }
+                x -= u * step;
+                moved -= step;
+                if step.abs() <= 1e-17 * (rr + r) {
+                    break;
+                }
+            }
+            if x.is_finite() && moved.abs() <= 4.0 * t_ulp {
+                q = x;
+            }
+        }
         let rho = q.x.hypot(q.y);
         // The meridian half-plane through q (any one on the axis).
         let radial = if rho > 0.0 {
