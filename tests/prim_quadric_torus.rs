@@ -969,6 +969,28 @@ fn cylinder_axis_and_parallel_rays() {
     assert!(!capped.contains(Vec3::new(1.0, 2.0, 5.0)));
 }
 
+/// A negative-definite quadric is the outside of an ellipsoid: unbounded, with two
+/// half-line spans through the middle and an inward normal... that is, outward from the
+/// solid, towards the ellipsoid's centre.
+#[test]
+fn complement_of_a_sphere() {
+    let q = Quadric::new([-1.0, -1.0, -1.0, 0.0, 0.0, 0.0, 0.0, 0.0, 0.0, 4.0], None).unwrap();
+    assert!(!q.is_bounded() && q.bounds() == Aabb::INFINITE);
+    let ray = Ray::new(Vec3::new(-5.0, 0.0, 0.0), Vec3::X);
+    let h = q.intersect(&ray).unwrap();
+    assert!(
+        (h.t - 3.0).abs() < 1e-6 && h.ng.dot(Vec3::X) > 0.999,
+        "{h:?}"
+    );
+    let mut s = Spans::new();
+    q.spans(&ray, &mut s);
+    assert_eq!(s.len(), 2, "{s:?}");
+    assert_eq!((s[0].t_in, s[1].t_out), (f32::NEG_INFINITY, f32::INFINITY));
+    assert!((s[0].t_out - 3.0).abs() < 1e-6 && (s[1].t_in - 7.0).abs() < 1e-6);
+    assert!(s[0].n_out.dot(Vec3::X) > 0.999 && s[1].n_in.dot(Vec3::X) < -0.999);
+    assert!(q.contains(Vec3::new(3.0, 0.0, 0.0)) && !q.contains(Vec3::ZERO));
+}
+
 /// Tangent rays: exactly tangent gives the tangent point or nothing; a hair inside two
 /// close hits; a hair outside none.
 #[test]
@@ -1240,6 +1262,151 @@ fn small_quadric_far_away() {
     let far = Ray::new(c - Vec3::new(0.0, 0.0, 1e6), Vec3::Z);
     let h = s.intersect(&far).unwrap();
     assert!((h.t - (1e6 - 1e-2)).abs() <= 0.07, "{}", h.t);
+}
+
+/// Each preset is the surface its documentation describes: on a rotated axis, points of
+/// the analytic surface have `F ≈ 0`, and points slightly inside (outside) are negative
+/// (positive).
+#[test]
+fn presets_match_their_definitions() {
+    let point = Vec3::new(3.0, -2.0, 1.5);
+    let axis = Vec3::new(1.0, -2.0, 0.5);
+    let w = axis.as_dvec3().normalize();
+    let (e1, _) = w.any_orthonormal_pair();
+    let p0 = point.as_dvec3();
+    // (preset, radius of the surface at height h along the axis, heights to test); the
+    // sizes are exact in f32.
+    type Radius = Box<dyn Fn(f64) -> f64>;
+    let cases: Vec<(&str, Quadric, Radius, Vec<f64>)> = vec![
+        (
+            "cylinder",
+            Quadric::cylinder(point, axis, 0.75).unwrap(),
+            Box::new(|_| 0.75),
+            vec![-5.0, 0.0, 3.0],
+        ),
+        (
+            "cone",
+            Quadric::cone(point, axis, 0.375).unwrap(),
+            Box::new(|h: f64| 0.375 * h.abs()),
+            vec![-2.0, 0.5, 3.0],
+        ),
+        (
+            "paraboloid",
+            Quadric::paraboloid(point, axis, 0.25).unwrap(),
+            Box::new(|h: f64| (h).sqrt()),
+            vec![0.25, 1.0, 4.0],
+        ),
+        (
+            "hyperboloid (1 sheet)",
+            Quadric::hyperboloid_one_sheet(point, axis, 0.5, 2.0).unwrap(),
+            Box::new(|h: f64| (0.25 + 4.0 * h * h).sqrt()),
+            vec![-1.0, 0.0, 0.3],
+        ),
+        (
+            "hyperboloid (2 sheets)",
+            Quadric::hyperboloid_two_sheets(point, axis, 0.5, 2.0).unwrap(),
+            Box::new(|h: f64| (4.0 * (h * h - 0.25)).sqrt()),
+            vec![-2.0, 0.75, 1.5],
+        ),
+        (
+            "sphere",
+            Quadric::sphere(point, 1.5).unwrap(),
+            Box::new(|h: f64| (2.25 - h * h).sqrt()),
+            vec![-1.0, 0.0, 1.2],
+        ),
+    ];
+    for (name, q, radius, heights) in cases {
+        assert!(!q.is_bounded() || name == "sphere", "{name}");
+        for h in heights {
+            let r = radius(h);
+            let at = |k: f64| p0 + w * h + e1 * (r * k);
+            let (on, inner, outer) = (q.value(at(1.0)), q.value(at(0.97)), q.value(at(1.03)));
+            assert!(
+                inner < 0.0 && outer > 0.0,
+                "{name} at h = {h}: {inner} {outer}"
+            );
+            assert!(
+                on.abs() < 1e-9 * (inner.abs() + outer.abs()),
+                "{name} at h = {h}: F = {on}"
+            );
+        }
+    }
+    // The axis-aligned ellipsoid.
+    let e = Quadric::ellipsoid(point, Vec3::new(1.0, 2.0, 0.5)).unwrap();
+    for (k, r) in [1.0, 2.0, 0.5].into_iter().enumerate() {
+        let mut d = DVec3::ZERO;
+        d[k] = r;
+        assert!(e.value(p0 + d).abs() < 1e-12 && e.value(p0 + d * 0.99) < 0.0);
+    }
+}
+
+/// The coefficients' scale does not matter: the same quadric multiplied by 1e±200
+/// gives the same hits (the constructor rescales by a power of two).
+#[test]
+fn coefficient_scale_does_not_matter() {
+    let base = [1.0, 2.0, 0.5, 0.1, -0.2, 0.3, -0.4, 0.2, 0.1, -3.0];
+    let q = Quadric::new(base, None).unwrap();
+    for k in [1e-200, 1e-30, 3.0, 1e30, 1e200] {
+        let scaled = Quadric::new(base.map(|c| c * k), None).unwrap();
+        for dir in [
+            Vec3::X,
+            Vec3::new(0.3, -1.0, 0.2),
+            Vec3::new(-1.0, -1.0, 4.0),
+        ] {
+            let ray = Ray::new(Vec3::new(-4.0, 3.0, -2.0) * 0.5, dir);
+            let (a, b) = (q.intersect(&ray), scaled.intersect(&ray));
+            assert_eq!(a.map(|h| h.t), b.map(|h| h.t), "scale {k}");
+            let mut sa = Spans::new();
+            let mut sb = Spans::new();
+            q.spans(&ray, &mut sa);
+            scaled.spans(&ray, &mut sb);
+            assert_eq!(sa, sb, "scale {k}");
+        }
+    }
+}
+
+/// Along the equatorial ray through the centre the torus is crossed four times, one
+/// after another as `tmin` advances.
+#[test]
+fn torus_four_hits_in_order() {
+    let t = Torus::new(Vec3::new(1.0, 2.0, 3.0), Vec3::Y, 3.0, 1.0).unwrap();
+    let mut ray = Ray::new(Vec3::new(-9.0, 2.0, 3.0), Vec3::X * 2.0);
+    let mut got = Vec::new();
+    while let Some(h) = t.intersect(&ray) {
+        got.push(h.t);
+        ray.tmin = h.t;
+    }
+    let want = [3.0f32, 4.0, 6.0, 7.0];
+    assert_eq!(got.len(), 4, "{got:?}");
+    for (g, w) in got.iter().zip(want) {
+        assert!((g - w).abs() < 1e-6, "{got:?}");
+    }
+}
+
+/// A plane far from the origin: the hit and the surface point keep f32 precision of
+/// the coordinates, and the half-space spans flip with the direction.
+#[test]
+fn plane_far_away() {
+    let n = Vec3::new(1.0, 2.0, -2.0);
+    let point = Vec3::new(1e6, -2e6, 5e5);
+    let plane = Plane::from_point_normal(point, n).unwrap();
+    assert_eq!(plane.bounds(), Aabb::INFINITE);
+    assert!((plane.normal().length() - 1.0).abs() < 1e-7);
+    let ray = Ray::new(point + Vec3::new(3.0, 1.0, 2.0), -n);
+    let h = plane.intersect(&ray).unwrap();
+    let sp = plane.surface(&ray, &h);
+    let nd = n.as_dvec3().normalize();
+    let off = nd.dot(sp.p.as_dvec3() - point.as_dvec3()).abs();
+    assert!(
+        off <= nd.abs().dot(sp.err.as_dvec3()),
+        "{off} vs {:?}",
+        sp.err
+    );
+    assert!(sp.err.max_element() <= 2.0 * 2e6 * f32::EPSILON);
+    let mut s = Spans::new();
+    plane.spans(&ray, &mut s);
+    assert_eq!((s[0].t_in, s[0].t_out), (h.t, f32::INFINITY));
+    assert!(plane.contains(point - n) && !plane.contains(point + n));
 }
 
 /// The worst errors over many random cases, printed (run with `--nocapture`) and held

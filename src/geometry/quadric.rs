@@ -682,6 +682,14 @@ impl Quadric {
         } else {
             (r_qa, r_cq)
         };
+        // Near a tangent the two formulas can round past each other: then both are the
+        // double root.
+        let (entry, exit) = if (a > 0.0) == (entry <= exit) {
+            (entry, exit)
+        } else {
+            let mid = 0.5 * (entry + exit);
+            (mid, mid)
+        };
         let (en, ex) = (
             Crossing {
                 r: entry,
