@@ -205,7 +205,8 @@ impl Torus {
         let c1 = -8.0 * rn2 * bxy;
         let gh = |s: f64| {
             let q = p + dn * s;
-            let rho = q.x.hypot(q.y);
+            // Normalised coordinates are O(1): no overflow, and sqrt is much cheaper.
+            let rho = (q.x * q.x + q.y * q.y).sqrt();
             let z2 = q.z * q.z;
             let g = (rho - rn) * (rho - rn) + z2 - sn2;
             let h = (rho + rn) * (rho + rn) + z2 - sn2;
@@ -233,16 +234,18 @@ impl Torus {
             let (a, b) = (w[0], w[1]);
             let (fa, fb) = (f1(a), f1(b));
             if (fa > 0.0) != (fb > 0.0) {
-                crit.push(bracket_root(|s| (f1(s), f2(s)), a, b, fa > 0.0));
+                crit.push(bracket_root(|s| (f1(s), f2(s)), (a, b), (fa, fb), 1e-12));
             }
         }
         crit.push(s_max);
         let mut roots: smallvec::SmallVec<[f64; 4]> = Default::default();
+        // In normalised units, 1e-15 is at the f64 resolution of f's terms (O(1)).
         let mut fa = f(crit[0]);
         for w in crit.windows(2) {
             let fb = f(w[1]);
             if (fa > 0.0) != (fb > 0.0) && roots.len() < 4 {
-                roots.push(bracket_root(|s| (f(s), f1(s)), w[0], w[1], fa > 0.0));
+                let fun = |s: f64| (f(s), f1(s));
+                roots.push(bracket_root(fun, (w[0], w[1]), (fa, fb), 1e-15));
             }
             fa = fb;
         }
@@ -272,7 +275,7 @@ impl Torus {
     fn at(&self, line: &TorusLine, s: f64, exit: bool) -> (Vec3, f32, f32) {
         let rn = self.major / (self.major + self.minor);
         let q = line.p + line.dn * s;
-        let rho = q.x.hypot(q.y);
+        let rho = (q.x * q.x + q.y * q.y).sqrt();
         let radial = if rho > 0.0 {
             DVec3::new(q.x / rho, q.y / rho, 0.0)
         } else {
@@ -424,14 +427,26 @@ fn wrap01(x: f64) -> f32 {
     }
 }
 
-/// The root of a function monotone on `[lo, hi]` whose sign differs at the two ends
-/// (`pos_lo`: the function is positive at `lo`), by safeguarded Newton iteration
-/// (`fun` returns the value and the derivative): Newton steps while they stay inside the
+/// The root of a function monotone on `[lo, hi]` whose values `f_lo`, `f_hi` at the two
+/// ends differ in sign, by safeguarded Newton iteration (`fun` returns the value and the
+/// derivative) from the regula falsi point: Newton steps while they stay inside the
 /// shrinking bracket and at least halve the step, bisection otherwise (Numerical
-/// Recipes' `rtsafe`). Stops at f64 resolution.
-fn bracket_root(fun: impl Fn(f64) -> (f64, f64), lo: f64, hi: f64, pos_lo: bool) -> f64 {
+/// Recipes' `rtsafe`). Stops once a step is below `tol` (absolute) or the bracket
+/// cannot shrink further.
+fn bracket_root(
+    fun: impl Fn(f64) -> (f64, f64),
+    (lo, hi): (f64, f64),
+    (f_lo, f_hi): (f64, f64),
+    tol: f64,
+) -> f64 {
+    let pos_lo = f_lo > 0.0;
     let (mut lo, mut hi) = (lo, hi);
-    let mut x = 0.5 * (lo + hi);
+    let guess = lo + (hi - lo) * (f_lo / (f_lo - f_hi));
+    let mut x = if guess > lo && guess < hi {
+        guess
+    } else {
+        0.5 * (lo + hi)
+    };
     let mut dx_old = hi - lo;
     let mut dx = dx_old;
     let (mut fx, mut dfx) = fun(x);
@@ -454,7 +469,7 @@ fn bracket_root(fun: impl Fn(f64) -> (f64, f64), lo: f64, hi: f64, pos_lo: bool)
             dx = 0.5 * (hi - lo);
             lo + dx
         };
-        if x_new == x || hi - lo <= 4.0 * f64::EPSILON * x.abs().max(f64::MIN_POSITIVE) {
+        if x_new == x || dx.abs() <= tol {
             return x_new;
         }
         x = x_new;
@@ -493,15 +508,12 @@ mod tests {
 
     #[test]
     fn bracket_root_finds_simple_roots() {
-        let r = bracket_root(|x| (x * x - 2.0, 2.0 * x), 0.0, 2.0, false);
+        let f = |x: f64| (x * x - 2.0, 2.0 * x);
+        let r = bracket_root(f, (0.0, 2.0), (-2.0, 2.0), 1e-15);
         assert!((r - 2f64.sqrt()).abs() < 1e-15);
-        // A flat function: bisection still converges.
-        let r = bracket_root(
-            |x| ((x - 0.3).powi(7), 7.0 * (x - 0.3).powi(6)),
-            0.0,
-            1.0,
-            false,
-        );
+        // A flat function (a root of multiplicity 7): bisection still converges.
+        let g = |x: f64| ((x - 0.3).powi(7), 7.0 * (x - 0.3).powi(6));
+        let r = bracket_root(g, (0.0, 1.0), (g(0.0).0, g(1.0).0), 1e-15);
         assert!((r - 0.3).abs() < 1e-6);
     }
 
