@@ -970,8 +970,8 @@ fn cylinder_axis_and_parallel_rays() {
 }
 
 /// A negative-definite quadric is the outside of an ellipsoid: unbounded, with two
-/// half-line spans through the middle and an inward normal... that is, outward from the
-/// solid, towards the ellipsoid's centre.
+/// half-line spans through the middle, and normals pointing out of the solid, i.e.
+/// towards the ellipsoid's centre.
 #[test]
 fn complement_of_a_sphere() {
     let q = Quadric::new([-1.0, -1.0, -1.0, 0.0, 0.0, 0.0, 0.0, 0.0, 0.0, 4.0], None).unwrap();
