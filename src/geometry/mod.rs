@@ -11,18 +11,24 @@ mod boxes;
 mod capped;
 mod cone;
 pub mod csg;
+mod plane;
 pub mod polygon;
 mod polyhedron;
+mod quadric;
 pub mod reference;
 mod sphere;
+mod torus;
 mod triangle;
 
 pub use boxes::{AaBox, OBox};
 pub use capped::CappedCone;
 pub use cone::Cone;
 pub use csg::{Csg, CsgOp, CsgTree};
+pub use plane::Plane;
 pub use polyhedron::Polyhedron;
+pub use quadric::Quadric;
 pub use sphere::Sphere;
+pub use torus::Torus;
 pub use triangle::{Triangle, WatertightRay};
 
 use crate::math::{Aabb, Ray, Vec3};
