@@ -5,10 +5,15 @@
 use criterion::{criterion_group, criterion_main, Criterion, Throughput};
 use emray::accel::bvh::Bvh;
 use emray::accel::Accel;
-use emray::geometry::{Cone, Csg, CsgOp, CsgTree, Kind, Shape, Sphere, Triangle};
+use emray::geometry::{
+    AaBox, CappedCone, Cone, Csg, CsgOp, CsgTree, Kind, OBox, Plane, Polyhedron, Quadric, Shape,
+    Sphere, Torus, Triangle,
+};
 use emray::math::{Ray, Vec3};
 use emray::scene::{Camera, Material, Scene};
+use glam::Quat;
 use std::hint::black_box;
+use std::sync::Arc;
 
 struct Lcg(u64);
 
@@ -63,7 +68,37 @@ fn scene(kind: Kind, n: usize) -> Scene {
                     CsgTree::leaf(Shape::Sphere(Sphere::new(c - d, rad))),
                 );
                 let csg = Csg::new(&lens).expect("valid CSG");
-                s.add_shape(Shape::Csg(std::sync::Arc::new(csg)), 0);
+                s.add_shape(Shape::Csg(Arc::new(csg)), 0);
+            }
+            other => {
+                let size = 0.1 + 0.2 * r.f();
+                let axis = r.v(1.0) + Vec3::splat(0.01);
+                let shape = match other {
+                    Kind::Quadric => Shape::Quadric(Arc::new(
+                        Quadric::ellipsoid(c, Vec3::new(size, size * 0.6, size * 1.3)).unwrap(),
+                    )),
+                    Kind::CappedCone => Shape::CappedCone(Arc::new(
+                        CappedCone::new(c, axis, size * 3.0, size, size * 0.5).unwrap(),
+                    )),
+                    Kind::Box => Shape::Box(AaBox::new(c, c + r.v(0.6).abs() + 0.05).unwrap()),
+                    Kind::OBox => Shape::OBox(Arc::new(
+                        OBox::new(
+                            c,
+                            Vec3::splat(size),
+                            Quat::from_axis_angle(axis.normalize(), 0.7),
+                        )
+                        .unwrap(),
+                    )),
+                    Kind::Polyhedron => Shape::Polyhedron(Arc::new(
+                        Polyhedron::preset("dodecahedron", c, size * 1.5).unwrap(),
+                    )),
+                    Kind::Torus => Shape::Torus(Arc::new(
+                        Torus::new(c, axis, size * 1.5, size * 0.5).unwrap(),
+                    )),
+                    // Unbounded: one plane per scene is plenty.
+                    _ => Shape::Plane(Plane::new(Vec3::Y, -25.0 - 0.01 * r.f()).unwrap()),
+                };
+                s.add_shape(shape, 0);
             }
         }
     }
@@ -99,7 +134,10 @@ fn run<A: Accel>(c: &mut Criterion, name: &str, accel: &A, rays: &[Ray]) {
 fn bench(c: &mut Criterion) {
     let rays = rays(10_000);
     for kind in Kind::ALL {
-        let s = scene(kind, 10_000);
+        // Planes are unbounded: tested against every ray outside the hierarchy, so
+        // one is the meaningful case.
+        let n = if kind == Kind::Plane { 1 } else { 10_000 };
+        let s = scene(kind, n);
         run(c, &format!("bvh/{}", kind.name()), &Bvh::build(&s), &rays);
         #[cfg(feature = "embree")]
         run(

@@ -11,18 +11,24 @@ mod boxes;
 mod capped;
 mod cone;
 pub mod csg;
+mod plane;
 pub mod polygon;
 mod polyhedron;
+mod quadric;
 pub mod reference;
 mod sphere;
+mod torus;
 mod triangle;
 
 pub use boxes::{AaBox, OBox};
 pub use capped::CappedCone;
 pub use cone::Cone;
 pub use csg::{Csg, CsgOp, CsgTree};
+pub use plane::Plane;
 pub use polyhedron::Polyhedron;
+pub use quadric::Quadric;
 pub use sphere::Sphere;
+pub use torus::Torus;
 pub use triangle::{Triangle, WatertightRay};
 
 use crate::math::{Aabb, Ray, Vec3};
@@ -115,11 +121,37 @@ pub enum Kind {
     Cone = 2,
     /// Constructive solid geometry roots.
     Csg = 3,
+    /// General quadrics, optionally clipped to a box.
+    Quadric = 4,
+    /// Capped (closed) cones and cylinders.
+    CappedCone = 5,
+    /// Axis-aligned boxes.
+    Box = 6,
+    /// Oriented boxes.
+    OBox = 7,
+    /// Convex polyhedra.
+    Polyhedron = 8,
+    /// Infinite planes.
+    Plane = 9,
+    /// Tori.
+    Torus = 10,
 }
 
 impl Kind {
     /// All kinds in geometry-id order.
-    pub const ALL: [Kind; 4] = [Kind::Triangle, Kind::Sphere, Kind::Cone, Kind::Csg];
+    pub const ALL: [Kind; 11] = [
+        Kind::Triangle,
+        Kind::Sphere,
+        Kind::Cone,
+        Kind::Csg,
+        Kind::Quadric,
+        Kind::CappedCone,
+        Kind::Box,
+        Kind::OBox,
+        Kind::Polyhedron,
+        Kind::Plane,
+        Kind::Torus,
+    ];
 
     /// The kind with geometry id `id`.
     pub fn from_id(id: u32) -> Option<Kind> {
@@ -133,6 +165,13 @@ impl Kind {
             Kind::Sphere => "spheres",
             Kind::Cone => "cones",
             Kind::Csg => "csg",
+            Kind::Quadric => "quadrics",
+            Kind::CappedCone => "capped_cones",
+            Kind::Box => "boxes",
+            Kind::OBox => "oriented_boxes",
+            Kind::Polyhedron => "polyhedra",
+            Kind::Plane => "planes",
+            Kind::Torus => "tori",
         }
     }
 
@@ -143,6 +182,13 @@ impl Kind {
             Kind::Sphere => "sphere",
             Kind::Cone => "open cone",
             Kind::Csg => "CSG solid",
+            Kind::Quadric => "quadric",
+            Kind::CappedCone => "capped cone",
+            Kind::Box => "box",
+            Kind::OBox => "oriented box",
+            Kind::Polyhedron => "polyhedron",
+            Kind::Plane => "plane",
+            Kind::Torus => "torus",
         }
     }
 }
@@ -156,6 +202,20 @@ pub enum Shape {
     Cone(Cone),
     /// A CSG root.
     Csg(Arc<Csg>),
+    /// A general quadric.
+    Quadric(Arc<Quadric>),
+    /// A capped cone or cylinder.
+    CappedCone(Arc<CappedCone>),
+    /// An axis-aligned box.
+    Box(AaBox),
+    /// An oriented box.
+    OBox(Arc<OBox>),
+    /// A convex polyhedron.
+    Polyhedron(Arc<Polyhedron>),
+    /// An infinite plane.
+    Plane(Plane),
+    /// A torus.
+    Torus(Arc<Torus>),
 }
 
 /// Call `$f` on the primitive inside any [`Shape`].
@@ -166,6 +226,28 @@ macro_rules! dispatch {
             Shape::Cone($s) => $e,
             Shape::Csg(c) => {
                 let $s: &Csg = c;
+                $e
+            }
+            Shape::Quadric(c) => {
+                let $s: &Quadric = c;
+                $e
+            }
+            Shape::CappedCone(c) => {
+                let $s: &CappedCone = c;
+                $e
+            }
+            Shape::Box($s) => $e,
+            Shape::OBox(c) => {
+                let $s: &OBox = c;
+                $e
+            }
+            Shape::Polyhedron(c) => {
+                let $s: &Polyhedron = c;
+                $e
+            }
+            Shape::Plane($s) => $e,
+            Shape::Torus(c) => {
+                let $s: &Torus = c;
                 $e
             }
         }
@@ -179,6 +261,13 @@ impl Shape {
             Shape::Sphere(_) => Kind::Sphere,
             Shape::Cone(_) => Kind::Cone,
             Shape::Csg(_) => Kind::Csg,
+            Shape::Quadric(_) => Kind::Quadric,
+            Shape::CappedCone(_) => Kind::CappedCone,
+            Shape::Box(_) => Kind::Box,
+            Shape::OBox(_) => Kind::OBox,
+            Shape::Polyhedron(_) => Kind::Polyhedron,
+            Shape::Plane(_) => Kind::Plane,
+            Shape::Torus(_) => Kind::Torus,
         }
     }
 
@@ -187,7 +276,11 @@ impl Shape {
         match self {
             Shape::Sphere(s) => !s.inside_only,
             Shape::Cone(_) => false,
-            Shape::Csg(_) => true,
+            // A quadric is a solid where {F <= 0} is bounded (clipped or an ellipsoid).
+            Shape::Quadric(q) => q.is_bounded(),
+            // The plane's half-space: unbounded, but usable to cut bounded solids.
+            Shape::Plane(_) => true,
+            _ => true,
         }
     }
 
@@ -198,6 +291,13 @@ impl Shape {
             Shape::Sphere(s) => s.spans(ray, out),
             Shape::Cone(_) => {}
             Shape::Csg(c) => c.spans(ray, out),
+            Shape::Quadric(c) => c.spans(ray, out),
+            Shape::CappedCone(c) => c.spans(ray, out),
+            Shape::Box(c) => c.spans(ray, out),
+            Shape::OBox(c) => c.spans(ray, out),
+            Shape::Polyhedron(c) => c.spans(ray, out),
+            Shape::Plane(c) => c.spans(ray, out),
+            Shape::Torus(c) => c.spans(ray, out),
         }
     }
 
@@ -207,6 +307,13 @@ impl Shape {
             Shape::Sphere(s) => s.contains(p),
             Shape::Cone(_) => false,
             Shape::Csg(c) => c.contains(p),
+            Shape::Quadric(c) => c.contains(p),
+            Shape::CappedCone(c) => c.contains(p),
+            Shape::Box(c) => c.contains(p),
+            Shape::OBox(c) => c.contains(p),
+            Shape::Polyhedron(c) => c.contains(p),
+            Shape::Plane(c) => c.contains(p),
+            Shape::Torus(c) => c.contains(p),
         }
     }
 }

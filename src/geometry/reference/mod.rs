@@ -5,6 +5,9 @@ pub mod solids;
 
 use crate::math::{DRay, DVec3};
 
+pub mod quadric;
+pub mod torus;
+
 /// Nearest root `> tmin` of `a t² + 2 b t + c = 0` among those passing `accept`,
 /// solved directly in f64.
 fn solve(a: f64, b: f64, c: f64, tmin: f64, mut accept: impl FnMut(f64) -> bool) -> Option<f64> {
