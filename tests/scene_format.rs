@@ -188,8 +188,7 @@ type = "polyhedron"
 sides = 6
 radius = 1
 height = 2
-base = [0, 0, 0]
-axis = [0, 1, 0]
+center = [0, 0, 0]
 
 [[objects]]
 type = "quadric"
@@ -310,6 +309,21 @@ fn every_key_round_trips() {
             .map(|p| *p.get_ref()),
         Some(1)
     );
+}
+
+#[test]
+fn every_key_file_builds_and_its_rewrite_builds_the_same() {
+    let dir = temp_dir();
+    write(dir.path(), "parts/table.nff", TABLE_NFF);
+    let a = write(dir.path(), "every.toml", EVERY_KEY);
+    let file = scene_toml::parse_file(EVERY_KEY, &a).unwrap();
+    let b = write(dir.path(), "again.toml", &file.to_toml_string().unwrap());
+    let sa = scene_toml::load(&a).unwrap();
+    let sb = scene_toml::load(&b).unwrap();
+    assert_eq!(sa, sb);
+    for kind in Kind::ALL {
+        assert!(sa.count(kind) > 0, "no {kind:?} in the every-key scene");
+    }
 }
 
 #[test]
@@ -501,6 +515,312 @@ apex = [0, 0, 3]
         (Vec3::ZERO, 1.0, Vec3::new(0.0, 2.0, 0.0), 0.5)
     );
     assert_eq!(s.cones.items[1].apex_radius, 0.0);
+}
+
+/// The only analytic shape of a scene, with its transform to world if it is an
+/// instance's.
+fn only_shape(s: &Scene) -> (Shape, Option<emray::math::Xform>) {
+    let mut all: Vec<(Shape, Option<emray::math::Xform>)> =
+        s.analytic().map(|(_, _, sh)| (sh, None)).collect();
+    for inst in &s.instances {
+        for (_, _, sh) in s.objects[inst.object as usize].analytic() {
+            all.push((sh, Some(inst.xform)));
+        }
+    }
+    assert_eq!(all.len(), 1, "{all:?}");
+    all.pop().unwrap()
+}
+
+/// Whether the scene's only shape contains world point `p`.
+fn contains(s: &Scene, p: Vec3) -> bool {
+    let (shape, xf) = only_shape(s);
+    match xf {
+        Some(x) => shape.contains(x.to_object.transform_point3(p)),
+        None => shape.contains(p),
+    }
+}
+
+fn check_inside(s: &Scene, inside: &[[f32; 3]], outside: &[[f32; 3]]) {
+    for p in inside {
+        assert!(contains(s, Vec3::from(*p)), "{p:?} should be inside");
+    }
+    for p in outside {
+        assert!(!contains(s, Vec3::from(*p)), "{p:?} should be outside");
+    }
+}
+
+#[test]
+fn closed_solids() {
+    let s = build("[[objects]]\ntype = \"cylinder\"\nbase = [1, 0, 0]\naxis = [0, 2, 0]\nheight = 3\nradius = 0.5\n");
+    assert_eq!(s.count(Kind::CappedCone), 1);
+    let Shape::CappedCone(c) = &s.shapes.items[0] else {
+        panic!()
+    };
+    assert_eq!(
+        (
+            c.base(),
+            c.axis(),
+            c.height(),
+            c.base_radius(),
+            c.top_radius()
+        ),
+        (Vec3::X, Vec3::Y, 3.0, 0.5, 0.5)
+    );
+    check_inside(
+        &s,
+        &[[1.0, 2.9, 0.0], [1.4, 0.1, 0.0]],
+        &[[1.0, 3.1, 0.0], [1.6, 1.0, 0.0], [1.0, -0.1, 0.0]],
+    );
+
+    let s = build("[[objects]]\ntype = \"capped_cone\"\nbase = [0, 0, 0]\naxis = [0, 0, 1]\nheight = 2\nbase_radius = 1\ntop_radius = 0\n");
+    let Shape::CappedCone(c) = &s.shapes.items[0] else {
+        panic!()
+    };
+    assert_eq!(
+        (c.base_radius(), c.top_radius(), c.height()),
+        (1.0, 0.0, 2.0)
+    );
+    check_inside(
+        &s,
+        &[[0.9, 0.0, 0.05], [0.0, 0.0, 1.9]],
+        &[[0.6, 0.0, 1.0], [0.0, 0.0, 2.1]],
+    );
+
+    let s = build("[[objects]]\ntype = \"box\"\nmin = [-1, 0, 2]\nmax = [1, 1, 5]\n");
+    assert_eq!(s.count(Kind::Box), 1);
+    let Shape::Box(b) = &s.shapes.items[0] else {
+        panic!()
+    };
+    assert_eq!(
+        (b.min(), b.max()),
+        (Vec3::new(-1.0, 0.0, 2.0), Vec3::new(1.0, 1.0, 5.0))
+    );
+
+    // An oriented box three ways: size + rotation steps, half_size + axes, and the
+    // same with a default (identity) orientation.
+    let s = build("[[objects]]\ntype = \"obox\"\ncenter = [0, 0, 0]\nsize = [4, 2, 2]\nrotation = [{ rotate = [0, 0, 1], angle = 90 }]\n");
+    assert_eq!(s.count(Kind::OBox), 1);
+    let Shape::OBox(b) = &s.shapes.items[0] else {
+        panic!()
+    };
+    assert_close(b.half_extents(), Vec3::new(2.0, 1.0, 1.0));
+    check_inside(
+        &s,
+        &[[0.0, 1.9, 0.0], [0.9, 0.0, 0.0]],
+        &[[1.1, 0.0, 0.0], [0.0, 2.1, 0.0]],
+    );
+    let s = build("[[objects]]\ntype = \"obox\"\ncenter = [0, 0, 0]\nhalf_size = [2, 1, 1]\naxes = [[0, 1, 0], [-1, 0, 0], [0, 0, 1]]\n");
+    check_inside(&s, &[[0.0, 1.9, 0.0]], &[[1.1, 0.0, 0.0]]);
+    let s = build("[[objects]]\ntype = \"obox\"\ncenter = [5, 0, 0]\nhalf_size = [2, 1, 1]\n");
+    check_inside(&s, &[[6.9, 0.0, 0.0]], &[[5.0, 1.1, 0.0]]);
+
+    // Polyhedra: planes, a preset, a prism.
+    let s = build("[[objects]]\ntype = \"polyhedron\"\nplanes = [[1, 0, 0, 1], [-1, 0, 0, 1], [0, 1, 0, 2], [0, -1, 0, 2], [0, 0, 1, 1], [0, 0, -1, 1]]\n");
+    assert_eq!(s.count(Kind::Polyhedron), 1);
+    check_inside(&s, &[[0.9, 1.9, -0.9]], &[[1.1, 0.0, 0.0], [0.0, 2.1, 0.0]]);
+    let s = build("[[objects]]\ntype = \"polyhedron\"\npreset = \"octahedron\"\ncenter = [0, 1, 0]\nradius = 2\n");
+    let Shape::Polyhedron(p) = &s.shapes.items[0] else {
+        panic!()
+    };
+    assert_eq!(p.face_count(), 8);
+    check_inside(
+        &s,
+        &[[1.9, 1.0, 0.0], [0.0, 2.9, 0.0]],
+        &[[1.1, 2.0, 0.0], [0.0, -1.1, 0.0]],
+    );
+    let s = build("[[objects]]\ntype = \"polyhedron\"\nsides = 6\nradius = 1\nheight = 4\n");
+    let Shape::Polyhedron(p) = &s.shapes.items[0] else {
+        panic!()
+    };
+    assert_eq!(p.face_count(), 8);
+    check_inside(
+        &s,
+        &[[0.95, 0.0, 1.9]],
+        &[[0.0, 0.95, 0.0], [0.0, 0.0, 2.1]],
+    );
+}
+
+#[test]
+fn quadrics_planes_and_tori() {
+    // The unit sphere as a quadric, clipped to z ≥ 0.
+    let s = build("[[objects]]\ntype = \"quadric\"\ncoefficients = [1, 1, 1, 0, 0, 0, 0, 0, 0, -1]\nclip = { min = [-2, -2, 0], max = [2, 2, 2] }\n");
+    assert_eq!(s.count(Kind::Quadric), 1);
+    check_inside(
+        &s,
+        &[[0.0, 0.0, 0.9], [0.6, 0.6, 0.1]],
+        &[[0.0, 0.0, -0.5], [0.8, 0.8, 0.1]],
+    );
+    // An unclipped cylinder x² + y² = 1 along z: unbounded, not a solid.
+    let s =
+        build("[[objects]]\ntype = \"quadric\"\ncoefficients = [1, 1, 0, 0, 0, 0, 0, 0, 0, -1]\n");
+    assert!(!s.shapes.items[0].is_solid());
+    assert!(!s.shapes.items[0].bounds().is_finite());
+
+    let s = build("[[objects]]\ntype = \"plane\"\npoint = [0, -1, 0]\nnormal = [0, 2, 0]\n");
+    assert_eq!(s.count(Kind::Plane), 1);
+    let Shape::Plane(p) = &s.shapes.items[0] else {
+        panic!()
+    };
+    assert_eq!((p.normal(), p.offset()), (Vec3::Y, -1.0));
+    check_inside(&s, &[[100.0, -1.1, 7.0]], &[[0.0, -0.9, 0.0]]);
+
+    let s = build("[[objects]]\ntype = \"torus\"\ncenter = [0, 0, 0]\naxis = [0, 1, 0]\nmajor_radius = 2\nminor_radius = 0.5\n");
+    assert_eq!(s.count(Kind::Torus), 1);
+    let Shape::Torus(t) = &s.shapes.items[0] else {
+        panic!()
+    };
+    assert_eq!(
+        (t.center(), t.axis(), t.major_radius(), t.minor_radius()),
+        (Vec3::ZERO, Vec3::Y, 2.0, 0.5)
+    );
+    check_inside(
+        &s,
+        &[[2.4, 0.0, 0.0], [0.0, 0.4, -2.0]],
+        &[[0.0, 0.0, 0.0], [2.0, 0.6, 0.0]],
+    );
+}
+
+#[test]
+fn transformed_primitives_are_baked_when_exact() {
+    // Each case: the object, whether it stays a top-level shape (baked) rather than
+    // becoming an instance, and points inside and outside in world space.
+    type Case<'a> = (&'a str, bool, &'a [[f32; 3]], &'a [[f32; 3]]);
+    let cases: &[Case] = &[
+        // A box under translation and per-axis scale stays a box.
+        ("type = \"box\"\nmin = [0, 0, 0]\nmax = [1, 1, 1]\ntransform = [{ scale = [2, -3, 1] }, { translate = [0, 0, 5] }]",
+         true, &[[1.9, -2.9, 5.9]], &[[0.5, 0.5, 5.5], [2.1, -1.0, 5.5]]),
+        // Rotated, it is an instance.
+        ("type = \"box\"\nmin = [0, 0, 0]\nmax = [2, 1, 1]\ntransform = [{ rotate = [0, 0, 1], angle = 90 }]",
+         false, &[[-0.5, 1.9, 0.5]], &[[1.5, 0.5, 0.5]]),
+        ("type = \"obox\"\ncenter = [0, 0, 0]\nhalf_size = [2, 1, 1]\ntransform = [{ rotate = [0, 0, 1], angle = 90 }, { scale = 2 }, { translate = [10, 0, 0] }]",
+         true, &[[10.0, 3.9, 0.0]], &[[12.1, 0.0, 0.0]]),
+        ("type = \"cylinder\"\nbase = [0, 0, 0]\naxis = [0, 1, 0]\nheight = 1\nradius = 1\ntransform = [{ rotate = [1, 0, 0], angle = 90 }, { scale = 3 }]",
+         true, &[[0.0, 0.0, 2.9], [2.9, 0.0, 0.1]], &[[0.0, 0.0, 3.1], [0.0, 0.0, -0.1]]),
+        // A stretched cylinder is an elliptic one: an instance.
+        ("type = \"cylinder\"\nbase = [0, 0, 0]\naxis = [0, 1, 0]\nheight = 1\nradius = 1\ntransform = [{ scale = [3, 1, 1] }]",
+         false, &[[2.9, 0.5, 0.0]], &[[0.0, 0.5, 1.1]]),
+        ("type = \"torus\"\ncenter = [0, 0, 0]\naxis = [0, 1, 0]\nmajor_radius = 2\nminor_radius = 0.5\ntransform = [{ rotate = [1, 0, 0], angle = 90 }, { translate = [0, 0, 1] }]",
+         true, &[[2.0, 0.0, 1.4]], &[[2.0, 0.0, 0.0]]),
+        // Polyhedra, planes and unclipped quadrics bake under any affine map.
+        ("type = \"polyhedron\"\npreset = \"cube\"\nradius = 1.7320508\ntransform = [{ matrix = [[1, 1, 0, 0], [0, 1, 0, 0], [0, 0, 1, 0], [0, 0, 0, 1]] }]",
+         true, &[[1.9, 0.95, 0.0]], &[[-1.9, 0.95, 0.0], [0.0, 1.1, 0.0]]),
+        ("type = \"plane\"\npoint = [0, 0, 0]\nnormal = [1, 1, 0]\ntransform = [{ scale = [2, 1, 1] }, { translate = [1, 0, 0] }]",
+         true, &[[0.0, 0.0, 0.0], [1.0, -0.1, 0.0]], &[[1.2, 0.0, 0.0], [0.0, 0.6, 0.0]]),
+        ("type = \"quadric\"\ncoefficients = [1, 1, 1, 0, 0, 0, 0, 0, 0, -1]\ntransform = [{ scale = [3, 1, 1] }, { translate = [0, 100, 0] }]",
+         true, &[[2.9, 100.0, 0.0]], &[[0.0, 101.1, 0.0], [0.0, 0.0, 0.0]]),
+        // A clipped quadric keeps its box: an instance.
+        ("type = \"quadric\"\ncoefficients = [1, 1, 1, 0, 0, 0, 0, 0, 0, -1]\nclip = { min = [-2, -2, -2], max = [2, 2, 0] }\ntransform = [{ scale = [3, 1, 1] }]",
+         false, &[[2.9, 0.0, -0.1]], &[[2.9, 0.0, 0.1]]),
+    ];
+    for (obj, baked, inside, outside) in cases {
+        let s = build(&format!("[[objects]]\n{obj}\n"));
+        assert_eq!(s.instances.is_empty(), *baked, "{obj}");
+        check_inside(&s, inside, outside);
+    }
+}
+
+#[test]
+fn csg_of_the_new_solids() {
+    // A box with a cylinder drilled through it, cut by a plane at y = 0.5.
+    let s = build(
+        r#"
+[[objects]]
+type = "intersection"
+children = [
+  { type = "difference", children = [
+      { type = "box", min = [-1, -1, -1], max = [1, 1, 1] },
+      { type = "cylinder", base = [0, 0, -2], axis = [0, 0, 1], height = 4, radius = 0.5 },
+  ] },
+  { type = "plane", point = [0, 0.5, 0], normal = [0, 1, 0] },
+]
+"#,
+    );
+    check_inside(
+        &s,
+        &[[0.9, 0.4, 0.0], [0.0, -0.9, 0.9]],
+        &[[0.0, 0.0, 0.0], [0.9, 0.6, 0.0], [1.1, 0.0, 0.0]],
+    );
+    // Planes alone bound nothing.
+    error_at(
+        "[[objects]]\ntype = \"intersection\" # HERE\nchildren = [\n  { type = \"plane\", point = [0, 0, 0], normal = [0, 1, 0] },\n  { type = \"plane\", point = [0, 0, 0], normal = [1, 0, 0] },\n]\n",
+        &["unbounded"],
+    );
+    // An unclipped, unbounded quadric is no operand.
+    error_at(
+        "[[objects]]\ntype = \"union\"\nchildren = [\n  { type = \"sphere\", center = [0, 0, 0], radius = 1 },\n  { type = \"quadric\", coefficients = [1, 1, 0, 0, 0, 0, 0, 0, 0, -1] }, # HERE\n]\n",
+        &["a quadric is not a closed solid"],
+    );
+}
+
+#[test]
+fn errors_of_the_new_primitives() {
+    error_at(
+        "[[objects]]\ntype = \"box\"\nmin = [0, 0, 0]\nmax = [1, 0, 1] # HERE\n",
+        &["must be below max"],
+    );
+    error_at(
+        "[[objects]] # HERE\ntype = \"box\"\nmin = [0, 0, 0]\n",
+        &["missing key `max` for a box"],
+    );
+    error_at(
+        "[[objects]]\ntype = \"obox\"\ncenter = [0, 0, 0]\nsize = [1, 1, 0] # HERE\n",
+        &["positive components"],
+    );
+    error_at("[[objects]]\ntype = \"obox\"\ncenter = [0, 0, 0]\nsize = [1, 1, 1]\nhalf_size = [1, 1, 1] # HERE\n", &["not both"]);
+    error_at(
+        "[[objects]]\ntype = \"obox\"\ncenter = [0, 0, 0]\nsize = [1, 1, 1]\nrotation = [{ scale = 2 }] # HERE\n",
+        &["rotations only"],
+    );
+    error_at(
+        "[[objects]]\ntype = \"obox\"\ncenter = [0, 0, 0]\nsize = [1, 1, 1]\naxes = [[1, 0, 0], [1, 0, 0], [0, 0, 1]] # HERE\n",
+        &["not orthonormal"],
+    );
+    error_at("[[objects]]\ntype = \"cylinder\"\nbase = [0, 0, 0]\naxis = [0, 0, 0] # HERE\nheight = 1\nradius = 1\n", &["must not be zero"]);
+    error_at("[[objects]]\ntype = \"cylinder\"\nbase = [0, 0, 0]\naxis = [0, 1, 0]\nheight = 1\nradius = 0 # HERE\n", &["must be positive"]);
+    error_at(
+        "[[objects]]\ntype = \"capped_cone\"\nbase = [0, 0, 0]\naxis = [0, 1, 0]\nheight = 1\nbase_radius = 0\ntop_radius = 0 # HERE\n",
+        &["both be zero"],
+    );
+    error_at(
+        "[[objects]]\ntype = \"polyhedron\"\npreset = \"icosahedrn\" # HERE\nradius = 1\n",
+        &["unknown polyhedron preset", "did you mean `icosahedron`"],
+    );
+    error_at(
+        "[[objects]]\ntype = \"polyhedron\"\nplanes = [[1, 0, 0, 1], [0, 1, 0, 1], [0, 0, 1, 1], [1, 1, 1, 1]] # HERE\n",
+        &["polyhedron"],
+    );
+    error_at(
+        "[[objects]]\ntype = \"polyhedron\"\nplanes = [[1, 0, 0, 1], [0, 0, 0, 1], [0, 0, 1, 1], [1, 1, 1, 1]]\npreset = \"cube\" # HERE\n",
+        &["one of `planes`, `preset` or `sides`"],
+    );
+    error_at(
+        "[[objects]]\ntype = \"polyhedron\"\nsides = 2 # HERE\nradius = 1\nheight = 1\n",
+        &["sides"],
+    );
+    error_at(
+        "[[objects]]\ntype = \"quadric\"\ncoefficients = [1, 1, 1, 0, 0, 0, 0, 0, 0, 1] # HERE\n",
+        &["quadric"],
+    );
+    error_at(
+        "[[objects]]\ntype = \"quadric\"\ncoefficients = [1, 1, 1, 0, 0, 0, 0, 0, 0, -1]\nclip = { min = [0, 0, 0], max = [1, -1, 1] } # HERE\n",
+        &["clip box"],
+    );
+    error_at(
+        "[[objects]]\ntype = \"quadric\"\ncoefficients = [1, 1, 1] # HERE\n",
+        &["invalid length 3"],
+    );
+    error_at(
+        "[[objects]]\ntype = \"plane\"\npoint = [0, 0, 0]\nnormal = [0, 0, 0] # HERE\n",
+        &["must not be zero"],
+    );
+    error_at(
+        "[[objects]]\ntype = \"torus\"\ncenter = [0, 0, 0]\naxis = [0, 1, 0]\nmajor_radius = 1\nminor_radius = 0 # HERE\n",
+        &["must be positive"],
+    );
+    error_at(
+        "[[objects]]\ntype = \"torus\"\ncenter = [0, 0, 0]\naxis = [0, 1, 0]\nmajor_radius = 1\nminor_radius = 0.2\nradius = 3 # HERE\n",
+        &["`radius` does not apply to a torus"],
+    );
 }
 
 #[test]

@@ -22,11 +22,14 @@ use super::format::{
 use super::{suggest, SceneSettings, Source, MAX_SIDE};
 use crate::geometry::bezier::{teapot_patches, tessellate, BezierPatch};
 use crate::geometry::polygon::Triangulator;
-use crate::geometry::{Cone, Csg, CsgOp, CsgTree, Shape, Sphere, Triangle};
+use crate::geometry::{
+    AaBox, CappedCone, Cone, Csg, CsgOp, CsgTree, OBox, Plane, Polyhedron, Quadric, Shape, Sphere,
+    Torus, Triangle,
+};
 use crate::load::{nff, obj, LoadError};
-use crate::math::{Vec3, Xform};
+use crate::math::{Aabb, Vec3, Xform};
 use crate::scene::{Camera, Geometry, Instance, Light, LoadStats, Material, Scene, Spot, INHERIT};
-use glam::{Affine3A, DAffine3, DMat3, DVec3};
+use glam::{Affine3A, DAffine3, DMat3, DMat4, DQuat, DVec3, Quat};
 use std::collections::HashMap;
 use std::ops::Range;
 use std::path::{Path, PathBuf};
@@ -60,6 +63,14 @@ const DEFAULT_CUTOFF: f64 = 45.0;
 enum Ty {
     Sphere,
     Cone,
+    Cylinder,
+    CappedCone,
+    Box,
+    OBox,
+    Polyhedron,
+    Quadric,
+    Plane,
+    Torus,
     Triangle,
     Polygon,
     Mesh,
@@ -79,6 +90,34 @@ const TYPES: &[(&str, Ty, &[&str])] = &[
         "cone",
         Ty::Cone,
         &["base", "base_radius", "apex", "apex_radius"],
+    ),
+    (
+        "cylinder",
+        Ty::Cylinder,
+        &["base", "axis", "height", "radius"],
+    ),
+    (
+        "capped_cone",
+        Ty::CappedCone,
+        &["base", "axis", "height", "base_radius", "top_radius"],
+    ),
+    ("box", Ty::Box, &["min", "max"]),
+    (
+        "obox",
+        Ty::OBox,
+        &["center", "size", "half_size", "rotation", "axes"],
+    ),
+    (
+        "polyhedron",
+        Ty::Polyhedron,
+        &["planes", "preset", "center", "radius", "sides", "height"],
+    ),
+    ("quadric", Ty::Quadric, &["coefficients", "clip"]),
+    ("plane", Ty::Plane, &["point", "normal"]),
+    (
+        "torus",
+        Ty::Torus,
+        &["center", "axis", "major_radius", "minor_radius"],
     ),
     ("triangle", Ty::Triangle, &["vertices", "normals"]),
     ("polygon", Ty::Polygon, &["vertices", "normals"]),
@@ -322,7 +361,135 @@ fn bake(shape: &Shape, m: &DAffine3) -> Option<Shape> {
                 sign * (c.apex_radius as f64 * k) as f32,
             )))
         }
-        Shape::Csg(_) => None,
+        Shape::Box(b) => {
+            // Axis-aligned stays axis-aligned under a diagonal linear part.
+            let l = m.matrix3;
+            let diagonal = l.x_axis.y == 0.0
+                && l.x_axis.z == 0.0
+                && l.y_axis.x == 0.0
+                && l.y_axis.z == 0.0
+                && l.z_axis.x == 0.0
+                && l.z_axis.y == 0.0;
+            if !diagonal {
+                return None;
+            }
+            let a = m.transform_point3(b.min().as_dvec3());
+            let c = m.transform_point3(b.max().as_dvec3());
+            AaBox::new(f32v(a.min(c)), f32v(a.max(c)))
+                .ok()
+                .map(Shape::Box)
+        }
+        Shape::OBox(b) => {
+            let k = similarity_scale(m)?;
+            let axes = b.axes().map(|a| f32v((m.matrix3 * a.as_dvec3()) / k));
+            OBox::from_axes(
+                f32v(m.transform_point3(b.center().as_dvec3())),
+                f32v(b.half_extents().as_dvec3() * k),
+                axes,
+            )
+            .ok()
+            .map(|b| Shape::OBox(Arc::new(b)))
+        }
+        Shape::CappedCone(c) => {
+            let k = similarity_scale(m)?;
+            CappedCone::new(
+                f32v(m.transform_point3(c.base().as_dvec3())),
+                f32v(m.matrix3 * c.axis().as_dvec3()),
+                (c.height() as f64 * k) as f32,
+                (c.base_radius() as f64 * k) as f32,
+                (c.top_radius() as f64 * k) as f32,
+            )
+            .ok()
+            .map(|c| Shape::CappedCone(Arc::new(c)))
+        }
+        Shape::Polyhedron(p) => {
+            // Half-spaces n·x ≤ d map to n'·y ≤ d + n'·t with n' = M⁻ᵀn.
+            let inv_t = m.matrix3.inverse().transpose();
+            let planes = p
+                .world_planes()
+                .into_iter()
+                .map(|(n, d)| {
+                    let n2 = inv_t * n;
+                    (f32v(n2), (d + n2.dot(m.translation)) as f32)
+                })
+                .collect();
+            Polyhedron::new(planes)
+                .ok()
+                .map(|p| Shape::Polyhedron(Arc::new(p)))
+        }
+        Shape::Quadric(q) if q.clip().is_none() => {
+            // F(L⁻¹(y − t)) about the origin t: the coefficients through L⁻¹ alone.
+            let [a, b, c, d, e, f, g, h, i, j] = q.coefficients();
+            let qm = DMat4::from_cols_array_2d(&[
+                [a, d, e, g],
+                [d, b, f, h],
+                [e, f, c, i],
+                [g, h, i, j],
+            ]);
+            let inv = DMat4::from_mat3(m.matrix3.inverse());
+            let r = inv.transpose() * qm * inv;
+            let k = |x: usize, y: usize| 0.5 * (r.col(x)[y] + r.col(y)[x]);
+            let coeffs = [
+                k(0, 0),
+                k(1, 1),
+                k(2, 2),
+                k(0, 1),
+                k(0, 2),
+                k(1, 2),
+                k(0, 3),
+                k(1, 3),
+                k(2, 3),
+                k(3, 3),
+            ];
+            let t = m.translation;
+            if !t.is_finite() {
+                return None;
+            }
+            Quadric::about(f32v(t), coeffs, None)
+                .ok()
+                .map(|q| Shape::Quadric(Arc::new(q)))
+        }
+        Shape::Plane(p) => {
+            let n = p.normal().as_dvec3();
+            let point = m.transform_point3(n * p.offset());
+            let normal = m.matrix3.inverse().transpose() * n;
+            Plane::from_point_normal(f32v(point), f32v(normal))
+                .ok()
+                .map(Shape::Plane)
+        }
+        Shape::Torus(t) => {
+            let k = similarity_scale(m)?;
+            Torus::new(
+                f32v(m.transform_point3(t.center().as_dvec3())),
+                f32v(m.matrix3 * t.axis().as_dvec3()),
+                (t.major_radius() as f64 * k) as f32,
+                (t.minor_radius() as f64 * k) as f32,
+            )
+            .ok()
+            .map(|t| Shape::Torus(Arc::new(t)))
+        }
+        Shape::Csg(_) | Shape::Quadric(_) => None,
+    }
+}
+
+/// A primitive constructor's message, prefixed with the object type unless it names
+/// the primitive already.
+fn from_constructor(ty: Ty, e: String) -> String {
+    const NAMES: [&str; 9] = [
+        "box",
+        "oriented box",
+        "capped cone",
+        "cylinder",
+        "polyhedron",
+        "prism",
+        "quadric",
+        "plane",
+        "torus",
+    ];
+    if NAMES.iter().any(|n| e.starts_with(n)) {
+        e
+    } else {
+        format!("{}: {e}", ty.name())
     }
 }
 
@@ -377,6 +544,18 @@ impl<'a, 's> Builder<'a, 's> {
             Err(self.err(
                 v.span(),
                 format!("{what} must not have negative components, found {x}"),
+            ))
+        }
+    }
+
+    fn positive3(&self, v: &Spanned<V3>, what: &str) -> R<Vec3> {
+        let x = v3(v.get_ref());
+        if x.min_element() > 0.0 {
+            Ok(f32v(x))
+        } else {
+            Err(self.err(
+                v.span(),
+                format!("{what} must have positive components, found {x}"),
             ))
         }
     }
@@ -901,7 +1080,16 @@ impl<'a, 's> Builder<'a, 's> {
                 };
                 self.bezier(node, &x, m, sink)
             }
-            Ty::Sphere | Ty::Cone => {
+            Ty::Sphere
+            | Ty::Cone
+            | Ty::Cylinder
+            | Ty::CappedCone
+            | Ty::Box
+            | Ty::OBox
+            | Ty::Polyhedron
+            | Ty::Quadric
+            | Ty::Plane
+            | Ty::Torus => {
                 let m = match inherited {
                     Some(m) => m,
                     None => self.fallback_material(sink),
@@ -944,6 +1132,221 @@ impl<'a, 's> Builder<'a, 's> {
                     f32v(a),
                     ra_v as f32,
                 )))
+            }
+            Ty::Box => {
+                let min = self.need(&o.min, "min", node, ty)?;
+                let max = self.need(&o.max, "max", node, ty)?;
+                let b = AaBox::new(f32v(v3(min.get_ref())), f32v(v3(max.get_ref())))
+                    .map_err(|e| self.err(max.span(), from_constructor(ty, e)))?;
+                Ok(Shape::Box(b))
+            }
+            Ty::OBox => {
+                let center = f32v(v3(self.need(&o.center, "center", node, ty)?.get_ref()));
+                let half = match (&o.size, &o.half_size) {
+                    (Some(s), None) => self.positive3(s, "obox `size`")? * 0.5,
+                    (None, Some(h)) => self.positive3(h, "obox `half_size`")?,
+                    (Some(_), Some(h)) => {
+                        return Err(
+                            self.err(h.span(), "an obox takes `size` or `half_size`, not both")
+                        )
+                    }
+                    (None, None) => {
+                        return Err(self.err(
+                            node.span(),
+                            "missing key `size` (or `half_size`) for an obox",
+                        ))
+                    }
+                };
+                let b = match (&o.rotation, &o.axes) {
+                    (Some(r), None) => {
+                        let m = self.transform_list(r)?;
+                        let det = m.matrix3.determinant();
+                        if m.translation != DVec3::ZERO
+                            || !similarity_scale(&m).is_some_and(|s| (s - 1.0).abs() <= 1e-6)
+                            || det < 0.0
+                        {
+                            return Err(self.err(
+                                r.span(),
+                                "an obox `rotation` must be made of rotations only",
+                            ));
+                        }
+                        let q = DQuat::from_mat3(&m.matrix3).as_quat();
+                        OBox::new(center, half, q)
+                            .map_err(|e| self.err(r.span(), from_constructor(ty, e)))?
+                    }
+                    (None, Some(a)) => {
+                        let axes = a.get_ref().map(|v| f32v(v3(&v)));
+                        OBox::from_axes(center, half, axes)
+                            .map_err(|e| self.err(a.span(), from_constructor(ty, e)))?
+                    }
+                    (None, None) => OBox::new(center, half, Quat::IDENTITY)
+                        .map_err(|e| self.err(node.span(), from_constructor(ty, e)))?,
+                    (Some(_), Some(a)) => {
+                        return Err(
+                            self.err(a.span(), "an obox takes `rotation` or `axes`, not both")
+                        )
+                    }
+                };
+                Ok(Shape::OBox(Arc::new(b)))
+            }
+            Ty::Cylinder | Ty::CappedCone => {
+                let base = f32v(v3(self.need(&o.base, "base", node, ty)?.get_ref()));
+                let axis = f32v(self.direction(self.need(&o.axis, "axis", node, ty)?, "`axis`")?);
+                let height =
+                    self.positive(self.need(&o.height, "height", node, ty)?, "`height`")? as f32;
+                let c = if ty == Ty::Cylinder {
+                    let r = self.need(&o.radius, "radius", node, ty)?;
+                    let r = self.positive(r, "cylinder `radius`")? as f32;
+                    CappedCone::cylinder(base, axis, height, r)
+                } else {
+                    let rb = self.need(&o.base_radius, "base_radius", node, ty)?;
+                    let rt = self.need(&o.top_radius, "top_radius", node, ty)?;
+                    let (b, t) = (
+                        self.non_negative(rb, "`base_radius`")? as f32,
+                        self.non_negative(rt, "`top_radius`")? as f32,
+                    );
+                    if b == 0.0 && t == 0.0 {
+                        return Err(self.err(rt.span(), "capped cone radii must not both be zero"));
+                    }
+                    CappedCone::new(base, axis, height, b, t)
+                };
+                Ok(Shape::CappedCone(Arc::new(c.map_err(|e| {
+                    self.err(node.span(), from_constructor(ty, e))
+                })?)))
+            }
+            Ty::Polyhedron => {
+                let center = o
+                    .center
+                    .as_ref()
+                    .map_or(Vec3::ZERO, |c| f32v(v3(c.get_ref())));
+                let p = match (&o.planes, &o.preset, &o.sides) {
+                    (Some(planes), None, None) => {
+                        if let Some((k, span)) = [
+                            ("center", o.center.as_ref().map(|v| v.span())),
+                            ("radius", o.radius.as_ref().map(|v| v.span())),
+                            ("height", o.height.as_ref().map(|v| v.span())),
+                        ]
+                        .into_iter()
+                        .find_map(|(k, s)| s.map(|s| (k, s)))
+                        {
+                            return Err(self.err(span, format!("`{k}` is for a preset or a prism, not a polyhedron given by `planes`")));
+                        }
+                        let mut list = Vec::with_capacity(planes.get_ref().len());
+                        for p in planes.get_ref() {
+                            let [a, b, c, d] = p.get_ref().map(|x| x.0);
+                            let n = DVec3::new(a, b, c);
+                            if n == DVec3::ZERO {
+                                return Err(self.err(p.span(), "a plane's normal must not be zero"));
+                            }
+                            list.push((f32v(n), d as f32));
+                        }
+                        Polyhedron::new(list)
+                            .map_err(|e| self.err(planes.span(), from_constructor(ty, e)))?
+                    }
+                    (None, Some(name), None) => {
+                        if let Some(h) = &o.height {
+                            return Err(self
+                                .err(h.span(), "`height` is for a prism (`sides`), not a preset"));
+                        }
+                        let n = name.get_ref().as_str();
+                        if !Polyhedron::PRESETS
+                            .iter()
+                            .any(|p| p.eq_ignore_ascii_case(n))
+                        {
+                            return Err(self.err(
+                                name.span(),
+                                format!(
+                                    "unknown polyhedron preset `{n}`{}; presets: {}",
+                                    did_you_mean(n, Polyhedron::PRESETS.iter().copied()),
+                                    Polyhedron::PRESETS.join(", ")
+                                ),
+                            ));
+                        }
+                        let r = self.need(&o.radius, "radius", node, ty)?;
+                        let r = self.positive(r, "polyhedron `radius`")? as f32;
+                        Polyhedron::preset(n, center, r)
+                            .map_err(|e| self.err(node.span(), from_constructor(ty, e)))?
+                    }
+                    (None, None, Some(sides)) => {
+                        let r = self.need(&o.radius, "radius", node, ty)?;
+                        let r = self.positive(r, "prism `radius`")? as f32;
+                        let h = self.need(&o.height, "height", node, ty)?;
+                        let h = self.positive(h, "prism `height`")? as f32;
+                        Polyhedron::prism(center, *sides.get_ref(), r, h)
+                            .map_err(|e| self.err(sides.span(), from_constructor(ty, e)))?
+                    }
+                    (None, None, None) => {
+                        return Err(self.err(
+                            node.span(),
+                            "missing key `planes`, `preset` or `sides` for a polyhedron",
+                        ))
+                    }
+                    _ => {
+                        let second = [
+                            o.planes.as_ref().map(|v| v.span()),
+                            o.preset.as_ref().map(|v| v.span()),
+                            o.sides.as_ref().map(|v| v.span()),
+                        ]
+                        .into_iter()
+                        .flatten()
+                        .nth(1)
+                        .unwrap_or(node.span());
+                        return Err(self.err(
+                            second,
+                            "a polyhedron takes one of `planes`, `preset` or `sides`",
+                        ));
+                    }
+                };
+                Ok(Shape::Polyhedron(Arc::new(p)))
+            }
+            Ty::Quadric => {
+                let c = self.need(&o.coefficients, "coefficients", node, ty)?;
+                let coeffs = c.get_ref().map(|x| x.0);
+                let clip = match &o.clip {
+                    Some(b) => {
+                        let (lo, hi) =
+                            (v3(b.get_ref().min.get_ref()), v3(b.get_ref().max.get_ref()));
+                        if !lo.cmplt(hi).all() {
+                            return Err(self.err(
+                                b.span(),
+                                format!("the clip box's `min` {lo} must be below its `max` {hi} on every axis"),
+                            ));
+                        }
+                        Some(Aabb::from_points(f32v(lo), f32v(hi)))
+                    }
+                    None => None,
+                };
+                let q = Quadric::new(coeffs, clip)
+                    .map_err(|e| self.err(c.span(), from_constructor(ty, e)))?;
+                Ok(Shape::Quadric(Arc::new(q)))
+            }
+            Ty::Plane => {
+                let p = self.need(&o.point, "point", node, ty)?;
+                let n = self.need(&o.normal, "normal", node, ty)?;
+                let n = self.direction(n, "plane `normal`")?;
+                let plane = Plane::from_point_normal(f32v(v3(p.get_ref())), f32v(n))
+                    .map_err(|e| self.err(node.span(), from_constructor(ty, e)))?;
+                Ok(Shape::Plane(plane))
+            }
+            Ty::Torus => {
+                let c = self.need(&o.center, "center", node, ty)?;
+                let axis = self.direction(self.need(&o.axis, "axis", node, ty)?, "torus `axis`")?;
+                let major = self.positive(
+                    self.need(&o.major_radius, "major_radius", node, ty)?,
+                    "`major_radius`",
+                )?;
+                let minor = self.positive(
+                    self.need(&o.minor_radius, "minor_radius", node, ty)?,
+                    "`minor_radius`",
+                )?;
+                let t = Torus::new(
+                    f32v(v3(c.get_ref())),
+                    f32v(axis),
+                    major as f32,
+                    minor as f32,
+                )
+                .map_err(|e| self.err(node.span(), from_constructor(ty, e)))?;
+                Ok(Shape::Torus(Arc::new(t)))
             }
             _ => unreachable!("{ty:?} is not an analytic primitive"),
         }
@@ -1170,7 +1573,16 @@ impl<'a, 's> Builder<'a, 's> {
                 self.define_stack.pop();
                 t
             }
-            Ty::Sphere | Ty::Cone => {
+            Ty::Sphere
+            | Ty::Cone
+            | Ty::Cylinder
+            | Ty::CappedCone
+            | Ty::Box
+            | Ty::OBox
+            | Ty::Polyhedron
+            | Ty::Quadric
+            | Ty::Plane
+            | Ty::Torus => {
                 let shape = self.analytic(node, ty)?;
                 if !shape.is_solid() {
                     return Err(self.err(
