@@ -1823,6 +1823,14 @@ fn documentation_examples_build() {
     for ty in [
         "sphere",
         "cone",
+        "cylinder",
+        "capped_cone",
+        "box",
+        "obox",
+        "polyhedron",
+        "quadric",
+        "plane",
+        "torus",
         "triangle",
         "polygon",
         "mesh",
@@ -1833,7 +1841,12 @@ fn documentation_examples_build() {
         "intersection",
         "difference",
     ] {
-        assert!(doc.contains(&format!("`{ty}`")), "`{ty}` undocumented");
+        assert!(
+            doc.contains(&format!("### `{ty}`"))
+                || doc.contains(&format!(", `{ty}`"))
+                || doc.contains(&format!("`{ty}`, ")),
+            "`{ty}` undocumented"
+        );
     }
 }
 
