@@ -1065,6 +1065,46 @@ of = "pair"
 }
 
 #[test]
+fn defines_wrap_any_transformed_solid_and_bake_exact_maps() {
+    let s = build(
+        r#"
+[define.d]
+type = "group"
+children = [
+  { type = "torus", center = [0, 0, 0], axis = [0, 1, 0], major_radius = 2, minor_radius = 0.5, transform = [{ scale = [1, 3, 1] }] },
+  { type = "cone", base = [0, 0, 0], base_radius = 1, apex = [0, 1, 0], transform = [{ rotate = [1, 0, 0], angle = 90 }, { scale = 2 }] },
+  { type = "plane", point = [0, 0, 0], normal = [0, 1, 0], transform = [{ scale = [1, 2, 3] }, { translate = [0, -5, 0] }] },
+]
+
+[[objects]]
+type = "instance"
+of = "d"
+"#,
+    );
+    let obj = &s.objects[0];
+    assert_eq!(
+        (
+            obj.count(Kind::Csg),
+            obj.count(Kind::Cone),
+            obj.count(Kind::Plane)
+        ),
+        (1, 1, 1)
+    );
+    let torus = obj
+        .shapes
+        .items
+        .iter()
+        .find(|s| s.kind() == Kind::Csg)
+        .unwrap();
+    assert!(torus.contains(Vec3::new(2.0, 1.4, 0.0)) && !torus.contains(Vec3::new(2.0, 1.6, 0.0)));
+    assert_close(obj.cones.items[0].apex, Vec3::new(0.0, 0.0, 2.0));
+    let Some(Shape::Plane(p)) = obj.shapes.items.iter().find(|s| s.kind() == Kind::Plane) else {
+        panic!()
+    };
+    assert_eq!((p.normal(), p.offset()), (Vec3::Y, -5.0));
+}
+
+#[test]
 fn nested_csg_classifies_points() {
     let s = build(
         r#"
