@@ -11,7 +11,6 @@
 use super::{Intersect, Shape, ShapeHit, Solid, Span, Spans, SurfacePoint};
 use crate::math::{Aabb, Ray, Vec3, Xform};
 use smallvec::SmallVec;
-use std::sync::Arc;
 
 /// A set operation.
 #[derive(Clone, Copy, Debug, PartialEq, Eq, Hash)]
@@ -113,7 +112,6 @@ pub struct Csg {
     leaves: Vec<Leaf>,
     program: Vec<Step>,
     bounds: Aabb,
-    depth: usize,
 }
 
 /// Deepest nesting accepted (the evaluation stack is sized by it).
@@ -137,9 +135,8 @@ impl Csg {
             leaves: Vec::new(),
             program: Vec::new(),
             bounds: Aabb::EMPTY,
-            depth: 0,
         };
-        let (bounds, depth) = csg.compile(tree, None, 1)?;
+        let bounds = csg.compile(tree, None, 1)?;
         if !bounds.is_finite() && !bounds.is_empty() {
             return Err(
                 "the CSG solid is unbounded (intersect unbounded operands with a bounded solid)"
@@ -147,7 +144,6 @@ impl Csg {
             );
         }
         csg.bounds = bounds;
-        csg.depth = depth;
         Ok(csg)
     }
 
@@ -156,7 +152,7 @@ impl Csg {
         tree: &CsgTree,
         xform: Option<Xform>,
         level: usize,
-    ) -> Result<(Aabb, usize), String> {
+    ) -> Result<Aabb, String> {
         if level > MAX_DEPTH {
             return Err(format!("CSG nested deeper than {MAX_DEPTH} levels"));
         }
@@ -183,11 +179,11 @@ impl Csg {
                     material: *material,
                 });
                 self.program.push(Step::Leaf(id));
-                Ok((b, 1))
+                Ok(b)
             }
             CsgTree::Op { op, a, b } => {
-                let (ba, da) = self.compile(a, xform, level + 1)?;
-                let (bb, db) = self.compile(b, xform, level + 1)?;
+                let ba = self.compile(a, xform, level + 1)?;
+                let bb = self.compile(b, xform, level + 1)?;
                 self.program.push(Step::Op(*op));
                 let bounds = match op {
                     CsgOp::Union => ba.union(&bb),
@@ -197,8 +193,7 @@ impl Csg {
                     },
                     CsgOp::Difference => ba,
                 };
-                // The stack holds the left result while the right one is evaluated.
-                Ok((bounds, da.max(db + 1)))
+                Ok(bounds)
             }
             CsgTree::Transform { xform: x, child } => {
                 let combined = match xform {
@@ -430,6 +425,3 @@ impl Solid for Csg {
         stack.pop().unwrap_or(false)
     }
 }
-
-/// Shared, immutable CSG (cheap to clone into the backends).
-pub type CsgRef = Arc<Csg>;

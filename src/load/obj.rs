@@ -121,15 +121,7 @@ use std::path::Path;
 /// missing. Mid-grey (0.5), fully diffuse, ambient weight 1, no highlight.
 pub const DEFAULT_MATERIAL: Material = Material {
     color: Vec3::splat(0.5),
-    ka: 1.0,
-    kd: 1.0,
-    ks: 0.0,
-    shine: 0.0,
-    kr: 0.0,
-    t: 0.0,
-    ior: 1.0,
-    filter: Vec3::ONE,
-    priority: 0,
+    ..Material::DEFAULT
 };
 
 /// Full vertical field of view of the automatic camera, in degrees.

@@ -117,21 +117,25 @@ pub struct Material {
     pub priority: u32,
 }
 
-impl Default for Material {
+impl Material {
     /// White, fully diffuse: what a primitive before any `f` gets.
+    pub const DEFAULT: Material = Material {
+        color: Vec3::ONE,
+        ka: 1.0,
+        kd: 1.0,
+        ks: 0.0,
+        shine: 0.0,
+        kr: 0.0,
+        t: 0.0,
+        ior: 1.0,
+        filter: Vec3::ONE,
+        priority: 0,
+    };
+}
+
+impl Default for Material {
     fn default() -> Self {
-        Material {
-            color: Vec3::ONE,
-            ka: 1.0,
-            kd: 1.0,
-            ks: 0.0,
-            shine: 0.0,
-            kr: 0.0,
-            t: 0.0,
-            ior: 1.0,
-            filter: Vec3::ONE,
-            priority: 0,
-        }
+        Material::DEFAULT
     }
 }
 

@@ -40,6 +40,43 @@ pub fn sphere(ray: &DRay, center: DVec3, radius: f64, inside_only: bool, tmin: f
     })
 }
 
+/// The line `ray` against the infinite cone through the disk at `base` (radius `rb`)
+/// with unit axis `w` and radius growing by `k` per unit along it: the quadratic
+/// `a t² + 2 b t + c` whose roots are the lateral crossings, with the pieces it is made
+/// of (axial and perpendicular parts of the origin offset and the direction, and the
+/// cone's radius at the origin's axial position).
+pub(crate) struct ConeLine {
+    pub(crate) fs: f64,
+    pub(crate) ds: f64,
+    pub(crate) fp: DVec3,
+    pub(crate) dp: DVec3,
+    pub(crate) r0: f64,
+    pub(crate) a: f64,
+    pub(crate) b: f64,
+    pub(crate) c: f64,
+}
+
+impl ConeLine {
+    pub(crate) fn new(ray: &DRay, base: DVec3, w: DVec3, rb: f64, k: f64) -> ConeLine {
+        let f = ray.org - base;
+        let fs = f.dot(w);
+        let ds = ray.dir.dot(w);
+        let fp = f - w * fs;
+        let dp = ray.dir - w * ds;
+        let r0 = rb + k * fs;
+        ConeLine {
+            fs,
+            ds,
+            fp,
+            dp,
+            r0,
+            a: dp.dot(dp) - k * k * ds * ds,
+            b: dp.dot(fp) - k * ds * r0,
+            c: fp.dot(fp) - r0 * r0,
+        }
+    }
+}
+
 /// Open cone/cylinder between `base` (radius `rb`) and `apex` (radius `ra`).
 pub fn cone(
     ray: &DRay,
@@ -53,15 +90,9 @@ pub fn cone(
     let h = (apex - base).length();
     let w = (apex - base) / h;
     let k = (ra - rb) / h;
-    let f = ray.org - base;
-    let fs = f.dot(w);
-    let ds = ray.dir.dot(w);
-    let fp = f - w * fs;
-    let dp = ray.dir - w * ds;
-    let r0 = rb + k * fs;
-    let a = dp.dot(dp) - k * k * ds * ds;
-    let b = dp.dot(fp) - k * ds * r0;
-    let c = fp.dot(fp) - r0 * r0;
+    let ConeLine {
+        fs, ds, a, b, c, ..
+    } = ConeLine::new(ray, base, w, rb, k);
     solve(a, b, c, tmin, |t| {
         let s = fs + t * ds;
         if !(0.0..=h).contains(&s) {

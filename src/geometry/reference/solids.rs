@@ -4,6 +4,7 @@
 //! independent of the f32 intersectors, which clip intervals (lateral ∩ slab, slabs,
 //! Haines' half-spaces) and never test a point against a face.
 
+use super::ConeLine;
 use crate::math::{DRay, DVec3};
 
 /// Where the line `org + t·dir` crosses a solid's surface, with the outward unit normal
@@ -66,15 +67,16 @@ pub fn capped_cone(
 ) -> Vec<Crossing> {
     let w = axis.normalize();
     let k = (rt - rb) / h;
-    let f = ray.org - base;
-    let fs = f.dot(w);
-    let ds = ray.dir.dot(w);
-    let fp = f - w * fs;
-    let dp = ray.dir - w * ds;
-    let r0 = rb + k * fs;
-    let a = dp.dot(dp) - k * k * ds * ds;
-    let b = dp.dot(fp) - k * ds * r0;
-    let c = fp.dot(fp) - r0 * r0;
+    let ConeLine {
+        fs,
+        ds,
+        fp,
+        dp,
+        r0,
+        a,
+        b,
+        c,
+    } = ConeLine::new(ray, base, w, rb, k);
     // b² − a c by Lagrange's identity, which does not cancel for lines near an apex.
     let disc = (dp * r0 - fp * (k * ds)).length_squared() - dp.cross(fp).length_squared();
     let mut out = Vec::new();
