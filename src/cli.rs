@@ -21,6 +21,82 @@ pub enum Command {
     Render(RenderArgs),
     /// Write a Standard Procedural Database as NFF, as the SPD 3.14 programs do.
     Gen(GenArgs),
+    /// Render many scenes: failures isolated, resumable, split into shards.
+    Batch(BatchArgs),
+    /// Stitch parts rendered with `render --tile` or `--crop` into the whole image.
+    Merge(MergeArgs),
+}
+
+/// `emray batch`.
+#[derive(Args, Debug, Clone)]
+pub struct BatchArgs {
+    /// Scene files, globs (quoted, e.g. 'scenes/*.nff') or `spd:NAME[?size=N]` specs.
+    #[arg(value_name = "SCENE")]
+    pub scenes: Vec<PathBuf>,
+    /// A TOML manifest of jobs (README "Batch rendering"), instead of scene arguments.
+    #[arg(short, long, value_name = "FILE.toml", conflicts_with = "scenes")]
+    pub manifest: Option<PathBuf>,
+    /// Output template: `{stem}`, `{backend}`, `{index}`, `{spp}` [default: `{stem}.png`,
+    /// or the manifest's].
+    #[arg(short, long, value_name = "TEMPLATE")]
+    pub output: Option<String>,
+    /// Ray-query backend (overrides the manifest).
+    #[arg(long, value_enum)]
+    pub backend: Option<BackendArg>,
+    /// Image size, overriding the scenes' (and the manifest's).
+    #[arg(long, value_name = "WxH", value_parser = parse_res)]
+    pub res: Option<(u32, u32)>,
+    /// Samples per pixel (overrides the manifest).
+    #[arg(long, value_parser = clap::value_parser!(u32).range(1..=65536))]
+    pub spp: Option<u32>,
+    /// Maximum ray-tree depth (overrides the manifest).
+    #[arg(long, value_parser = clap::value_parser!(u32).range(1..=64))]
+    pub max_depth: Option<u32>,
+    /// SPD testing mode for every job.
+    #[arg(long)]
+    pub spd: bool,
+    /// PNG value encoding (overrides the manifest).
+    #[arg(long, value_enum)]
+    pub encoding: Option<EncodingArg>,
+    /// Worker threads in all (default: all cores).
+    #[arg(short, long, value_name = "N", value_parser = clap::value_parser!(u32).range(1..=4096))]
+    pub threads: Option<u32>,
+    /// Jobs rendered at once, sharing the threads.
+    #[arg(short, long, value_name = "N", default_value_t = 1, value_parser = clap::value_parser!(u32).range(1..=4096))]
+    pub jobs: u32,
+    /// Run only shard I of N: the jobs whose name hashes (FNV-1a 64) to I modulo N.
+    #[arg(long, value_name = "I/N", value_parser = emray::batch::parse_shard)]
+    pub shard: Option<(u32, u32)>,
+    /// Skip jobs whose output exists and decodes as a whole image (resume).
+    #[arg(long)]
+    pub skip_existing: bool,
+    /// Write a JSON report of every job to FILE (rewritten after each job); `{shard}`
+    /// in the name becomes the shard index.
+    #[arg(long, value_name = "FILE")]
+    pub report: Option<String>,
+    /// Print this shard's jobs (name, scene, output) and exit without rendering.
+    #[arg(long)]
+    pub list: bool,
+    /// Refuse jobs estimated to need more memory (e.g. 8G) [default: 3/4 of RAM].
+    #[arg(long, value_name = "SIZE", value_parser = emray::batch::limits::parse_size)]
+    pub max_memory: Option<u64>,
+    /// No progress, only errors.
+    #[arg(short, long)]
+    pub quiet: bool,
+}
+
+/// `emray merge`.
+#[derive(Args, Debug, Clone)]
+pub struct MergeArgs {
+    /// The parts (EXR files from `render --tile` or `--crop`).
+    #[arg(required = true, value_name = "PART.exr")]
+    pub parts: Vec<PathBuf>,
+    /// The whole image (.exr or .png).
+    #[arg(short, long, value_name = "FULL")]
+    pub output: PathBuf,
+    /// PNG value encoding.
+    #[arg(long, value_enum, default_value_t = EncodingArg::Srgb)]
+    pub encoding: EncodingArg,
 }
 
 /// `emray gen`.
@@ -113,6 +189,15 @@ pub struct RenderArgs {
     /// PNG value encoding.
     #[arg(long, value_enum, default_value_t = EncodingArg::Srgb)]
     pub encoding: EncodingArg,
+    /// Render only band I of N horizontal bands, to an EXR part for `emray merge`.
+    #[arg(long, value_name = "I/N", value_parser = emray::batch::parse_shard, conflicts_with = "crop")]
+    pub tile: Option<(u32, u32)>,
+    /// Render only columns x0..x1 and rows y0..y1 (half-open), to an EXR part.
+    #[arg(long, value_name = "x0,x1,y0,y1", value_parser = emray::batch::parse_crop)]
+    pub crop: Option<emray::Region>,
+    /// Refuse a render estimated to need more memory (e.g. 8G) [default: 3/4 of RAM].
+    #[arg(long, value_name = "SIZE", value_parser = emray::batch::limits::parse_size)]
+    pub max_memory: Option<u64>,
     /// No progress bar and no messages but errors.
     #[arg(short, long)]
     pub quiet: bool,
@@ -136,8 +221,26 @@ impl RenderArgs {
             stats: false,
             stats_json: None,
             encoding: EncodingArg::Srgb,
+            tile: None,
+            crop: None,
+            max_memory: None,
             quiet: false,
             verbose: 0,
+        }
+    }
+}
+
+impl BatchArgs {
+    /// The settings that override every job's.
+    pub fn overrides(&self) -> emray::batch::manifest::Overrides {
+        emray::batch::manifest::Overrides {
+            output: self.output.clone(),
+            backend: self.backend.map(Backend::from),
+            res: self.res,
+            spp: self.spp,
+            max_depth: self.max_depth,
+            spd: self.spd,
+            encoding: self.encoding.map(Encoding::from),
         }
     }
 }

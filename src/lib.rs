@@ -8,6 +8,7 @@
 #![warn(missing_docs)]
 
 pub mod accel;
+pub mod batch;
 pub mod gen;
 pub mod geometry;
 pub mod load;
@@ -18,5 +19,5 @@ pub mod run;
 pub mod scene;
 
 pub use accel::{Accel, Backend, Hit};
-pub use render::{RenderSettings, RenderStats};
+pub use render::{Region, RenderSettings, RenderStats};
 pub use scene::Scene;

@@ -8,7 +8,6 @@ use cli::{Cli, Command, RenderArgs};
 use emray::accel::Backend;
 use emray::gen::Database;
 use emray::load;
-use emray::render::RenderSettings;
 use emray::Scene;
 use std::io::{IsTerminal, Write};
 use std::path::{Path, PathBuf};
@@ -23,18 +22,11 @@ fn main() -> ExitCode {
     let args = match cli.command {
         Some(Command::Render(a)) => a,
         Some(Command::Gen(g)) => return gen(&g),
+        Some(Command::Batch(b)) => return batch(&b),
+        Some(Command::Merge(m)) => return merge(&m),
         None => RenderArgs::default_scene(),
     };
-    let level = match (args.quiet, args.verbose) {
-        (true, _) => "error",
-        (false, 0) => "warn",
-        (false, 1) => "info",
-        (false, 2) => "debug",
-        _ => "trace",
-    };
-    env_logger::Builder::from_env(env_logger::Env::default().default_filter_or(level))
-        .format_timestamp(None)
-        .init();
+    init_log(args.quiet, args.verbose);
     let jobs = match plan(&args) {
         Ok(j) => j,
         Err(e) => {
@@ -46,6 +38,116 @@ fn main() -> ExitCode {
         Ok(()) => ExitCode::SUCCESS,
         Err(e) => {
             eprintln!("emray: error: {e:#}");
+            ExitCode::from(1)
+        }
+    }
+}
+
+fn init_log(quiet: bool, verbose: u8) {
+    let level = match (quiet, verbose) {
+        (true, _) => "error",
+        (false, 0) => "warn",
+        (false, 1) => "info",
+        (false, 2) => "debug",
+        _ => "trace",
+    };
+    env_logger::Builder::from_env(env_logger::Env::default().default_filter_or(level))
+        .format_timestamp(None)
+        .init();
+}
+
+/// `emray batch`: exit 2 on a usage error (nothing run), 1 when a job failed, 130 when
+/// interrupted, else 0.
+fn batch(b: &cli::BatchArgs) -> ExitCode {
+    use emray::batch;
+    init_log(b.quiet, 0);
+    let usage = |e: String| {
+        eprintln!("emray: error: {e}");
+        ExitCode::from(2)
+    };
+    let jobs = match &b.manifest {
+        Some(m) => match batch::manifest::load(m, &b.overrides()) {
+            Ok(j) => j,
+            Err(e) => {
+                eprintln!("emray: error: {e}");
+                return ExitCode::from(1);
+            }
+        },
+        None if b.scenes.is_empty() => {
+            return usage("give scene files, globs or --manifest FILE".into())
+        }
+        None => {
+            let settings = batch::JobSettings {
+                backend: b.backend.map(Backend::from),
+                res: b.res,
+                spp: b.spp,
+                max_depth: b.max_depth,
+                spd: b.spd,
+                encoding: b.encoding.map(Into::into).unwrap_or_default(),
+            };
+            let template = b.output.as_deref().unwrap_or("{stem}.png");
+            match batch::expand_scene_args(&b.scenes)
+                .and_then(|s| batch::jobs_from_scenes(&s, template, &settings))
+            {
+                Ok(j) => j,
+                Err(e) => return usage(e),
+            }
+        }
+    };
+    if let Err(e) = batch::check_jobs(&jobs) {
+        return usage(e);
+    }
+    let jobs: Vec<batch::Job> = match b.shard {
+        Some((i, n)) => jobs
+            .into_iter()
+            .filter(|j| batch::shard_of(&j.name, n) == i)
+            .collect(),
+        None => jobs,
+    };
+    if b.list {
+        for j in &jobs {
+            println!("{}\t{}\t{}", j.name, j.scene.display(), j.output.display());
+        }
+        return ExitCode::SUCCESS;
+    }
+    let shard_index = b.shard.map_or(0, |(i, _)| i);
+    let opts = batch::BatchOptions {
+        threads: b.threads.map(|t| t as usize),
+        jobs: b.jobs as usize,
+        skip_existing: b.skip_existing,
+        report: b
+            .report
+            .as_ref()
+            .map(|r| PathBuf::from(r.replace("{shard}", &shard_index.to_string()))),
+        quiet: b.quiet,
+        max_memory: b
+            .max_memory
+            .unwrap_or_else(batch::limits::default_max_memory),
+        shard: b.shard,
+    };
+    let report = batch::run(jobs, &opts);
+    if report.failed > 0 {
+        eprintln!(
+            "emray: error: {} of {} jobs failed",
+            report.failed, report.total
+        );
+    }
+    ExitCode::from(report.exit_code())
+}
+
+/// `emray merge`: exit 1 when the parts do not make one image or cannot be written.
+fn merge(m: &cli::MergeArgs) -> ExitCode {
+    let result = emray::output::Format::from_path(&m.output)
+        .map_err(|e| e.to_string())
+        .and_then(|_| emray::batch::merge::merge(&m.parts))
+        .and_then(|film| {
+            emray::output::write_image(&m.output, &film, m.encoding.into())
+                .map_err(|e| e.to_string())
+        });
+    match result {
+        Ok(()) => ExitCode::SUCCESS,
+        Err(e) => {
+            eprintln!("emray: error: {e}");
             ExitCode::from(1)
         }
     }
@@ -84,20 +186,9 @@ fn gen(g: &cli::GenArgs) -> ExitCode {
     }
 }
 
-/// The file-name stem of a scene: the file's, or `NAME_sN` for a generated one.
-fn scene_stem(scene: &Path) -> String {
-    if let Ok(Some((db, size))) = Database::parse_spec(&scene.to_string_lossy()) {
-        return format!("{}_s{size}", db.name());
-    }
-    scene
-        .file_stem()
-        .map(|s| s.to_string_lossy().into_owned())
-        .unwrap_or_else(|| "emray".into())
-}
-
 /// Where scene `scene` goes.
 fn output_for(args: &RenderArgs, scene: &Path) -> PathBuf {
-    let stem = scene_stem(scene);
+    let stem = emray::batch::scene_stem(scene);
     PathBuf::from(match &args.output {
         Some(t) if t.contains("{stem}") => t.replace("{stem}", &stem),
         Some(t) => t.clone(),
@@ -128,6 +219,20 @@ fn plan(args: &RenderArgs) -> Result<Vec<Job>, String> {
             .map(|s| (Some(s.clone()), output_for(args, s)))
             .collect()
     };
+    if args.tile.is_some() || args.crop.is_some() {
+        if jobs.len() != 1 {
+            return Err("--tile and --crop render one scene".into());
+        }
+        if !matches!(
+            emray::output::Format::from_path(&jobs[0].1),
+            Ok(emray::output::Format::Exr)
+        ) {
+            return Err(format!(
+                "--tile and --crop write an EXR part (for emray merge), not '{}'",
+                jobs[0].1.display()
+            ));
+        }
+    }
     for (scene, out) in &jobs {
         emray::output::Format::from_path(out).map_err(|e| e.to_string())?;
         if let Some(s) = scene {
@@ -163,43 +268,46 @@ fn render_all(args: &RenderArgs, jobs: &[Job]) -> Result<()> {
 fn render_one(args: &RenderArgs, scene_path: Option<&Path>, out: &Path) -> Result<()> {
     let t0 = Instant::now();
     let (name, scene): (String, Scene) = match scene_path {
-        Some(p) => {
-            let name = p.display().to_string();
-            match Database::parse_spec(&name).map_err(anyhow::Error::msg)? {
-                Some((db, size)) => {
-                    let text = db.generate(size);
-                    (name.clone(), load::nff::parse_str(&text, p)?)
-                }
-                None => (name, load::load_path(p)?),
-            }
-        }
+        Some(p) => (
+            p.display().to_string(),
+            emray::batch::load_scene(p).map_err(anyhow::Error::msg)?,
+        ),
         None => (
             "default".into(),
             load::nff::parse_str(DEFAULT_SCENE, Path::new("<default scene>"))?,
         ),
     };
     let load_ms = t0.elapsed().as_secs_f64() * 1e3;
-    let mut settings = RenderSettings::for_scene(&scene);
-    if let Some((w, h)) = args.res {
-        settings.width = w;
-        settings.height = h;
+    let job = emray::batch::JobSettings {
+        backend: args.backend.map(Backend::from),
+        res: args.res,
+        spp: args.spp,
+        max_depth: args.max_depth,
+        spd: args.spd,
+        encoding: args.encoding.into(),
+    };
+    let mut settings = job.apply(&scene);
+    let backend = job.backend();
+    let (w, h) = (settings.width, settings.height);
+    settings.region = match (args.tile, args.crop) {
+        (Some((i, n)), _) => Some(emray::Region::band(i, n, w, h)),
+        (None, Some(c)) if !c.fits(w, h) => bail!(
+            "{name}: crop {},{},{},{} is not inside the {w}x{h} image",
+            c.x0,
+            c.x1,
+            c.y0,
+            c.y1
+        ),
+        (None, c) => c,
+    };
+    if settings.region.is_some_and(|r| r.height() == 0) {
+        bail!("{name}: --tile leaves no rows for this part of a {h}-row image (use fewer tiles)");
     }
-    settings.spp = args.spp.or(scene.render.spp).unwrap_or(1);
-    settings.max_depth = args.max_depth.or(scene.render.max_depth).unwrap_or(5);
-    if args.spd {
-        // SPD testing mode: 512x512 from a 513x513 corner grid, depth 5, one sample.
-        if args.res.is_none() {
-            settings.width = 512;
-            settings.height = 512;
-        }
-        settings.spd = true;
-        settings.spp = 1;
-        settings.max_depth = 5;
-    }
-    let backend: Backend = args
-        .backend
-        .map(Backend::from)
-        .unwrap_or_else(Backend::default_available);
+    let max_memory = args
+        .max_memory
+        .unwrap_or_else(emray::batch::limits::default_max_memory);
+    emray::batch::limits::check(Path::new(&name), &scene, &settings, max_memory)
+        .map_err(anyhow::Error::msg)?;
 
     let show_bar = !args.quiet && std::io::stderr().is_terminal();
     let bar = show_bar.then(|| {
@@ -225,7 +333,17 @@ fn render_one(args: &RenderArgs, scene_path: Option<&Path>, out: &Path) -> Resul
     if let Some(b) = &bar {
         b.finish_and_clear();
     }
-    emray::output::write_image(out, &film, args.encoding.into())?;
+    match settings.region {
+        Some(region) => {
+            let info = emray::output::part::PartInfo {
+                full: (w, h),
+                region,
+                hash: Some(emray::batch::merge::render_hash(&scene, &settings, backend)),
+            };
+            emray::output::part::write_exr(out, &film, Some(&info))?
+        }
+        None => emray::output::write_image(out, &film, args.encoding.into())?,
+    }
     if args.stats {
         println!("{}\noutput     {}", report.summary(), out.display());
     } else if !args.quiet {

@@ -2,6 +2,8 @@
 //! file extension, always written to a temporary file beside the target and renamed,
 //! so a failed or interrupted write never leaves a truncated image.
 
+pub mod part;
+
 use crate::render::Film;
 use std::fs;
 use std::io::{BufWriter, Write};
@@ -101,48 +103,41 @@ pub fn differing_pixels(a: &Film, b: &Film) -> usize {
 
 /// Write `film` to `path` (format by extension) through a temporary file and a rename.
 pub fn write_image(path: &Path, film: &Film, encoding: Encoding) -> Result<(), OutputError> {
-    let format = Format::from_path(path)?;
-    let err = |e: &dyn std::fmt::Display| OutputError::Write {
+    match Format::from_path(path)? {
+        Format::Png => write_atomic(path, |file| {
+            let mut w = BufWriter::new(file);
+            let enc = image::codecs::png::PngEncoder::new(&mut w);
+            image::ImageEncoder::write_image(
+                enc,
+                &to_rgb8(film, encoding),
+                film.width,
+                film.height,
+                image::ExtendedColorType::Rgb8,
+            )
+            .map_err(|e| e.to_string())?;
+            let file = w.into_inner().map_err(|e| e.into_error().to_string())?;
+            file.sync_all().map_err(|e| e.to_string())
+        }),
+        Format::Exr => part::write_exr(path, film, None),
+    }
+}
+
+/// Write `path` through a temporary file beside it that `write` fills, then a rename;
+/// on failure the temporary file is removed and the target left as it was.
+pub(crate) fn write_atomic(
+    path: &Path,
+    write: impl FnOnce(fs::File) -> Result<(), String>,
+) -> Result<(), OutputError> {
+    let err = |message: String| OutputError::Write {
         path: path.to_path_buf(),
-        message: e.to_string(),
+        message,
     };
     let tmp = temp_name(path);
-    let result = (|| -> Result<(), OutputError> {
-        match format {
-            Format::Png => {
-                let file = fs::File::create(&tmp).map_err(|e| err(&e))?;
-                let mut w = BufWriter::new(file);
-                let enc = image::codecs::png::PngEncoder::new(&mut w);
-                image::ImageEncoder::write_image(
-                    enc,
-                    &to_rgb8(film, encoding),
-                    film.width,
-                    film.height,
-                    image::ExtendedColorType::Rgb8,
-                )
-                .map_err(|e| err(&e))?;
-                let file = w.into_inner().map_err(|e| err(&e.into_error()))?;
-                file.sync_all().map_err(|e| err(&e))?;
-            }
-            Format::Exr => {
-                let (w, h) = (film.width as usize, film.height as usize);
-                let px = &film.pixels;
-                let channels =
-                    exr::prelude::SpecificChannels::rgb(|p: exr::prelude::Vec2<usize>| {
-                        let v = px[p.y() * w + p.x()];
-                        (v.x, v.y, v.z)
-                    });
-                let image = exr::prelude::Image::from_channels((w, h), channels);
-                let file = fs::File::create(&tmp).map_err(|e| err(&e))?;
-                let mut bw = BufWriter::new(file);
-                exr::prelude::WritableImage::write(&image)
-                    .to_buffered(&mut bw)
-                    .map_err(|e| err(&e))?;
-                bw.flush().map_err(|e| err(&e))?;
-            }
-        }
-        fs::rename(&tmp, path).map_err(|e| err(&e))
-    })();
+    let result = fs::File::create(&tmp)
+        .map_err(|e| e.to_string())
+        .and_then(write)
+        .and_then(|()| fs::rename(&tmp, path).map_err(|e| e.to_string()))
+        .map_err(err);
     if result.is_err() {
         let _ = fs::remove_file(&tmp);
     }
@@ -151,18 +146,47 @@ pub fn write_image(path: &Path, film: &Film, encoding: Encoding) -> Result<(), O
 
 /// Write a text file through a temporary file and a rename.
 pub fn write_text(path: &Path, text: &str) -> Result<(), OutputError> {
-    let err = |e: &dyn std::fmt::Display| OutputError::Write {
-        path: path.to_path_buf(),
-        message: e.to_string(),
+    write_atomic(path, |mut f| {
+        f.write_all(text.as_bytes()).map_err(|e| e.to_string())
+    })
+}
+
+/// Remove temporary files that an earlier, killed process left for `path` (their
+/// names are `.NAME.PID.tmp`); returns how many went.
+pub fn remove_stale_temps(path: &Path) -> usize {
+    let (Some(dir), Some(name)) = (path.parent(), path.file_name()) else {
+        return 0;
     };
-    let tmp = temp_name(path);
-    let result = fs::write(&tmp, text)
-        .and_then(|()| fs::rename(&tmp, path))
-        .map_err(|e| err(&e));
-    if result.is_err() {
-        let _ = fs::remove_file(&tmp);
+    let dir = if dir.as_os_str().is_empty() {
+        Path::new(".")
+    } else {
+        dir
+    };
+    let prefix = format!(".{}.", name.to_string_lossy());
+    let Ok(entries) = fs::read_dir(dir) else {
+        return 0;
+    };
+    let mut removed = 0;
+    for e in entries.flatten() {
+        let n = e.file_name().to_string_lossy().into_owned();
+        let stale = n
+            .strip_prefix(&prefix)
+            .and_then(|rest| rest.strip_suffix(".tmp"))
+            .is_some_and(|pid| !pid.is_empty() && pid.bytes().all(|b| b.is_ascii_digit()));
+        if stale && fs::remove_file(e.path()).is_ok() {
+            removed += 1;
+        }
     }
-    result
+    removed
+}
+
+/// Whether `path` holds a whole image that decodes (what a resumed batch trusts).
+pub fn is_complete_image(path: &Path) -> bool {
+    match Format::from_path(path) {
+        Ok(Format::Png) => image::open(path).is_ok(),
+        Ok(Format::Exr) => part::read_exr(path).is_ok(),
+        Err(_) => false,
+    }
 }
 
 /// A hidden temporary name in the same directory (so the rename is atomic).

@@ -31,6 +31,61 @@ pub struct RenderSettings {
     pub spd: bool,
     /// Tile edge in pixels.
     pub tile: u32,
+    /// Render only this part of the image (`None`: all of it). The film then holds
+    /// the region alone; every pixel comes out as in the full render.
+    pub region: Option<Region>,
+}
+
+/// A rectangle of pixels, `x0..x1` by `y0..y1` (half-open, from the top-left).
+#[derive(Clone, Copy, Debug, PartialEq, Eq, Hash)]
+pub struct Region {
+    /// First column.
+    pub x0: u32,
+    /// One past the last column.
+    pub x1: u32,
+    /// First row.
+    pub y0: u32,
+    /// One past the last row.
+    pub y1: u32,
+}
+
+impl Region {
+    /// The whole `width × height` image.
+    pub fn full(width: u32, height: u32) -> Self {
+        Region {
+            x0: 0,
+            x1: width,
+            y0: 0,
+            y1: height,
+        }
+    }
+
+    /// Band `index` of `count` horizontal bands of a `width × height` image (rows split
+    /// as evenly as they go; the bands cover the image exactly once).
+    pub fn band(index: u32, count: u32, width: u32, height: u32) -> Self {
+        let row = |k: u32| (k as u64 * height as u64 / count.max(1) as u64) as u32;
+        Region {
+            x0: 0,
+            x1: width,
+            y0: row(index),
+            y1: row(index + 1),
+        }
+    }
+
+    /// Width in pixels.
+    pub fn width(&self) -> u32 {
+        self.x1 - self.x0
+    }
+
+    /// Height in pixels.
+    pub fn height(&self) -> u32 {
+        self.y1 - self.y0
+    }
+
+    /// Whether the region is non-empty and inside a `width × height` image.
+    pub fn fits(&self, width: u32, height: u32) -> bool {
+        self.x0 < self.x1 && self.y0 < self.y1 && self.x1 <= width && self.y1 <= height
+    }
 }
 
 impl RenderSettings {
@@ -43,6 +98,7 @@ impl RenderSettings {
             max_depth: 5,
             spd: false,
             tile: 16,
+            region: None,
         }
     }
 }
@@ -82,22 +138,28 @@ pub fn render<A: Accel>(
     let (gw, gh) = if settings.spd { (w + 1, h + 1) } else { (w, h) };
     let gen = RayGen::new(&scene.camera, gw, gh);
     let tracer = whitted::Tracer::new(scene, accel, settings);
+    // The samples of the region: pixel (i, j) of the image is sample (i, j) of the
+    // grid, wherever the region is, so a part is the full render's pixels exactly.
+    let r = settings.region.unwrap_or(Region::full(w, h));
+    let extra = u32::from(settings.spd);
+    let (ox, oy) = (r.x0, r.y0);
+    let (rw, rh) = (r.width() + extra, r.height() + extra);
     let ts = settings.tile.max(1);
-    let tiles: Vec<(u32, u32)> = (0..gh.div_ceil(ts))
-        .flat_map(|ty| (0..gw.div_ceil(ts)).map(move |tx| (tx * ts, ty * ts)))
+    let tiles: Vec<(u32, u32)> = (0..rh.div_ceil(ts))
+        .flat_map(|ty| (0..rw.div_ceil(ts)).map(move |tx| (tx * ts, ty * ts)))
         .collect();
     let done = AtomicUsize::new(0);
     let total = tiles.len();
     let results: Vec<(Vec<glam::Vec3>, RayCounts)> = tiles
         .par_iter()
         .map(|&(x0, y0)| {
-            let x1 = (x0 + ts).min(gw);
-            let y1 = (y0 + ts).min(gh);
+            let x1 = (x0 + ts).min(rw);
+            let y1 = (y0 + ts).min(rh);
             let mut counts = RayCounts::default();
             let mut px = Vec::with_capacity(((x1 - x0) * (y1 - y0)) as usize);
             for j in y0..y1 {
                 for i in x0..x1 {
-                    px.push(tracer.pixel(&gen, i, j, &mut counts));
+                    px.push(tracer.pixel(&gen, ox + i, oy + j, &mut counts));
                 }
             }
             if let Some(p) = progress {
@@ -106,13 +168,13 @@ pub fn render<A: Accel>(
             (px, counts)
         })
         .collect();
-    let mut grid = Film::new(gw, gh);
+    let mut grid = Film::new(rw, rh);
     let mut rays = RayCounts::default();
     for (&(x0, y0), (px, counts)) in tiles.iter().zip(results) {
         rays += counts;
-        let x1 = (x0 + ts).min(gw);
+        let x1 = (x0 + ts).min(rw);
         let mut it = px.into_iter();
-        for j in y0..(y0 + ts).min(gh) {
+        for j in y0..(y0 + ts).min(rh) {
             for i in x0..x1 {
                 grid.set(i, j, it.next().expect("tile size"));
             }

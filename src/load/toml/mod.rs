@@ -86,6 +86,17 @@ fn parse_file_in(source: &Source) -> Result<SceneFile, LoadError> {
     })
 }
 
+/// Read and deserialise a TOML file other than a scene (a batch manifest), with errors
+/// at their `path:line:col`.
+pub(crate) fn parse_toml_file<T: serde::de::DeserializeOwned>(path: &Path) -> Result<T, LoadError> {
+    let text = read_text(path)?;
+    let source = Source::new(path, &text);
+    ::toml::from_str::<T>(&text).map_err(|e| {
+        let span = e.span().unwrap_or(0..0);
+        source.err(span, serde_message(e.message()))
+    })
+}
+
 /// The file's bytes as text (invalid UTF-8 is an error: TOML requires UTF-8).
 pub(crate) fn read_text(path: &Path) -> Result<String, LoadError> {
     let bytes = std::fs::read(path).map_err(|e| LoadError {

@@ -1,0 +1,133 @@
+//! Memory limits: a render is refused, with the numbers, before its large buffers and
+//! the acceleration structure are allocated, when its estimate exceeds the limit.
+
+use crate::render::{Region, RenderSettings};
+use crate::Scene;
+use std::path::Path;
+
+/// Bytes per primitive allowed for the acceleration structure (either backend's nodes
+/// and references, with room to spare).
+pub const ACCEL_BYTES_PER_PRIM: u64 = 160;
+
+/// The estimated peak bytes of rendering `scene` with `settings`: the sample grid, the
+/// tiles' results, the 8-bit copy for PNG, and the acceleration structure.
+pub fn estimate_bytes(scene: &Scene, settings: &RenderSettings) -> u64 {
+    let r = settings
+        .region
+        .unwrap_or(Region::full(settings.width, settings.height));
+    let extra = u64::from(settings.spd);
+    let samples = (r.width() as u64 + extra) * (r.height() as u64 + extra);
+    let prims = scene.prim_count() as u64
+        + scene
+            .objects
+            .iter()
+            .map(|o| o.prim_count() as u64)
+            .sum::<u64>()
+        + scene.instances.len() as u64;
+    // Grid + per-tile results (12 bytes each) + the averaged film + 3 bytes of PNG.
+    samples * 12 * 2 + r.width() as u64 * r.height() as u64 * 15 + prims * ACCEL_BYTES_PER_PRIM
+}
+
+/// The default limit: three quarters of the machine's memory (`/proc/meminfo`), else
+/// 16 GiB.
+pub fn default_max_memory() -> u64 {
+    std::fs::read_to_string("/proc/meminfo")
+        .ok()
+        .and_then(|t| {
+            t.lines()
+                .find_map(|l| l.strip_prefix("MemTotal:"))
+                .and_then(|v| v.trim().trim_end_matches("kB").trim().parse::<u64>().ok())
+        })
+        .map(|kib| kib * 1024 / 4 * 3)
+        .unwrap_or(16 << 30)
+}
+
+/// Parse a size: bytes, or a number with `K`, `M`, `G` or `T` (binary multiples;
+/// `KiB`/`KB`-style suffixes are accepted too).
+pub fn parse_size(s: &str) -> Result<u64, String> {
+    let t = s.trim();
+    let bad = || format!("'{s}' is not a size (e.g. 512M, 4G, 1.5G, 1000000)");
+    let split = t
+        .find(|c: char| !(c.is_ascii_digit() || c == '.'))
+        .unwrap_or(t.len());
+    let (num, unit) = t.split_at(split);
+    let v: f64 = num.parse().map_err(|_| bad())?;
+    let unit = unit.trim().to_ascii_uppercase();
+    let shift = match unit.trim_end_matches('B').trim_end_matches('I') {
+        "" => 0,
+        "K" => 10,
+        "M" => 20,
+        "G" => 30,
+        "T" => 40,
+        _ => return Err(bad()),
+    };
+    let bytes = v * (1u64 << shift) as f64;
+    if !bytes.is_finite() || bytes < 1.0 || bytes > u64::MAX as f64 / 2.0 {
+        return Err(bad());
+    }
+    Ok(bytes as u64)
+}
+
+/// Human-readable bytes.
+pub fn format_bytes(b: u64) -> String {
+    let gib = b as f64 / (1u64 << 30) as f64;
+    if gib >= 1.0 {
+        format!("{gib:.1} GiB")
+    } else {
+        format!("{:.1} MiB", b as f64 / (1u64 << 20) as f64)
+    }
+}
+
+/// Refuse the render when its estimate is over `max` bytes.
+pub fn check(
+    scene_path: &Path,
+    scene: &Scene,
+    settings: &RenderSettings,
+    max: u64,
+) -> Result<(), String> {
+    let need = estimate_bytes(scene, settings);
+    if need > max {
+        return Err(format!(
+            "{}: rendering {}x{} with {} primitives needs about {}, over the memory limit of {} (--max-memory)",
+            scene_path.display(),
+            settings.width,
+            settings.height,
+            scene.prim_count(),
+            format_bytes(need),
+            format_bytes(max)
+        ));
+    }
+    Ok(())
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+
+    #[test]
+    fn sizes_parse() {
+        assert_eq!(parse_size("1000"), Ok(1000));
+        assert_eq!(parse_size("512M"), Ok(512 << 20));
+        assert_eq!(parse_size("4GiB"), Ok(4 << 30));
+        assert_eq!(parse_size("1.5g"), Ok(3 << 29));
+        assert!(parse_size("lots").is_err());
+        assert!(parse_size("0").is_err());
+        assert!(parse_size("5Q").is_err());
+    }
+
+    #[test]
+    fn big_images_are_refused_with_numbers() {
+        let scene = crate::load::nff::parse_str(
+            "v\nfrom 0 0 5\nat 0 0 0\nup 0 1 0\nangle 40\nhither 1\nresolution 8 8\ns 0 0 0 1\n",
+            Path::new("t.nff"),
+        )
+        .unwrap();
+        let mut s = RenderSettings::for_scene(&scene);
+        assert!(check(Path::new("t.nff"), &scene, &s, 1 << 20).is_ok());
+        s.width = 30000;
+        s.height = 30000;
+        let e = check(Path::new("t.nff"), &scene, &s, 1 << 30).unwrap_err();
+        assert!(e.starts_with("t.nff: rendering 30000x30000"), "{e}");
+        assert!(e.contains("--max-memory"), "{e}");
+    }
+}

@@ -1,0 +1,126 @@
+//! OpenEXR files that hold a part of an image: the data window is the part, the display
+//! window the whole image, and a text attribute `emray_hash` names the scene and
+//! settings it was rendered from, so that `emray merge` can check the parts belong
+//! together.
+
+use super::{write_atomic, OutputError};
+use crate::render::{Film, Region};
+use exr::prelude::{
+    read, AttributeValue, Image, ImageAttributes, IntegerBounds, Layer, LayerAttributes,
+    ReadChannels, ReadLayers, SpecificChannels, Text, Vec2, WritableImage,
+};
+use glam::Vec3;
+use std::io::BufWriter;
+use std::path::Path;
+
+/// The attribute holding the scene-and-settings hash.
+pub const HASH_ATTRIBUTE: &str = "emray_hash";
+
+/// Where a part lies and what it was rendered from.
+#[derive(Clone, Debug, PartialEq, Eq)]
+pub struct PartInfo {
+    /// Size of the whole image.
+    pub full: (u32, u32),
+    /// The pixels the part holds.
+    pub region: Region,
+    /// Scene-and-settings hash, if the file has one.
+    pub hash: Option<String>,
+}
+
+/// Write `film` as a linear f32 RGB EXR. With `part`, `film` is `part.region` of a
+/// `part.full` image: the data window says so and the hash is stored.
+pub fn write_exr(path: &Path, film: &Film, part: Option<&PartInfo>) -> Result<(), OutputError> {
+    let (w, h) = (film.width as usize, film.height as usize);
+    let (full, origin) = match part {
+        Some(p) => (
+            (p.full.0 as usize, p.full.1 as usize),
+            (p.region.x0 as i32, p.region.y0 as i32),
+        ),
+        None => ((w, h), (0, 0)),
+    };
+    let px = &film.pixels;
+    let channels = SpecificChannels::rgb(|p: Vec2<usize>| {
+        let v = px[p.y() * w + p.x()];
+        (v.x, v.y, v.z)
+    });
+    let mut layer_attributes = LayerAttributes {
+        layer_position: Vec2(origin.0, origin.1),
+        ..LayerAttributes::default()
+    };
+    if let Some(hash) = part.and_then(|p| p.hash.as_deref()) {
+        let text = Text::new_or_none(hash).ok_or_else(|| OutputError::Write {
+            path: path.to_path_buf(),
+            message: "the part hash is not plain text".into(),
+        })?;
+        layer_attributes
+            .other
+            .insert(Text::from(HASH_ATTRIBUTE), AttributeValue::Text(text));
+    }
+    let layer = Layer::new(
+        (w, h),
+        layer_attributes,
+        exr::image::Encoding::FAST_LOSSLESS,
+        channels,
+    );
+    let attributes = ImageAttributes::new(IntegerBounds::new((0, 0), full));
+    let image = Image::new(attributes, layer);
+    write_atomic(path, |file| {
+        let mut bw = BufWriter::new(file);
+        image
+            .write()
+            .to_buffered(&mut bw)
+            .map_err(|e| e.to_string())?;
+        let file = bw.into_inner().map_err(|e| e.into_error().to_string())?;
+        file.sync_all().map_err(|e| e.to_string())
+    })
+}
+
+/// Read an RGB EXR: its pixels (the data window) and where they lie.
+pub fn read_exr(path: &Path) -> Result<(Film, PartInfo), String> {
+    let image = read()
+        .no_deep_data()
+        .largest_resolution_level()
+        .rgb_channels(
+            |size, _| Film::new(size.x() as u32, size.y() as u32),
+            |film: &mut Film, pos, (r, g, b): (f32, f32, f32)| {
+                film.set(pos.x() as u32, pos.y() as u32, Vec3::new(r, g, b))
+            },
+        )
+        .first_valid_layer()
+        .all_attributes()
+        .from_file(path)
+        .map_err(|e| format!("{}: not a readable RGB EXR: {e}", path.display()))?;
+    let display = image.attributes.display_window;
+    let layer = image.layer_data;
+    let pos = layer.attributes.layer_position;
+    let (dx, dy) = (display.position.x(), display.position.y());
+    let (fw, fh) = (display.size.x(), display.size.y());
+    let film = layer.channel_data.pixels;
+    let (x0, y0) = (pos.x() - dx, pos.y() - dy);
+    let fits = x0 >= 0
+        && y0 >= 0
+        && x0 as u64 + film.width as u64 <= fw as u64
+        && y0 as u64 + film.height as u64 <= fh as u64;
+    if !fits || fw > u32::MAX as usize || fh > u32::MAX as usize {
+        return Err(format!(
+            "{}: the data window lies outside the display window",
+            path.display()
+        ));
+    }
+    let region = Region {
+        x0: x0 as u32,
+        x1: x0 as u32 + film.width,
+        y0: y0 as u32,
+        y1: y0 as u32 + film.height,
+    };
+    let hash = match layer.attributes.other.get(&Text::from(HASH_ATTRIBUTE)) {
+        Some(AttributeValue::Text(t)) => Some(t.to_string()),
+        _ => None,
+    };
+    let info = PartInfo {
+        full: (fw as u32, fh as u32),
+        region,
+        hash,
+    };
+    Ok((film, info))
+}
