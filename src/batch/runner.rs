@@ -6,7 +6,7 @@ use serde::Serialize;
 use std::io::IsTerminal;
 use std::path::{Path, PathBuf};
 use std::sync::atomic::{AtomicBool, AtomicUsize, Ordering};
-use std::sync::{mpsc, Arc, Once};
+use std::sync::{mpsc, Arc, Once, RwLock};
 use std::time::{Duration, Instant};
 
 /// How to run a batch.
@@ -112,6 +112,11 @@ impl BatchReport {
 /// Set by Ctrl-C.
 static STOP: AtomicBool = AtomicBool::new(false);
 
+/// Workers hold it shared while they write an image (after checking [`STOP`]); on
+/// Ctrl-C the batch takes it exclusively, so it returns with no image half-written and
+/// no temporary file left, and every image in place is in the report.
+static WRITE_GATE: RwLock<()> = RwLock::new(());
+
 fn catch_ctrl_c() {
     static ONCE: Once = Once::new();
     ONCE.call_once(|| {
@@ -127,12 +132,12 @@ enum Msg {
     Finished(Box<JobRecord>),
 }
 
-/// Run one job on the current rayon pool.
-fn run_job(
+/// Load and render one job.
+fn render_job(
     job: &Job,
     max_memory: u64,
     progress: &(dyn Fn(usize, usize) + Sync),
-) -> Result<Report, String> {
+) -> Result<(crate::render::Film, Report), String> {
     let t0 = Instant::now();
     let scene = load_scene(&job.scene)?;
     let load_ms = t0.elapsed().as_secs_f64() * 1e3;
@@ -148,9 +153,7 @@ fn run_job(
         Some(progress),
     )
     .map_err(|e| format!("{name}: {e}"))?;
-    crate::output::write_image(&job.output, &film, job.settings.encoding)
-        .map_err(|e| e.to_string())?;
-    Ok(report)
+    Ok((film, report))
 }
 
 fn panic_message(p: &(dyn std::any::Any + Send)) -> String {
@@ -206,8 +209,21 @@ fn worker(
                 let _ = txp.send(Msg::Progress(i, d, t));
             };
             let result = std::panic::catch_unwind(std::panic::AssertUnwindSafe(|| {
-                pool.install(|| run_job(job, opts.max_memory, &progress))
+                pool.install(|| render_job(job, opts.max_memory, &progress))
             }));
+            // The image is written and the job reported with the gate held shared, and
+            // not at all once the batch is interrupted (see WRITE_GATE).
+            let _gate = WRITE_GATE.read().unwrap_or_else(|e| e.into_inner());
+            if STOP.load(Ordering::SeqCst) {
+                return;
+            }
+            let result = result.map(|r| {
+                r.and_then(|(film, report)| {
+                    crate::output::write_image(&job.output, &film, job.settings.encoding)
+                        .map(|()| report)
+                        .map_err(|e| e.to_string())
+                })
+            });
             match result {
                 Ok(Ok(report)) => record.stats = Some(report),
                 Ok(Err(e)) => {
@@ -223,6 +239,11 @@ fn worker(
                     ));
                 }
             }
+            record.wall_ms = t0.elapsed().as_secs_f64() * 1e3;
+            if tx.send(Msg::Finished(Box::new(record))).is_err() {
+                return;
+            }
+            continue;
         }
         record.wall_ms = t0.elapsed().as_secs_f64() * 1e3;
         if tx.send(Msg::Finished(Box::new(record))).is_err() {
@@ -379,7 +400,9 @@ pub fn run(jobs: Vec<Job>, opts: &BatchOptions) -> BatchReport {
     while done < total {
         if STOP.load(Ordering::SeqCst) {
             report.interrupted = true;
-            // Take in what finished meanwhile; running jobs are abandoned.
+            // Wait for images being written; then take in what finished meanwhile.
+            // Running jobs are abandoned.
+            let _gate = WRITE_GATE.write().unwrap_or_else(|e| e.into_inner());
             while let Ok(m) = rx.try_recv() {
                 if let Msg::Finished(r) = m {
                     let i = r.index;

@@ -1,0 +1,22 @@
+//! OBJ loader (through a file, as the loader reads MTL files beside it): any bytes give
+//! a scene or a `LoadError`, never a panic.
+#![no_main]
+
+use libfuzzer_sys::fuzz_target;
+use std::path::PathBuf;
+use std::sync::OnceLock;
+
+fn path() -> &'static PathBuf {
+    static PATH: OnceLock<PathBuf> = OnceLock::new();
+    PATH.get_or_init(|| {
+        let dir = std::env::temp_dir().join(format!("emray-fuzz-obj-{}", std::process::id()));
+        std::fs::create_dir_all(&dir).expect("temporary folder");
+        dir.join("fuzz.obj")
+    })
+}
+
+fuzz_target!(|data: &[u8]| {
+    let p = path();
+    std::fs::write(p, data).expect("write the input");
+    let _ = emray::load::obj::load(p);
+});

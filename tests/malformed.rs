@@ -1,0 +1,214 @@
+//! Malformed input: truncated files, binary garbage, NaN, huge counts and sizes, deep
+//! nesting, unreadable files. Every case exits with status 1, prints one line naming
+//! the file, and writes no output (nor a temporary file).
+
+use std::path::Path;
+use std::process::{Command, Output};
+
+const CAMERA: &str = "v\nfrom 0 0 5\nat 0 0 0\nup 0 1 0\nangle 40\nhither 1\nresolution 8 8\n";
+
+/// Deterministic bytes that are no text format (xorshift).
+fn garbage(n: usize, seed: u64) -> Vec<u8> {
+    let mut x = seed | 1;
+    (0..n)
+        .map(|_| {
+            x ^= x << 13;
+            x ^= x >> 7;
+            x ^= x << 17;
+            (x >> 24) as u8
+        })
+        .collect()
+}
+
+fn nested_csg(depth: usize) -> String {
+    let mut s = String::from("{ type = \"sphere\", center = [0, 0, 0], radius = 1 }");
+    for _ in 0..depth {
+        s = format!(
+            "{{ type = \"union\", children = [{s}, {{ type = \"sphere\", center = [1, 0, 0], radius = 1 }}] }}"
+        );
+    }
+    format!(
+        "[camera]\nfrom = [0, 0, 5]\nat = [0, 0, 0]\nup = [0, 1, 0]\nfov = 40\nresolution = [8, 8]\n\
+         [[objects]]\ntype = \"group\"\nchildren = [{s}]\n"
+    )
+}
+
+/// The corpus: (file name, contents); `None` makes a directory (unreadable as a file).
+fn corpus() -> Vec<(&'static str, Option<Vec<u8>>)> {
+    let t = |s: String| Some(s.into_bytes());
+    vec![
+        (
+            "truncated.nff",
+            t(format!("{CAMERA}s 0 0 0 1\np 3\n0 0 0\n1 0")),
+        ),
+        ("truncated-view.nff", t("v\nfrom 0 0 5\nat 0 0".into())),
+        ("garbage.nff", Some(garbage(3000, 1))),
+        ("garbage.obj", Some(garbage(3000, 2))),
+        ("garbage.toml", Some(garbage(3000, 3))),
+        ("nul.nff", Some(vec![0; 64])),
+        ("nan.nff", t(format!("{CAMERA}s 0 0 NaN 1\n"))),
+        ("inf.nff", t(format!("{CAMERA}s 0 0 1e39 1\n"))),
+        ("nan-radius.nff", t(format!("{CAMERA}s 0 0 0 nan\n"))),
+        (
+            "huge-count.nff",
+            t(format!("{CAMERA}p 4000000000\n0 0 0\n")),
+        ),
+        ("huge-res.nff", t(CAMERA.replace("8 8", "100000 100000"))),
+        ("zero-res.nff", t(CAMERA.replace("8 8", "0 8"))),
+        ("huge-pixels.nff", t(CAMERA.replace("8 8", "60000 60000"))),
+        ("truncated.obj", t("v 0 0 0\nv 1 0".into())),
+        (
+            "nan.obj",
+            t("v 0 0 nan\nv 1 0 0\nv 0 1 0\nf 1 2 3\n".into()),
+        ),
+        (
+            "huge-index.obj",
+            t("v 0 0 0\nv 1 0 0\nf 1 2 4000000000\n".into()),
+        ),
+        ("no-faces.obj", t("v 0 0 0\n".into())),
+        (
+            "truncated.toml",
+            t("[camera]\nfrom = [0, 0, 5]\nat = [0, 0".into()),
+        ),
+        (
+            "nan.toml",
+            t(nested_csg(0).replace("radius = 1 }]", "radius = nan }]")),
+        ),
+        (
+            "huge-res.toml",
+            t(nested_csg(0).replace("[8, 8]", "[100000, 100000]")),
+        ),
+        ("deep-csg.toml", t(nested_csg(300))),
+        (
+            "deep-arrays.toml",
+            t(format!("a = {}{}\n", "[".repeat(20000), "]".repeat(20000))),
+        ),
+        (
+            "missing-include.toml",
+            t(nested_csg(0).replace(
+                "children = [",
+                "children = [{ type = \"include\", file = \"nowhere.obj\" }, ",
+            )),
+        ),
+        ("directory.nff", None),
+    ]
+}
+
+fn emray(dir: &Path, args: &[&str]) -> Output {
+    Command::new(env!("CARGO_BIN_EXE_emray"))
+        .current_dir(dir)
+        .args(args)
+        .output()
+        .expect("run emray")
+}
+
+#[test]
+fn every_malformed_file_fails_cleanly() {
+    let dir = tempfile::tempdir().unwrap();
+    let d = dir.path();
+    let cases = corpus();
+    for (name, data) in &cases {
+        match data {
+            Some(bytes) => std::fs::write(d.join(name), bytes).unwrap(),
+            None => std::fs::create_dir(d.join(name)).unwrap(),
+        }
+    }
+    let before = std::fs::read_dir(d).unwrap().count();
+    for (name, _) in &cases {
+        for out in ["out.png", "out.exr"] {
+            let o = emray(d, &["render", "-q", name, "-o", out]);
+            let err = String::from_utf8_lossy(&o.stderr);
+            assert_eq!(o.status.code(), Some(1), "{name}: {err}");
+            assert_eq!(err.lines().count(), 1, "{name}: {err}");
+            assert!(
+                err.starts_with(&format!("emray: error: {name}")),
+                "{name}: {err}"
+            );
+            assert_eq!(
+                std::fs::read_dir(d).unwrap().count(),
+                before,
+                "{name}: output left"
+            );
+        }
+    }
+    // The same corpus as one batch: every job fails, each reported, nothing written.
+    let mut args = vec![
+        "batch",
+        "-q",
+        "-o",
+        "{stem}-{index}.png",
+        "--report",
+        "r.json",
+    ];
+    args.extend(cases.iter().map(|(n, _)| *n));
+    let o = emray(d, &args);
+    assert_eq!(o.status.code(), Some(1));
+    let r: serde_json::Value =
+        serde_json::from_str(&std::fs::read_to_string(d.join("r.json")).unwrap()).unwrap();
+    assert_eq!(r["failed"].as_u64(), Some(cases.len() as u64));
+    for (job, (name, _)) in r["jobs"].as_array().unwrap().iter().zip(&cases) {
+        assert!(job["error"].as_str().unwrap().starts_with(name), "{job}");
+    }
+    assert!(!std::fs::read_dir(d).unwrap().any(|e| e
+        .unwrap()
+        .file_name()
+        .to_string_lossy()
+        .ends_with(".png")));
+}
+
+#[test]
+fn memory_limit_refuses_before_rendering() {
+    let dir = tempfile::tempdir().unwrap();
+    let d = dir.path();
+    std::fs::write(d.join("s.nff"), format!("{CAMERA}s 0 0 0 1\n")).unwrap();
+    let o = emray(
+        d,
+        &[
+            "render",
+            "s.nff",
+            "--res",
+            "16000x16000",
+            "--max-memory",
+            "64M",
+            "-o",
+            "o.png",
+        ],
+    );
+    let err = String::from_utf8_lossy(&o.stderr);
+    assert_eq!(o.status.code(), Some(1), "{err}");
+    assert!(
+        err.contains("s.nff: rendering 16000x16000") && err.contains("--max-memory"),
+        "{err}"
+    );
+    assert!(!d.join("o.png").exists());
+    let o = emray(
+        d,
+        &[
+            "batch",
+            "s.nff",
+            "--res",
+            "16000x16000",
+            "--max-memory",
+            "64M",
+        ],
+    );
+    assert_eq!(o.status.code(), Some(1));
+    let o = emray(
+        d,
+        &["render", "s.nff", "--max-memory", "lots", "-o", "o.png"],
+    );
+    assert_eq!(o.status.code(), Some(2));
+    let o = emray(
+        d,
+        &[
+            "render",
+            "-q",
+            "s.nff",
+            "--max-memory",
+            "64M",
+            "-o",
+            "o.png",
+        ],
+    );
+    assert!(o.status.success());
+}
