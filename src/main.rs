@@ -1,6 +1,7 @@
 //! The `emray` command.
 
 mod cli;
+mod quality_cmd;
 
 use anyhow::{bail, Context, Result};
 use clap::Parser;
@@ -23,6 +24,7 @@ fn main() -> ExitCode {
     let args = match cli.command {
         Some(Command::Render(a)) => a,
         Some(Command::Gen(g)) => return gen(&g),
+        Some(Command::Compare(c)) => return quality_cmd::compare(&c),
         None => RenderArgs::default_scene(),
     };
     let level = match (args.quiet, args.verbose) {
@@ -110,6 +112,14 @@ type Job = (Option<PathBuf>, PathBuf);
 
 /// The jobs, or a usage error (exit status 2) found before any work is done.
 fn plan(args: &RenderArgs) -> Result<Vec<Job>, String> {
+    for (name, v) in [
+        ("--bailout", args.bailout.unwrap_or(0.0)),
+        ("--aa-threshold", args.aa_threshold),
+    ] {
+        if !(v >= 0.0 && v.is_finite()) {
+            return Err(format!("{name} must be a finite number >= 0, not {v}"));
+        }
+    }
     if args.scenes.len() > 1 {
         if let Some(o) = &args.output {
             if !o.contains("{stem}") {
@@ -196,6 +206,18 @@ fn render_one(args: &RenderArgs, scene_path: Option<&Path>, out: &Path) -> Resul
         settings.spp = 1;
         settings.max_depth = 5;
     }
+    settings.bailout = args.bailout.unwrap_or(if args.spd {
+        0.0
+    } else {
+        emray::render::DEFAULT_BAILOUT
+    });
+    if args.aa == cli::AaArg::Adaptive {
+        settings.aa = emray::render::Aa::Adaptive {
+            threshold: args.aa_threshold,
+            depth: args.aa_depth,
+        };
+    }
+    settings.skip = !args.no_skip;
     let backend: Backend = args
         .backend
         .map(Backend::from)
