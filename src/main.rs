@@ -116,7 +116,7 @@ fn plan(args: &RenderArgs) -> Result<Vec<Job>, String> {
         ("--bailout", args.bailout.unwrap_or(0.0)),
         ("--aa-threshold", args.aa_threshold),
     ] {
-        if !(v >= 0.0 && v.is_finite()) {
+        if !v.is_finite() || v < 0.0 {
             return Err(format!("{name} must be a finite number >= 0, not {v}"));
         }
     }

@@ -54,7 +54,7 @@ pub fn table(m: &Metrics) -> String {
 pub fn compare(a: &CompareArgs) -> ExitCode {
     let run = || -> Result<bool, String> {
         for (name, v) in [("--max-rmse", a.max_rmse), ("--max-flip", a.max_flip)] {
-            if v.is_some_and(|v| !(v >= 0.0)) {
+            if v.is_some_and(|v| v.is_nan() || v < 0.0) {
                 return Err(format!("{name} must be a number ≥ 0"));
             }
         }
@@ -75,13 +75,13 @@ pub fn compare(a: &CompareArgs) -> ExitCode {
         }
         let mut pass = true;
         if let Some(x) = a.max_rmse {
-            if !(m.rmse <= x) {
+            if m.rmse.is_nan() || m.rmse > x {
                 eprintln!("emray: rmse {:.6e} exceeds --max-rmse {x}", m.rmse);
                 pass = false;
             }
         }
         if let Some(y) = a.max_flip {
-            if !(m.flip <= y) {
+            if m.flip.is_nan() || m.flip > y {
                 eprintln!("emray: flip {:.6} exceeds --max-flip {y}", m.flip);
                 pass = false;
             }

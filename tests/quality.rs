@@ -151,12 +151,7 @@ fn compare_reports_metrics_and_exits_by_threshold() {
     // A missing file or a size mismatch is an I/O or usage error, named.
     let small = dir.path().join("small.exr");
     emray::output::write_image(&small, &Film::new(4, 4), enc).unwrap();
-    let out = emray()
-        .arg("compare")
-        .arg(&small)
-        .arg(&a)
-        .output()
-        .unwrap();
+    let out = emray().arg("compare").arg(&small).arg(&a).output().unwrap();
     assert_eq!(out.status.code(), Some(2));
     assert!(String::from_utf8_lossy(&out.stderr).contains("small.exr"));
     let out = emray()

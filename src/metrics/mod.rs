@@ -163,7 +163,10 @@ pub fn compare(test: &Film, reference: &Film) -> Metrics {
         }
     }
     let mse = se / n;
-    let (ta, ra) = (to_rgb8(test, Encoding::Srgb), to_rgb8(reference, Encoding::Srgb));
+    let (ta, ra) = (
+        to_rgb8(test, Encoding::Srgb),
+        to_rgb8(reference, Encoding::Srgb),
+    );
     let differing = ta
         .chunks(3)
         .zip(ra.chunks(3))
@@ -199,7 +202,10 @@ fn flip_map(test: &[u8], reference: &[u8], w: u32, h: u32) -> (f64, Vec<f32>) {
 /// through the magma colour map (black = no visible difference, yellow-white = the
 /// largest), as a film of sRGB-decoded values ready for [`crate::output::write_image`].
 pub fn heat_map(test: &Film, reference: &Film) -> Film {
-    let (ta, ra) = (to_rgb8(test, Encoding::Srgb), to_rgb8(reference, Encoding::Srgb));
+    let (ta, ra) = (
+        to_rgb8(test, Encoding::Srgb),
+        to_rgb8(reference, Encoding::Srgb),
+    );
     let (_, map) = flip_map(&ta, &ra, test.width, test.height);
     let mut out = Film::new(test.width, test.height);
     for (p, &e) in out.pixels.iter_mut().zip(&map) {
@@ -263,7 +269,11 @@ mod tests {
         assert!((m.psnr - 20.0).abs() < 1e-4, "{}", m.psnr);
         assert!((m.max_abs - 0.1).abs() < 1e-6);
         let rel = 0.01 / (0.51f64 * 0.51);
-        assert!((m.rel_mse - rel).abs() < 1e-6 * rel.max(1.0), "{}", m.rel_mse);
+        assert!(
+            (m.rel_mse - rel).abs() < 1e-6 * rel.max(1.0),
+            "{}",
+            m.rel_mse
+        );
         assert_eq!(m.diff_8bit, 1.0);
         assert!(m.flip > 0.0 && m.flip < 1.0, "{}", m.flip);
     }
@@ -336,7 +346,9 @@ mod tests {
             Err(MetricsError::Format(_))
         ));
         let missing = dir.path().join("missing.png");
-        let e = read_image(&missing, Encoding::Srgb).unwrap_err().to_string();
+        let e = read_image(&missing, Encoding::Srgb)
+            .unwrap_err()
+            .to_string();
         assert!(e.contains("missing.png"), "{e}");
     }
 }

@@ -240,9 +240,36 @@ where
     let d = depth - 1;
     let q = [
         adaptive(sample, x, y, hs, [k[0], top, left, mid], threshold, d, c),
-        adaptive(sample, x + hs, y, hs, [top, k[1], mid, right], threshold, d, c),
-        adaptive(sample, x, y + hs, hs, [left, mid, k[2], bottom], threshold, d, c),
-        adaptive(sample, x + hs, y + hs, hs, [mid, right, bottom, k[3]], threshold, d, c),
+        adaptive(
+            sample,
+            x + hs,
+            y,
+            hs,
+            [top, k[1], mid, right],
+            threshold,
+            d,
+            c,
+        ),
+        adaptive(
+            sample,
+            x,
+            y + hs,
+            hs,
+            [left, mid, k[2], bottom],
+            threshold,
+            d,
+            c,
+        ),
+        adaptive(
+            sample,
+            x + hs,
+            y + hs,
+            hs,
+            [mid, right, bottom, k[3]],
+            threshold,
+            d,
+            c,
+        ),
     ];
     (q[0] + q[1] + q[2] + q[3]) * 0.25
 }
