@@ -132,6 +132,12 @@ pub struct RenderArgs {
     /// --spd].
     #[arg(long, value_name = "W")]
     pub bailout: Option<f32>,
+    /// Render the f64 reference instead: everything in double precision, brute-force
+    /// traversal, N×N stratified samples per pixel with N = floor(sqrt(--spp))
+    /// [default --spp 256: 16×16]. Spheres, cones and triangles only; other scenes are
+    /// refused.
+    #[arg(long)]
+    pub reference: bool,
     /// Cast the rays that cannot change the image too (shadow rays to lights behind the
     /// surface, reflection rays off Ks = 0): only to measure what skipping them saves.
     #[arg(long)]
@@ -170,6 +176,7 @@ impl RenderArgs {
             aa_depth: emray::render::DEFAULT_AA_DEPTH,
             bailout: None,
             no_skip: false,
+            reference: false,
             stats: false,
             stats_json: None,
             encoding: EncodingArg::Srgb,

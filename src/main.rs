@@ -112,6 +112,12 @@ type Job = (Option<PathBuf>, PathBuf);
 
 /// The jobs, or a usage error (exit status 2) found before any work is done.
 fn plan(args: &RenderArgs) -> Result<Vec<Job>, String> {
+    if args.reference && (args.spd || args.aa != cli::AaArg::Uniform) {
+        return Err(
+            "--reference samples N×N stratified: it cannot be combined with --spd or --aa adaptive"
+                .into(),
+        );
+    }
     for (name, v) in [
         ("--bailout", args.bailout.unwrap_or(0.0)),
         ("--aa-threshold", args.aa_threshold),
@@ -242,8 +248,13 @@ fn render_one(args: &RenderArgs, scene_path: Option<&Path>, out: &Path) -> Resul
             b.set_position(done as u64);
         }
     };
-    let (film, report) =
-        emray::run::render_scene(&name, &scene, backend, &settings, load_ms, Some(&progress))?;
+    let (film, report) = if args.reference {
+        let strata = (args.spp.unwrap_or(256) as f64).sqrt().floor() as u32;
+        emray::run::render_reference(&name, &scene, &settings, strata, load_ms)
+            .map_err(|why| anyhow::anyhow!("{name}: {why}"))?
+    } else {
+        emray::run::render_scene(&name, &scene, backend, &settings, load_ms, Some(&progress))?
+    };
     if let Some(b) = &bar {
         b.finish_and_clear();
     }

@@ -231,3 +231,44 @@ pub fn render_scene(
         Backend::Embree => Err(AccelError::Unavailable("embree")),
     }
 }
+
+/// Render `scene` with the f64 reference renderer ([`render::reference`]) using
+/// `strata × strata` samples per pixel; `Err` names what the reference does not model.
+pub fn render_reference(
+    name: &str,
+    scene: &Scene,
+    settings: &RenderSettings,
+    strata: u32,
+    load_ms: f64,
+) -> Result<(Film, Report), String> {
+    if let Some(why) = render::reference::unsupported(scene) {
+        return Err(why);
+    }
+    let t0 = Instant::now();
+    let (film, rays) = render::reference::render(
+        scene,
+        settings.width,
+        settings.height,
+        strata,
+        settings.max_depth,
+    );
+    let stats = RenderStats {
+        rays,
+        render_ms: t0.elapsed().as_secs_f64() * 1e3,
+    };
+    let accel = AccelStats {
+        backend: "reference",
+        prims: scene.prim_count(),
+        nodes: 0,
+        bytes: 0,
+        detail: format!("f64, brute force, {strata}x{strata} stratified samples"),
+    };
+    let mut st = settings.clone();
+    st.spp = strata * strata;
+    let t = Timings {
+        load: load_ms,
+        build: 0.0,
+        render: stats.render_ms,
+    };
+    Ok((film, Report::new(name, scene, &st, &accel, t, &stats)))
+}

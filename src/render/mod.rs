@@ -4,6 +4,7 @@
 
 mod camera;
 mod film;
+pub mod reference;
 mod whitted;
 
 pub use camera::RayGen;
