@@ -1,6 +1,7 @@
 //! The `emray` command.
 
 mod cli;
+mod quality_cmd;
 
 use anyhow::{bail, Context, Result};
 use clap::Parser;
@@ -24,6 +25,7 @@ fn main() -> ExitCode {
         Some(Command::Gen(g)) => return gen(&g),
         Some(Command::Batch(b)) => return batch(&b),
         Some(Command::Merge(m)) => return merge(&m),
+        Some(Command::Compare(c)) => return quality_cmd::compare(&c),
         None => RenderArgs::default_scene(),
     };
     init_log(args.quiet, args.verbose);
@@ -201,6 +203,20 @@ type Job = (Option<PathBuf>, PathBuf);
 
 /// The jobs, or a usage error (exit status 2) found before any work is done.
 fn plan(args: &RenderArgs) -> Result<Vec<Job>, String> {
+    if args.reference && (args.spd || args.aa != cli::AaArg::Uniform) {
+        return Err(
+            "--reference samples N×N stratified: it cannot be combined with --spd or --aa adaptive"
+                .into(),
+        );
+    }
+    for (name, v) in [
+        ("--bailout", args.bailout.unwrap_or(0.0)),
+        ("--aa-threshold", args.aa_threshold),
+    ] {
+        if !v.is_finite() || v < 0.0 {
+            return Err(format!("{name} must be a finite number >= 0, not {v}"));
+        }
+    }
     if args.scenes.len() > 1 {
         if let Some(o) = &args.output {
             if !o.contains("{stem}") {
@@ -220,6 +236,9 @@ fn plan(args: &RenderArgs) -> Result<Vec<Job>, String> {
             .collect()
     };
     if args.tile.is_some() || args.crop.is_some() {
+        if args.reference {
+            return Err("--reference renders whole images: not with --tile or --crop".into());
+        }
         if jobs.len() != 1 {
             return Err("--tile and --crop render one scene".into());
         }
@@ -287,6 +306,16 @@ fn render_one(args: &RenderArgs, scene_path: Option<&Path>, out: &Path) -> Resul
         encoding: args.encoding.into(),
     };
     let mut settings = job.apply(&scene);
+    if let Some(b) = args.bailout {
+        settings.bailout = b;
+    }
+    if args.aa == cli::AaArg::Adaptive {
+        settings.aa = emray::render::Aa::Adaptive {
+            threshold: args.aa_threshold,
+            depth: args.aa_depth,
+        };
+    }
+    settings.skip = !args.no_skip;
     let backend = job.backend();
     let (w, h) = (settings.width, settings.height);
     settings.region = match (args.tile, args.crop) {
@@ -328,8 +357,13 @@ fn render_one(args: &RenderArgs, scene_path: Option<&Path>, out: &Path) -> Resul
             b.set_position(done as u64);
         }
     };
-    let (film, report) =
-        emray::run::render_scene(&name, &scene, backend, &settings, load_ms, Some(&progress))?;
+    let (film, report) = if args.reference {
+        let strata = (args.spp.unwrap_or(256) as f64).sqrt().floor() as u32;
+        emray::run::render_reference(&name, &scene, &settings, strata, load_ms)
+            .map_err(|why| anyhow::anyhow!("{name}: {why}"))?
+    } else {
+        emray::run::render_scene(&name, &scene, backend, &settings, load_ms, Some(&progress))?
+    };
     if let Some(b) = &bar {
         b.finish_and_clear();
     }

@@ -213,6 +213,7 @@ fn tiles_merge_bit_identical_to_the_full_render() {
         for (mode, counts) in [
             (&["--spp", "3"][..], &[1, 2, 3, 7][..]),
             (&["--spd", "--res", "17x13"][..], &[2, 7][..]),
+            (&["--aa", "adaptive"][..], &[3][..]),
         ] {
             let base = [&["render", "-q", "t.nff", "--backend", backend][..], mode].concat();
             let o = emray(d, &[&base[..], &["-o", "full.exr"]].concat());

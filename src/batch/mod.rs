@@ -44,7 +44,8 @@ impl JobSettings {
         self.backend.unwrap_or_else(Backend::default_available)
     }
 
-    /// The render settings for `scene`: the scene's own, overridden by these.
+    /// The render settings for `scene`: the scene's own, overridden by these, with the
+    /// command line's defaults (the default bailout, none in SPD mode).
     pub fn apply(&self, scene: &Scene) -> RenderSettings {
         let mut s = RenderSettings::for_scene(scene);
         if let Some((w, h)) = self.res {
@@ -52,6 +53,7 @@ impl JobSettings {
             s.height = h;
         }
         s.spp = self.spp.or(scene.render.spp).unwrap_or(1);
+        s.bailout = crate::render::DEFAULT_BAILOUT;
         s.max_depth = self.max_depth.or(scene.render.max_depth).unwrap_or(5);
         if self.spd {
             // SPD testing mode: 512x512 from a 513x513 corner grid, depth 5, one sample.
@@ -62,6 +64,7 @@ impl JobSettings {
             s.spd = true;
             s.spp = 1;
             s.max_depth = 5;
+            s.bailout = 0.0;
         }
         s
     }
