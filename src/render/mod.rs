@@ -31,6 +31,8 @@ pub struct RenderSettings {
     pub spd: bool,
     /// Tile edge in pixels.
     pub tile: u32,
+    /// Embree build quality (the BVH backend ignores it).
+    pub embree_quality: crate::accel::EmbreeQuality,
 }
 
 impl RenderSettings {
@@ -43,6 +45,7 @@ impl RenderSettings {
             max_depth: 5,
             spd: false,
             tile: 16,
+            embree_quality: crate::accel::EmbreeQuality::Medium,
         }
     }
 }
