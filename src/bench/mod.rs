@@ -64,6 +64,18 @@ pub struct Rays {
     pub total: u64,
 }
 
+impl From<crate::render::RayCounts> for Rays {
+    fn from(c: crate::render::RayCounts) -> Rays {
+        Rays {
+            eye: c.eye,
+            reflection: c.reflection,
+            refraction: c.refraction,
+            shadow: c.shadow,
+            total: c.total(),
+        }
+    }
+}
+
 /// What one child run measured.
 #[derive(Clone, Debug, PartialEq, Serialize, Deserialize)]
 pub struct RunResult {
@@ -134,21 +146,20 @@ pub fn run_child(spec: &RunSpec) -> Result<RunResult, String> {
         settings.max_depth = 5;
     }
     settings.embree_quality = spec.embree_quality;
-    let (build_ms, ms, c, accel) = pool.install(|| match spec.mode {
+    let (build_ms, ms, rays, accel) = pool.install(|| match spec.mode {
         Mode::Render => {
             let (_, rep) =
                 crate::run::render_scene(&spec.scene, &scene, backend, &settings, load_ms, None)
                     .map_err(|e| e.to_string())?;
             let r = |k: &str| rep.rays.get(k).copied().unwrap_or(0);
-            let counts = crate::render::RayCounts {
+            let rays = Rays {
                 eye: r("eye"),
-                eye_hit: r("eye_hit"),
                 reflection: r("reflection"),
                 refraction: r("refraction"),
                 shadow: r("shadow"),
-                tir: r("tir"),
+                total: r("total"),
             };
-            Ok::<_, String>((rep.time_ms.build, rep.time_ms.render, counts, rep.accel))
+            Ok::<_, String>((rep.time_ms.build, rep.time_ms.render, rays, rep.accel))
         }
         Mode::Raw => {
             let work = RawWork {
@@ -157,7 +168,7 @@ pub fn run_child(spec: &RunSpec) -> Result<RunResult, String> {
             };
             let (build_ms, cast, counts, detail) =
                 with_accel(&scene, backend, &settings, work).map_err(|e| e.to_string())?;
-            Ok((build_ms, cast.ms, counts, detail))
+            Ok((build_ms, cast.ms, Rays::from(counts), detail))
         }
     })?;
     Ok(RunResult {
@@ -165,13 +176,7 @@ pub fn run_child(spec: &RunSpec) -> Result<RunResult, String> {
         load_ms,
         build_ms,
         ms,
-        rays: Rays {
-            eye: c.eye,
-            reflection: c.reflection,
-            refraction: c.refraction,
-            shadow: c.shadow,
-            total: c.total(),
-        },
+        rays,
         peak_kib: peak_rss_kib(),
         accel,
     })
