@@ -25,6 +25,7 @@ fn main() -> ExitCode {
         Some(Command::Render(a)) => a,
         Some(Command::Gen(g)) => return gen(&g),
         Some(Command::Compare(c)) => return quality_cmd::compare(&c),
+        Some(Command::Stress(s)) => return quality_cmd::stress(&s),
         None => RenderArgs::default_scene(),
     };
     let level = match (args.quiet, args.verbose) {
