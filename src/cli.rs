@@ -27,6 +27,9 @@ pub enum Command {
     /// Error metrics of an image against a reference (RMSE, PSNR, FLIP, ...); exit
     /// status 0 within the thresholds, 1 beyond, 2 on a usage or I/O error.
     Compare(crate::quality_cmd::CompareArgs),
+    /// Numerical stress cases (scale, translation, far/tiny spheres, watertightness)
+    /// with their measured numbers; exit status 1 if a bound is broken.
+    Stress(crate::quality_cmd::StressArgs),
 }
 
 /// `emray bench`.
