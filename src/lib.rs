@@ -9,6 +9,7 @@
 
 pub mod accel;
 pub mod batch;
+pub mod bench;
 pub mod gen;
 pub mod geometry;
 pub mod load;
@@ -18,6 +19,7 @@ pub mod output;
 pub mod render;
 pub mod run;
 pub mod scene;
+pub mod stress;
 
 pub use accel::{Accel, Backend, Hit};
 pub use render::{Region, RenderSettings, RenderStats};
