@@ -113,6 +113,10 @@ pub struct RenderArgs {
     /// PNG value encoding.
     #[arg(long, value_enum, default_value_t = EncodingArg::Srgb)]
     pub encoding: EncodingArg,
+    /// Environment map for rays that leave the scene (PNG/JPEG: 2:1 latitude-longitude
+    /// or a 4:3 cube cross), replacing the scene's own.
+    #[arg(long, value_name = "FILE")]
+    pub envmap: Option<PathBuf>,
     /// No progress bar and no messages but errors.
     #[arg(short, long)]
     pub quiet: bool,
@@ -136,6 +140,7 @@ impl RenderArgs {
             stats: false,
             stats_json: None,
             encoding: EncodingArg::Srgb,
+            envmap: None,
             quiet: false,
             verbose: 0,
         }

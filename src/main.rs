@@ -9,6 +9,7 @@ use emray::accel::Backend;
 use emray::gen::Database;
 use emray::load;
 use emray::render::RenderSettings;
+use emray::scene::Environment;
 use emray::Scene;
 use std::io::{IsTerminal, Write};
 use std::path::{Path, PathBuf};
@@ -162,7 +163,7 @@ fn render_all(args: &RenderArgs, jobs: &[Job]) -> Result<()> {
 
 fn render_one(args: &RenderArgs, scene_path: Option<&Path>, out: &Path) -> Result<()> {
     let t0 = Instant::now();
-    let (name, scene): (String, Scene) = match scene_path {
+    let (name, mut scene): (String, Scene) = match scene_path {
         Some(p) => {
             let name = p.display().to_string();
             match Database::parse_spec(&name).map_err(anyhow::Error::msg)? {
@@ -178,6 +179,9 @@ fn render_one(args: &RenderArgs, scene_path: Option<&Path>, out: &Path) -> Resul
             load::nff::parse_str(DEFAULT_SCENE, Path::new("<default scene>"))?,
         ),
     };
+    if let Some(env) = &args.envmap {
+        scene.environment = Some(Environment::load(env).map_err(anyhow::Error::msg)?);
+    }
     let load_ms = t0.elapsed().as_secs_f64() * 1e3;
     let mut settings = RenderSettings::for_scene(&scene);
     if let Some((w, h)) = args.res {
