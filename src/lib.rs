@@ -12,6 +12,7 @@ pub mod gen;
 pub mod geometry;
 pub mod load;
 pub mod math;
+pub mod metrics;
 pub mod output;
 pub mod render;
 pub mod run;
