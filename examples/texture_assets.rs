@@ -157,7 +157,10 @@ fn large_obj(dir: &Path, n: usize) {
     let h = |x: f32, z: f32| 0.1 * (6.0 * x).sin() * (5.0 * z).cos();
     for j in 0..=n {
         for i in 0..=n {
-            let (x, z) = (2.0 * i as f32 / n as f32 - 1.0, 2.0 * j as f32 / n as f32 - 1.0);
+            let (x, z) = (
+                2.0 * i as f32 / n as f32 - 1.0,
+                2.0 * j as f32 / n as f32 - 1.0,
+            );
             writeln!(f, "v {x} {} {z}", h(x, z)).unwrap();
         }
     }

@@ -63,7 +63,12 @@ fn bilinear_between_texels() {
     assert!(close(img.bilinear(uv), want, 1e-6));
     // A quarter of the way along both axes from (1, 0) to (2, 1).
     let uv = Vec2::new((1.5 + 0.25) / 3.0, 1.0 - (0.5 + 0.25) / 2.0);
-    let (a, b, c, d) = (img.texel(1, 0), img.texel(2, 0), img.texel(1, 1), img.texel(2, 1));
+    let (a, b, c, d) = (
+        img.texel(1, 0),
+        img.texel(2, 0),
+        img.texel(1, 1),
+        img.texel(2, 1),
+    );
     let want = (a * 0.75 + b * 0.25) * 0.75 + (c * 0.75 + d * 0.25) * 0.25;
     assert!(close(img.bilinear(uv), want, 1e-6));
 }
@@ -73,14 +78,22 @@ fn wrap_modes_repeat_and_clamp() {
     let mut img = grid_image();
     let centre = |i: f32, j: f32| Vec2::new((i + 0.5) / 3.0, 1.0 - (j + 0.5) / 2.0);
     // Repeat: one period away is the same texel; the edge blends with the far side.
-    assert!(close(img.bilinear(centre(0.0, 0.0) + Vec2::new(1.0, -2.0)), img.texel(0, 0), 1e-6));
+    assert!(close(
+        img.bilinear(centre(0.0, 0.0) + Vec2::new(1.0, -2.0)),
+        img.texel(0, 0),
+        1e-6
+    ));
     let edge = Vec2::new(0.0, 0.75);
     let want = (img.texel(2, 0) + img.texel(0, 0)) * 0.5;
     assert!(close(img.bilinear(edge), want, 1e-6));
     // Clamp: beyond the edge, the edge texel.
     img.wrap = Wrap::Clamp;
     assert!(close(img.bilinear(edge), img.texel(0, 0), 1e-6));
-    assert!(close(img.bilinear(Vec2::new(5.0, -3.0)), img.texel(2, 1), 1e-6));
+    assert!(close(
+        img.bilinear(Vec2::new(5.0, -3.0)),
+        img.texel(2, 1),
+        1e-6
+    ));
     assert_eq!(img.texel(-4, 9), img.texel(0, 1));
 }
 
@@ -103,7 +116,8 @@ fn checker_and_marble() {
         .map(|i| m.eval(Vec2::ZERO, Vec3::new(i as f32 * 0.013, 0.2, -0.1)).x)
         .collect();
     assert!(vals.iter().all(|v| (0.0..=1.0).contains(v)));
-    let spread = vals.iter().fold(0.0f32, |a, v| a.max(*v)) - vals.iter().fold(1.0f32, |a, v| a.min(*v));
+    let spread =
+        vals.iter().fold(0.0f32, |a, v| a.max(*v)) - vals.iter().fold(1.0f32, |a, v| a.min(*v));
     assert!(spread > 0.5, "veins vary: {spread}");
 }
 
@@ -122,7 +136,9 @@ fn inverse_bilinear_recovers_random_points_in_random_convex_quads() {
         // random plane.
         let mut ang: Vec<f32> = (0..4).map(|_| rnd() * std::f32::consts::TAU).collect();
         ang.sort_by(f32::total_cmp);
-        if ang.windows(2).any(|w| w[1] - w[0] < 0.3) || ang[0] + std::f32::consts::TAU - ang[3] < 0.3 {
+        if ang.windows(2).any(|w| w[1] - w[0] < 0.3)
+            || ang[0] + std::f32::consts::TAU - ang[3] < 0.3
+        {
             continue;
         }
         let n = Vec3::new(rnd() - 0.5, rnd() - 0.5, rnd() - 0.5).normalize_or(Vec3::Z);
@@ -135,14 +151,22 @@ fn inverse_bilinear_recovers_random_points_in_random_convex_quads() {
         let q = [q[0], q[1], q[2], q[3]];
         // Convexity check (all turns the same way).
         let turns: Vec<f32> = (0..4)
-            .map(|k| (q[(k + 1) % 4] - q[k]).cross(q[(k + 2) % 4] - q[(k + 1) % 4]).dot(n))
+            .map(|k| {
+                (q[(k + 1) % 4] - q[k])
+                    .cross(q[(k + 2) % 4] - q[(k + 1) % 4])
+                    .dot(n)
+            })
             .collect();
         if !(turns.iter().all(|t| *t > 1e-3) || turns.iter().all(|t| *t < -1e-3)) {
             continue;
         }
         let (s, t) = (rnd(), rnd());
-        let p = q[0] * ((1.0 - s) * (1.0 - t)) + q[1] * (s * (1.0 - t)) + q[2] * (s * t) + q[3] * ((1.0 - s) * t);
-        let st = inverse_bilinear(p, q).unwrap_or_else(|| panic!("no solution for {s} {t} in {q:?}"));
+        let p = q[0] * ((1.0 - s) * (1.0 - t))
+            + q[1] * (s * (1.0 - t))
+            + q[2] * (s * t)
+            + q[3] * ((1.0 - s) * t);
+        let st =
+            inverse_bilinear(p, q).unwrap_or_else(|| panic!("no solution for {s} {t} in {q:?}"));
         assert!(
             (st.x - s).abs() < 1e-5 && (st.y - t).abs() < 1e-5,
             "({s}, {t}) came back as {st} in {q:?}"
@@ -186,7 +210,10 @@ fn constant_slope_height_map_tilts_the_normal_by_the_analytic_angle() {
     );
     let want = (dh_du / 2.0).atan();
     assert!((n.dot(Vec3::Z).acos() - want).abs() < 1e-5, "{n}");
-    assert!(n.x < 0.0 && n.y.abs() < 1e-6, "tilted away from rising heights: {n}");
+    assert!(
+        n.x < 0.0 && n.y.abs() < 1e-6,
+        "tilted away from rising heights: {n}"
+    );
 
     // Through the scene: a triangle with vt, the shading normal at a hit.
     let mut s = Scene::new(camera(Vec3::Z * 5.0, Vec3::ZERO, 8));
@@ -200,7 +227,11 @@ fn constant_slope_height_map_tilts_the_normal_by_the_analytic_angle() {
         ..Material::DEFAULT
     });
     let tri = Triangle {
-        p: [Vec3::ZERO, Vec3::new(2.0, 0.0, 0.0), Vec3::new(0.0, 2.0, 0.0)],
+        p: [
+            Vec3::ZERO,
+            Vec3::new(2.0, 0.0, 0.0),
+            Vec3::new(0.0, 2.0, 0.0),
+        ],
     };
     s.geometry.add_triangle(tri, 0);
     s.geometry
@@ -216,7 +247,9 @@ fn constant_slope_height_map_tilts_the_normal_by_the_analytic_angle() {
     };
     let ray = Ray::new(Vec3::new(0.5, 0.5, 5.0), -Vec3::Z);
     let surf = s.surface(&hit, &ray);
-    let prm = surf.param.expect("a bump-mapped material gets texture coordinates");
+    let prm = surf
+        .param
+        .expect("a bump-mapped material gets texture coordinates");
     assert!((prm.uv - Vec2::new(0.25, 0.25)).length() < 1e-6);
     let (_, ns) = s.shading(&surf);
     assert!((ns.dot(Vec3::Z).acos() - want).abs() < 1e-5, "{ns}");
@@ -258,7 +291,10 @@ fn mirror_scene(from: Vec3, env: Environment) -> Scene {
         kr: 1.0,
         ..Material::DEFAULT
     });
-    s.geometry.add_shape(emray::geometry::Shape::Sphere(Sphere::new(Vec3::ZERO, 1.0)), 0);
+    s.geometry.add_shape(
+        emray::geometry::Shape::Sphere(Sphere::new(Vec3::ZERO, 1.0)),
+        0,
+    );
     s.environment = Some(env);
     s
 }
@@ -295,7 +331,10 @@ fn mirror_sphere_centre_pixel_shows_the_texel_behind_the_camera() {
         let film = render_scene("t", &s2, b, &RenderSettings::for_scene(&s2), 0.0, None)
             .unwrap()
             .0;
-        assert!(close(film.get(2, 2), Vec3::new(0.9, 0.2, 0.1), 1e-5), "{b:?}");
+        assert!(
+            close(film.get(2, 2), Vec3::new(0.9, 0.2, 0.1), 1e-5),
+            "{b:?}"
+        );
     }
 }
 
@@ -331,12 +370,28 @@ fn obj_vt_and_map_kd_decode_srgb_and_negative_indices() {
     )
     .unwrap();
     // Left half sRGB 128 (linear 0.2158), right half 255.
-    write_png(&dir.path().join("t.png"), 2, 1, |x, _| if x == 0 { [128; 3] } else { [255; 3] });
-    write_png(&dir.path().join("h.png"), 2, 1, |x, _| if x == 0 { [128; 3] } else { [255; 3] });
+    write_png(&dir.path().join("t.png"), 2, 1, |x, _| {
+        if x == 0 {
+            [128; 3]
+        } else {
+            [255; 3]
+        }
+    });
+    write_png(&dir.path().join("h.png"), 2, 1, |x, _| {
+        if x == 0 {
+            [128; 3]
+        } else {
+            [255; 3]
+        }
+    });
     let data = load_geometry(&dir.path().join("q.obj")).unwrap();
     assert!(data.warnings.is_empty(), "{:?}", data.warnings);
     assert_eq!(data.geometry.triangles.len(), 2);
-    assert_eq!(data.geometry.vertex_uvs.len(), 2, "each triangle has its vt");
+    assert_eq!(
+        data.geometry.vertex_uvs.len(),
+        2,
+        "each triangle has its vt"
+    );
     let m = &data.materials[0];
     assert_eq!(m.maps.uv_scale, [2.0, 2.0]);
     assert_eq!(m.maps.bump_scale, 0.5);
@@ -350,10 +405,15 @@ fn obj_vt_and_map_kd_decode_srgb_and_negative_indices() {
     assert!((colour.texel(0, 0).x - 0.215_861).abs() < 1e-4);
     assert!((height.texel(0, 0).x - 128.0 / 255.0).abs() < 1e-6);
     // Texture coordinates of each triangle corner follow its vertex.
-    for (t, uv) in data.geometry.triangles.items.iter().zip(&data.geometry.vertex_uvs) {
-        for k in 0..3 {
-            let p = t.p[k];
-            assert!((uv[k] - Vec2::new((p.x + 1.0) / 2.0, (p.y + 1.0) / 2.0)).length() < 1e-6);
+    for (t, uv) in data
+        .geometry
+        .triangles
+        .items
+        .iter()
+        .zip(&data.geometry.vertex_uvs)
+    {
+        for (p, uv) in t.p.iter().zip(uv) {
+            assert!((*uv - Vec2::new((p.x + 1.0) / 2.0, (p.y + 1.0) / 2.0)).length() < 1e-6);
         }
     }
 }
@@ -363,13 +423,28 @@ fn obj_without_vt_has_no_texture_coordinates_and_missing_texture_is_visible() {
     let dir = TempDir::new().unwrap();
     let obj = "mtllib m.mtl\nv 0 0 0\nv 1 0 0\nv 0 1 0\nusemtl a\nf 1 2 3\n";
     std::fs::write(dir.path().join("a.obj"), obj).unwrap();
-    std::fs::write(dir.path().join("m.mtl"), "newmtl a\nKd 1 1 1\nmap_Kd nothere.png\nbump gone.png\n").unwrap();
+    std::fs::write(
+        dir.path().join("m.mtl"),
+        "newmtl a\nKd 1 1 1\nmap_Kd nothere.png\nbump gone.png\n",
+    )
+    .unwrap();
     let data = load_geometry(&dir.path().join("a.obj")).unwrap();
     assert!(data.geometry.vertex_uvs.is_empty());
-    let w: Vec<&String> = data.warnings.iter().filter(|w| w.contains("nothere.png")).collect();
+    let w: Vec<&String> = data
+        .warnings
+        .iter()
+        .filter(|w| w.contains("nothere.png"))
+        .collect();
     assert_eq!(w.len(), 1, "{:?}", data.warnings);
-    assert!(w[0].contains("m.mtl:3") && w[0].contains("checkerboard"), "{}", w[0]);
-    assert!(data.warnings.iter().any(|w| w.contains("gone.png") && w.contains("left out")));
+    assert!(
+        w[0].contains("m.mtl:3") && w[0].contains("checkerboard"),
+        "{}",
+        w[0]
+    );
+    assert!(data
+        .warnings
+        .iter()
+        .any(|w| w.contains("gone.png") && w.contains("left out")));
     let m = &data.materials[0];
     assert_eq!(data.textures[m.maps.color as usize], MISSING_TEXTURE);
     assert_eq!(m.maps.bump, emray::scene::NO_TEXTURE);
@@ -425,18 +500,34 @@ material = "t"
 #[test]
 fn toml_materials_take_textures_and_report_bad_ones_at_their_line() {
     let dir = TempDir::new().unwrap();
-    write_png(&dir.path().join("t.png"), 4, 4, |x, y| [(x * 60) as u8, (y * 60) as u8, 200]);
+    write_png(&dir.path().join("t.png"), 4, 4, |x, y| {
+        [(x * 60) as u8, (y * 60) as u8, 200]
+    });
     let path = dir.path().join("s.toml");
     std::fs::write(&path, TOML_SCENE).unwrap();
     let scene = emray::load::load_path(&path).unwrap();
     let m = &scene.materials[0];
     assert_eq!(m.maps.uv_scale, [2.0, 3.0]);
-    assert!(matches!(scene.textures[m.maps.color as usize], Texture::Image(_)));
-    assert!(matches!(scene.textures[m.maps.bump as usize], Texture::Checker { .. }));
+    assert!(matches!(
+        scene.textures[m.maps.color as usize],
+        Texture::Image(_)
+    ));
+    assert!(matches!(
+        scene.textures[m.maps.bump as usize],
+        Texture::Checker { .. }
+    ));
 
     for (bad, line, what) in [
-        ("texture = { file = \"t.png\" }", "texture = { file = \"missing.png\" }", "missing.png"),
-        ("texture = { file = \"t.png\" }", "texture = { type = \"wood\" }", "unknown texture type"),
+        (
+            "texture = { file = \"t.png\" }",
+            "texture = { file = \"missing.png\" }",
+            "missing.png",
+        ),
+        (
+            "texture = { file = \"t.png\" }",
+            "texture = { type = \"wood\" }",
+            "unknown texture type",
+        ),
     ] {
         std::fs::write(&path, TOML_SCENE.replace(bad, line)).unwrap();
         let e = emray::load::load_path(&path).unwrap_err();
@@ -467,13 +558,19 @@ fn backends_agree_on_a_textured_obj_scene() {
         }
     });
     let mut scene = emray::load::load_path(&dir.path().join("s.obj")).unwrap();
-    scene.lights.push(Light::point(Vec3::new(-3.0, 3.0, 4.0), Vec3::splat(0.5)));
+    scene
+        .lights
+        .push(Light::point(Vec3::new(-3.0, 3.0, 4.0), Vec3::splat(0.5)));
     let mut settings = RenderSettings::for_scene(&scene);
     settings.width = 48;
     settings.height = 48;
     let films: Vec<_> = backends()
         .into_iter()
-        .map(|b| render_scene("t", &scene, b, &settings, 0.0, None).unwrap().0)
+        .map(|b| {
+            render_scene("t", &scene, b, &settings, 0.0, None)
+                .unwrap()
+                .0
+        })
         .collect();
     let film = &films[0];
     let distinct: std::collections::HashSet<[u32; 3]> = film
@@ -481,7 +578,11 @@ fn backends_agree_on_a_textured_obj_scene() {
         .iter()
         .map(|p| p.to_array().map(f32::to_bits))
         .collect();
-    assert!(distinct.len() > 20, "the textures show: {} distinct values", distinct.len());
+    assert!(
+        distinct.len() > 20,
+        "the textures show: {} distinct values",
+        distinct.len()
+    );
     for other in &films[1..] {
         let differ = film
             .pixels

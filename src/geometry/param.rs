@@ -145,7 +145,10 @@ impl CappedCone {
         // The base cap faces −axis: mirror u there so that ∂p/∂u × ∂p/∂v = −axis.
         let su = if top { 1.0 } else { -1.0 };
         Param {
-            uv: Vec2::new(0.5 + su * q.dot(e1) / (2.0 * r), 0.5 + q.dot(e2) / (2.0 * r)),
+            uv: Vec2::new(
+                0.5 + su * q.dot(e1) / (2.0 * r),
+                0.5 + q.dot(e2) / (2.0 * r),
+            ),
             dpdu: e1 * (su * 2.0 * r),
             dpdv: e2 * (2.0 * r),
         }
@@ -208,13 +211,18 @@ impl Shape {
             Shape::Torus(t) => t.param(p),
             Shape::Box(b) => {
                 let (min, max) = (b.min(), b.max());
-                box_param(p, ng, (min + max) * 0.5, (max - min) * 0.5, [Vec3::X, Vec3::Y, Vec3::Z])
+                box_param(
+                    p,
+                    ng,
+                    (min + max) * 0.5,
+                    (max - min) * 0.5,
+                    [Vec3::X, Vec3::Y, Vec3::Z],
+                )
             }
             Shape::OBox(b) => box_param(p, ng, b.center(), b.half_extents(), b.axes()),
-            Shape::Plane(_)
-            | Shape::Quadric(_)
-            | Shape::Polyhedron(_)
-            | Shape::Csg(_) => Param::planar(p, ng),
+            Shape::Plane(_) | Shape::Quadric(_) | Shape::Polyhedron(_) | Shape::Csg(_) => {
+                Param::planar(p, ng)
+            }
         }
     }
 }
@@ -340,7 +348,12 @@ mod tests {
         assert!((x.uv - Vec2::new(0.25, 0.5)).length() < 1e-6);
         assert!((at(Vec3::Y).uv.y - 1.0).abs() < 1e-6);
         assert!(at(-Vec3::Y).uv.y.abs() < 1e-6);
-        for d in [Vec3::X, Vec3::Z, -Vec3::X, Vec3::new(0.3, 0.8, -0.5).normalize()] {
+        for d in [
+            Vec3::X,
+            Vec3::Z,
+            -Vec3::X,
+            Vec3::new(0.3, 0.8, -0.5).normalize(),
+        ] {
             assert_frame_outward(&at(d), d);
         }
         // The poles: finite, non-degenerate frames.
@@ -387,9 +400,17 @@ mod tests {
     #[test]
     fn triangle_tangents_reproduce_the_edges() {
         let tri = Triangle {
-            p: [Vec3::ZERO, Vec3::new(2.0, 0.0, 0.0), Vec3::new(0.0, 3.0, 0.0)],
+            p: [
+                Vec3::ZERO,
+                Vec3::new(2.0, 0.0, 0.0),
+                Vec3::new(0.0, 3.0, 0.0),
+            ],
         };
-        let uv = [Vec2::new(0.5, 0.5), Vec2::new(1.0, 0.5), Vec2::new(0.5, 1.0)];
+        let uv = [
+            Vec2::new(0.5, 0.5),
+            Vec2::new(1.0, 0.5),
+            Vec2::new(0.5, 1.0),
+        ];
         let p = tri.param(0.25, 0.5, Some(&uv));
         assert!((p.uv - Vec2::new(0.625, 0.75)).length() < 1e-6);
         assert!((p.dpdu - Vec3::new(4.0, 0.0, 0.0)).length() < 1e-5);

@@ -317,7 +317,11 @@ fn noise(p: Vec3) -> f32 {
         lerp(
             v,
             lerp(u, grad(perm(aa), x, y, z), grad(perm(ba), x - 1.0, y, z)),
-            lerp(u, grad(perm(ab), x, y - 1.0, z), grad(perm(bb), x - 1.0, y - 1.0, z)),
+            lerp(
+                u,
+                grad(perm(ab), x, y - 1.0, z),
+                grad(perm(bb), x - 1.0, y - 1.0, z),
+            ),
         ),
         lerp(
             v,
@@ -559,6 +563,10 @@ mod tests {
             hi = hi.max(n);
         }
         assert!(lo >= -1.01 && hi <= 1.01 && hi - lo > 0.5, "{lo} {hi}");
-        assert_eq!(noise(Vec3::new(1.0, 2.0, 3.0)), 0.0, "zero at lattice points");
+        assert_eq!(
+            noise(Vec3::new(1.0, 2.0, 3.0)),
+            0.0,
+            "zero at lattice points"
+        );
     }
 }

@@ -30,8 +30,8 @@ use crate::load::{nff, obj, LoadError};
 use crate::math::{Aabb, Vec3, Xform};
 use crate::scene::texture::{Image, Wrap};
 use crate::scene::{
-    Camera, Environment, Maps, Geometry, Instance, Light, LoadStats, Material, Scene, Spot, Texture,
-    INHERIT,
+    Camera, Environment, Geometry, Instance, Light, LoadStats, Maps, Material, Scene, Spot,
+    Texture, INHERIT,
 };
 use glam::{Affine3A, DAffine3, DMat3, DMat4, DQuat, DVec3, Quat};
 use std::collections::HashMap;
@@ -687,8 +687,14 @@ impl<'a, 's> Builder<'a, 's> {
                 background = self.non_negative3(b, "`background`")?;
             }
             if let Some(e) = &r.environment {
-                let path = self.src.path.parent().unwrap_or(Path::new("")).join(e.get_ref());
-                self.environment = Some(Environment::load(&path).map_err(|m| self.err(e.span(), m))?);
+                let path = self
+                    .src
+                    .path
+                    .parent()
+                    .unwrap_or(Path::new(""))
+                    .join(e.get_ref());
+                self.environment =
+                    Some(Environment::load(&path).map_err(|m| self.err(e.span(), m))?);
             }
             if let Some(a) = &r.ambient {
                 ambient = self.non_negative3(a, "`ambient`")?;
@@ -749,12 +755,18 @@ impl<'a, 's> Builder<'a, 's> {
     fn texture(&self, def: &Spanned<TextureDef>, srgb: bool) -> R<Texture> {
         let t = def.get_ref();
         let colour = |v: &Option<Spanned<V3>>, default: Vec3| -> R<Vec3> {
-            v.as_ref().map_or(Ok(default), |c| self.non_negative3(c, "a texture colour"))
+            v.as_ref()
+                .map_or(Ok(default), |c| self.non_negative3(c, "a texture colour"))
         };
         let ty = t.ty.as_ref().map(|s| (s.get_ref().as_str(), s.span()));
         match (ty, &t.file) {
             (None | Some(("image", _)), Some(file)) => {
-                let path = self.src.path.parent().unwrap_or(Path::new("")).join(file.get_ref());
+                let path = self
+                    .src
+                    .path
+                    .parent()
+                    .unwrap_or(Path::new(""))
+                    .join(file.get_ref());
                 let mut img = Image::load(&path, srgb).map_err(|e| self.err(file.span(), e))?;
                 img.wrap = match t.wrap.as_ref().map(|w| (w.get_ref().as_str(), w.span())) {
                     None | Some(("repeat", _)) => Wrap::Repeat,
@@ -2021,7 +2033,13 @@ impl<'a, 's> Builder<'a, 's> {
                     ..m
                 })
                 .collect();
-            (data.geometry, materials, Vec::new(), data.stats, Format::Obj)
+            (
+                data.geometry,
+                materials,
+                Vec::new(),
+                data.stats,
+                Format::Obj,
+            )
         } else {
             let bytes = std::fs::read(&path).map_err(unreadable)?;
             let scene = nff::parse_str(&String::from_utf8_lossy(&bytes), &path).map_err(located)?;
