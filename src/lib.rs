@@ -8,6 +8,7 @@
 #![warn(missing_docs)]
 
 pub mod accel;
+pub mod bench;
 pub mod gen;
 pub mod geometry;
 pub mod load;
@@ -17,6 +18,7 @@ pub mod output;
 pub mod render;
 pub mod run;
 pub mod scene;
+pub mod stress;
 
 pub use accel::{Accel, Backend, Hit};
 pub use render::{RenderSettings, RenderStats};

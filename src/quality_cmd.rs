@@ -1,4 +1,5 @@
-//! `emray compare`: error metrics between two images, for people and for scripts.
+//! `emray compare`: error metrics between two images, for people and for scripts;
+//! `emray stress`: the numerical stress cases with their measured numbers.
 
 use clap::Args;
 use emray::metrics::{self, Metrics};
@@ -95,5 +96,106 @@ pub fn compare(a: &CompareArgs) -> ExitCode {
             eprintln!("emray: error: {e}");
             ExitCode::from(2)
         }
+    }
+}
+
+/// `emray stress`.
+#[derive(Args, Debug, Clone)]
+pub struct StressArgs {
+    /// Random rays per far/tiny sphere case.
+    #[arg(long, default_value_t = 1_000_000)]
+    pub rays: u32,
+}
+
+/// Run every stress case at full counts and print what was measured; exit 1 if a
+/// bound of `tests/stability.rs` is broken.
+pub fn stress(a: &StressArgs) -> ExitCode {
+    use emray::accel::bvh::Bvh;
+    use emray::stress::*;
+    use emray::Backend;
+    let mut ok = true;
+    let mut check = |cond: bool, what: String| {
+        println!("{} {what}", if cond { "ok  " } else { "FAIL" });
+        ok &= cond;
+    };
+    let mut backends = vec![Backend::Bvh];
+    if cfg!(feature = "embree") {
+        backends.push(Backend::Embree);
+    }
+    for &b in &backends {
+        let want = render(&floor_scene(1.0, 256), b);
+        for e in -4..=4 {
+            if e == 0 {
+                continue;
+            }
+            let share = differing_share(&render(&floor_scene(10f64.powi(e), 256), b), &want);
+            check(
+                share <= 1e-3,
+                format!(
+                    "scale 1e{e} ({b:?}, 256x256): {:.4}% pixels differ (bound 0.1%)",
+                    share * 100.0
+                ),
+            );
+        }
+    }
+    for e in -4..=4 {
+        let c = convex_scene(10f64.powi(e), 0.0, 256);
+        let (lit, bad) = acne(&c, &Bvh::build(&c));
+        check(
+            bad == 0,
+            format!("scale 1e{e}: acne {bad} of {lit} lit points"),
+        );
+    }
+    let base = render(&convex_scene(1.0, 0.0, 256), Backend::Bvh);
+    for e in 3..=6 {
+        let s = convex_scene(1.0, 10f64.powi(e), 256);
+        let (lit, bad) = acne(&s, &Bvh::build(&s));
+        let share = differing_share(&render(&s, Backend::Bvh), &base);
+        check(
+            e > 5 || bad == 0,
+            format!(
+                "offset 1e{e}: acne {bad} of {lit} lit points, {:.3}% pixels differ",
+                share * 100.0
+            ),
+        );
+    }
+    for (dist, radius) in [(1e4f32, 1.0f32), (1e2, 1e-4), (1e6, 1e3), (1e5, 1e-2)] {
+        let (worst, miss, extra) = far_sphere(dist, radius, a.rays, 7);
+        check(
+            worst < 1e-5,
+            format!(
+                "sphere r={radius:e} at {dist:e}: worst relative t error {worst:.3e} over {} rays; \
+                 silhouette: {miss} f32 misses, {extra} f32 extra hits",
+                a.rays
+            ),
+        );
+    }
+    for level in [2, 4] {
+        let (scene, targets) = tessellated_sphere(level);
+        let origins = origins(64, 3.0);
+        let (rays, misses) = watertight(&Bvh::build(&scene), &targets, &origins);
+        check(
+            misses == 0,
+            format!(
+                "watertight (bvh, {} triangles): {misses} misses of {rays}",
+                scene.triangles.len()
+            ),
+        );
+        #[cfg(feature = "embree")]
+        match emray::accel::embree::EmbreeAccel::build(&scene) {
+            Ok(e) => {
+                let (rays, misses) = watertight(&e, &targets, &origins);
+                println!(
+                    "info watertight (embree, {} triangles): {misses} misses of {rays}",
+                    scene.triangles.len()
+                );
+            }
+            Err(e) => println!("info embree unavailable: {e}"),
+        }
+    }
+    if ok {
+        ExitCode::SUCCESS
+    } else {
+        ExitCode::from(1)
     }
 }

@@ -32,6 +32,8 @@ pub struct RenderSettings {
     pub spd: bool,
     /// Tile edge in pixels.
     pub tile: u32,
+    /// Embree build quality (the BVH backend ignores it).
+    pub embree_quality: crate::accel::EmbreeQuality,
     /// Antialiasing: uniform `spp` samples per pixel, or adaptive subdivision.
     pub aa: Aa,
     /// Hall & Greenberg's adaptive ray-tree depth: a reflected or refracted ray whose
@@ -80,6 +82,7 @@ impl RenderSettings {
             max_depth: 5,
             spd: false,
             tile: 16,
+            embree_quality: crate::accel::EmbreeQuality::Medium,
             aa: Aa::Uniform,
             bailout: 0.0,
             skip: true,
