@@ -30,6 +30,9 @@ pub enum Command {
     /// Numerical stress cases (scale, translation, far/tiny spheres, watertightness)
     /// with their measured numbers; exit status 1 if a bound is broken.
     Stress(crate::quality_cmd::StressArgs),
+    /// Error against time: the f64 reference once, then a sweep of spp, adaptive AA,
+    /// bailout, depth and backends, to DIR/study.csv and DIR/study.svg.
+    Study(crate::quality_cmd::StudyArgs),
 }
 
 /// `emray bench`.
@@ -273,7 +276,7 @@ pub const MAX_SIDE: u32 = 65536;
 /// Largest accepted pixel count (2^28, 268 megapixels).
 pub const MAX_PIXELS: u64 = 1 << 28;
 
-fn parse_res(s: &str) -> Result<(u32, u32), String> {
+pub fn parse_res(s: &str) -> Result<(u32, u32), String> {
     let (w, h) = s
         .split_once(['x', 'X'])
         .ok_or_else(|| format!("'{s}' is not WxH (e.g. 640x480)"))?;

@@ -28,6 +28,7 @@ fn main() -> ExitCode {
         Some(Command::Bench(b)) => return bench(&b),
         Some(Command::Compare(c)) => return quality_cmd::compare(&c),
         Some(Command::Stress(s)) => return quality_cmd::stress(&s),
+        Some(Command::Study(s)) => return quality_cmd::study(&s),
         None => RenderArgs::default_scene(),
     };
     let level = match (args.quiet, args.verbose) {
