@@ -315,6 +315,10 @@ pub struct RenderArgs {
     /// Refuse a render estimated to need more memory (e.g. 8G) [default: 3/4 of RAM].
     #[arg(long, value_name = "SIZE", value_parser = emray::batch::limits::parse_size)]
     pub max_memory: Option<u64>,
+    /// Environment map for rays that leave the scene (PNG/JPEG: 2:1 latitude-longitude
+    /// or a 4:3 cube cross), replacing the scene's own.
+    #[arg(long, value_name = "FILE")]
+    pub envmap: Option<PathBuf>,
     /// No progress bar and no messages but errors.
     #[arg(short, long)]
     pub quiet: bool,
@@ -348,6 +352,7 @@ impl RenderArgs {
             tile: None,
             crop: None,
             max_memory: None,
+            envmap: None,
             quiet: false,
             verbose: 0,
         }

@@ -9,6 +9,7 @@ use cli::{Cli, Command, RenderArgs};
 use emray::accel::Backend;
 use emray::gen::Database;
 use emray::load;
+use emray::scene::Environment;
 use emray::Scene;
 use std::io::{IsTerminal, Write};
 use std::path::{Path, PathBuf};
@@ -367,7 +368,7 @@ fn render_all(args: &RenderArgs, jobs: &[Job]) -> Result<()> {
 
 fn render_one(args: &RenderArgs, scene_path: Option<&Path>, out: &Path) -> Result<()> {
     let t0 = Instant::now();
-    let (name, scene): (String, Scene) = match scene_path {
+    let (name, mut scene): (String, Scene) = match scene_path {
         Some(p) => (
             p.display().to_string(),
             emray::batch::load_scene(p).map_err(anyhow::Error::msg)?,
@@ -377,6 +378,9 @@ fn render_one(args: &RenderArgs, scene_path: Option<&Path>, out: &Path) -> Resul
             load::nff::parse_str(DEFAULT_SCENE, Path::new("<default scene>"))?,
         ),
     };
+    if let Some(env) = &args.envmap {
+        scene.environment = Some(Environment::load(env).map_err(anyhow::Error::msg)?);
+    }
     let load_ms = t0.elapsed().as_secs_f64() * 1e3;
     let job = emray::batch::JobSettings {
         backend: args.backend.map(Backend::from),
