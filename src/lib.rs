@@ -13,6 +13,7 @@ pub mod geometry;
 pub mod load;
 pub mod math;
 pub mod output;
+pub mod radiosity;
 pub mod render;
 pub mod run;
 pub mod scene;

@@ -23,6 +23,7 @@ fn main() -> ExitCode {
     let args = match cli.command {
         Some(Command::Render(a)) => a,
         Some(Command::Gen(g)) => return gen(&g),
+        Some(Command::Radiosity(r)) => return radiosity(&r),
         None => RenderArgs::default_scene(),
     };
     let level = match (args.quiet, args.verbose) {
@@ -82,6 +83,68 @@ fn gen(g: &cli::GenArgs) -> ExitCode {
             ExitCode::from(1)
         }
     }
+}
+
+/// `emray radiosity`: exit 1 on any input, solve or output error.
+fn radiosity(a: &cli::RadiosityArgs) -> ExitCode {
+    env_logger::Builder::from_env(env_logger::Env::default().default_filter_or("warn"))
+        .format_timestamp(None)
+        .init();
+    match radiosity_run(a) {
+        Ok(()) => ExitCode::SUCCESS,
+        Err(e) => {
+            eprintln!("emray: error: {e:#}");
+            ExitCode::from(1)
+        }
+    }
+}
+
+fn radiosity_run(a: &cli::RadiosityArgs) -> Result<()> {
+    use emray::radiosity::{RadiositySettings, SolverKind};
+    emray::output::Format::from_path(&a.output)?;
+    let mut builder = rayon::ThreadPoolBuilder::new();
+    if let Some(t) = a.threads {
+        builder = builder.num_threads(t as usize);
+    }
+    let pool = builder.build().context("cannot start the worker threads")?;
+    let scene = load::load_path(&a.scene)?;
+    let settings = RadiositySettings {
+        patch_size: a.patch_size,
+        shooter_level: a.ff_samples,
+        visibility_level: a.vis_samples,
+        epsilon: a.epsilon,
+        max_iterations: a.max_iterations,
+        solver: match a.solver {
+            cli::SolverArg::Progressive => SolverKind::Progressive,
+            cli::SolverArg::GaussSeidel => SolverKind::GaussSeidel,
+        },
+    };
+    let (w, h) = a.res.unwrap_or((scene.camera.width, scene.camera.height));
+    let spp = (a.spp as f32).sqrt().floor().max(1.0) as u32;
+    let backend: Backend = a
+        .backend
+        .map(Backend::from)
+        .unwrap_or_else(Backend::default_available);
+    let (sol, film, report) = pool
+        .install(|| emray::radiosity::run(&scene, backend, &settings, (w, h, spp)))
+        .with_context(|| a.scene.display().to_string())?;
+    emray::output::write_image(&a.output, &film, emray::output::Encoding::Srgb)?;
+    if let Some(p) = &a.ply {
+        emray::output::write_text(p, &sol.to_ply(1.0))?;
+    }
+    if a.stats {
+        println!("scene      {}\n{}", a.scene.display(), report.summary());
+    }
+    if let Some(path) = &a.stats_json {
+        let line = serde_json::to_string(&report).expect("report serialises");
+        let mut f = std::fs::OpenOptions::new()
+            .create(true)
+            .append(true)
+            .open(path)
+            .with_context(|| format!("{}: cannot open for writing", path.display()))?;
+        writeln!(f, "{line}").with_context(|| format!("{}: cannot write", path.display()))?;
+    }
+    Ok(())
 }
 
 /// The file-name stem of a scene: the file's, or `NAME_sN` for a generated one.

@@ -153,6 +153,7 @@ fn cube_of_quads_is_twelve_outward_triangles_with_its_materials() {
         ior: 1.0,
         filter: Vec3::ONE,
         priority: 0,
+        ..Material::DEFAULT
     };
     let m = &data.materials;
     assert!(close(m[0].color, red.color) && (m[0].ka - red.ka).abs() < 1e-6);

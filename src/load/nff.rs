@@ -471,6 +471,7 @@ impl<'a> Parser<'a, '_> {
             ior,
             filter: Vec3::ONE,
             priority: 0,
+            ..Material::DEFAULT
         });
         self.current_material = Some(self.materials.len() as u32 - 1);
         Ok(())

@@ -1091,6 +1091,7 @@ fn convert_material(m: &tobj::Material) -> (Material, Option<String>) {
         ior: ni.unwrap_or(1.0),
         filter: Vec3::ONE,
         priority: 0,
+        ..Material::DEFAULT
     };
     (material, warning)
 }
