@@ -46,7 +46,7 @@ pub struct RadiosityArgs {
     /// Also write the solved mesh with vertex colours as PLY.
     #[arg(long, value_name = "FILE.ply")]
     pub ply: Option<PathBuf>,
-    /// Longest element edge, in scene units [default: 1/24 of the scene's diagonal].
+    /// Longest element edge, in scene units [default: 1/12 of the scene's diagonal].
     #[arg(long, value_name = "SIZE")]
     pub patch_size: Option<f32>,
     /// Form-factor sample points per shooting element: 1, 4, 16 or 64.
@@ -191,6 +191,25 @@ pub struct RenderArgs {
     /// More log output (repeat for more).
     #[arg(short, long, action = clap::ArgAction::Count)]
     pub verbose: u8,
+    /// Global illumination: `radiosity` solves the diffuse interreflection first and
+    /// takes the diffuse term of polygons and meshes from it (two-pass).
+    #[arg(long, value_enum)]
+    pub gi: Option<GiArg>,
+    /// Radiosity patch size for `--gi radiosity` [default: 1/12 of the scene's
+    /// diagonal].
+    #[arg(long, value_name = "SIZE")]
+    pub patch_size: Option<f32>,
+    /// Shadow rays per emitting triangle (area light), a square number: 16 = 4×4
+    /// strata.
+    #[arg(long, default_value_t = 16, value_parser = clap::value_parser!(u32).range(1..=4096))]
+    pub area_samples: u32,
+}
+
+/// Global-illumination methods.
+#[derive(Clone, Copy, Debug, ValueEnum, PartialEq, Eq)]
+pub enum GiArg {
+    /// Two-pass: radiosity for the diffuse term, Whitted for the specular paths.
+    Radiosity,
 }
 
 impl RenderArgs {
@@ -210,6 +229,9 @@ impl RenderArgs {
             encoding: EncodingArg::Srgb,
             quiet: false,
             verbose: 0,
+            gi: None,
+            patch_size: None,
+            area_samples: 16,
         }
     }
 }

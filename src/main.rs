@@ -283,8 +283,27 @@ fn render_one(args: &RenderArgs, scene_path: Option<&Path>, out: &Path) -> Resul
             b.set_position(done as u64);
         }
     };
-    let (film, report) =
-        emray::run::render_scene(&name, &scene, backend, &settings, load_ms, Some(&progress))?;
+    settings.area_samples = (args.area_samples as f32).sqrt().floor().max(1.0) as u32;
+    let (film, report) = match args.gi {
+        None => {
+            emray::run::render_scene(&name, &scene, backend, &settings, load_ms, Some(&progress))?
+        }
+        Some(cli::GiArg::Radiosity) => {
+            let rad = emray::radiosity::RadiositySettings {
+                patch_size: args.patch_size,
+                ..Default::default()
+            };
+            emray::run::render_two_pass(
+                &name,
+                &scene,
+                backend,
+                &settings,
+                &rad,
+                load_ms,
+                Some(&progress),
+            )?
+        }
+    };
     if let Some(b) = &bar {
         b.finish_and_clear();
     }

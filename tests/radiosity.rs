@@ -27,8 +27,18 @@ fn camera() -> Camera {
 
 /// A quad `a b c d` (counterclockwise seen from its front) as two triangles.
 fn quad(s: &mut Scene, q: [Vec3; 4], material: u32) {
-    s.add_triangle(Triangle { p: [q[0], q[1], q[2]] }, material);
-    s.add_triangle(Triangle { p: [q[0], q[2], q[3]] }, material);
+    s.add_triangle(
+        Triangle {
+            p: [q[0], q[1], q[2]],
+        },
+        material,
+    );
+    s.add_triangle(
+        Triangle {
+            p: [q[0], q[2], q[3]],
+        },
+        material,
+    );
 }
 
 /// The six inward-facing faces of the box `lo..hi`, all of `material` except the
@@ -42,12 +52,32 @@ fn closed_box(s: &mut Scene, lo: Vec3, hi: Vec3, material: u32, ceiling: u32) {
         )
     };
     // Each face counterclockwise seen from inside.
-    quad(s, [v(0, 0, 0), v(0, 0, 1), v(1, 0, 1), v(1, 0, 0)], material); // floor
+    quad(
+        s,
+        [v(0, 0, 0), v(0, 0, 1), v(1, 0, 1), v(1, 0, 0)],
+        material,
+    ); // floor
     quad(s, [v(0, 1, 0), v(1, 1, 0), v(1, 1, 1), v(0, 1, 1)], ceiling); // ceiling
-    quad(s, [v(0, 0, 0), v(1, 0, 0), v(1, 1, 0), v(0, 1, 0)], material); // back z=lo
-    quad(s, [v(0, 0, 1), v(0, 1, 1), v(1, 1, 1), v(1, 0, 1)], material); // front z=hi
-    quad(s, [v(0, 0, 0), v(0, 1, 0), v(0, 1, 1), v(0, 0, 1)], material); // left x=lo
-    quad(s, [v(1, 0, 0), v(1, 0, 1), v(1, 1, 1), v(1, 1, 0)], material); // right x=hi
+    quad(
+        s,
+        [v(0, 0, 0), v(1, 0, 0), v(1, 1, 0), v(0, 1, 0)],
+        material,
+    ); // back z=lo
+    quad(
+        s,
+        [v(0, 0, 1), v(0, 1, 1), v(1, 1, 1), v(1, 0, 1)],
+        material,
+    ); // front z=hi
+    quad(
+        s,
+        [v(0, 0, 0), v(0, 1, 0), v(0, 1, 1), v(0, 0, 1)],
+        material,
+    ); // left x=lo
+    quad(
+        s,
+        [v(1, 0, 0), v(1, 0, 1), v(1, 1, 1), v(1, 1, 0)],
+        material,
+    ); // right x=hi
 }
 
 /// An outward-facing box (an occluder) `lo..hi`.
@@ -84,6 +114,7 @@ fn white_box(rho: f32) -> Scene {
 /// block: shadows, colour bleeding.
 fn cornellish() -> Scene {
     let mut s = Scene::new(camera());
+    s.ambient = Vec3::ZERO;
     let white = Vec3::splat(0.7);
     for color in [white, Vec3::new(0.7, 0.1, 0.1), Vec3::new(0.1, 0.6, 0.1)] {
         s.materials.push(Material {
@@ -295,7 +326,10 @@ fn point_to_disk_matches_the_analytic_value() {
             .collect();
         let f = point_to_polygon(Vec3::ZERO, Vec3::Z, &poly) as f64;
         let expect = point_to_disk(r as f64, h as f64);
-        assert!(((f - expect) / expect).abs() < 1e-3, "r {r} h {h}: {f} vs {expect}");
+        assert!(
+            ((f - expect) / expect).abs() < 1e-3,
+            "r {r} h {h}: {f} vs {expect}"
+        );
     }
 }
 
@@ -343,7 +377,9 @@ fn progressive_residual_decreases_and_agrees_with_gauss_seidel() {
             .elements
             .iter()
             .zip(&p.solve.radiosity)
-            .filter(|(e, _)| e.n.y > 0.9 && e.centroid().y < 0.01 && (e.centroid().x - x).abs() < 0.1)
+            .filter(|(e, _)| {
+                e.n.y > 0.9 && e.centroid().y < 0.01 && (e.centroid().x - x).abs() < 0.1
+            })
             .map(|(_, b)| *b)
             .fold(Vec3::ZERO, |a, b| a + b)
     };
@@ -386,7 +422,11 @@ fn the_view_shows_the_interpolated_solution() {
     .unwrap();
     let film = radiosity::render_view(&scene, &accel, &sol, 16, 16, 1);
     // Looking at the back wall from inside: every pixel lit, none black.
-    let lo = film.pixels.iter().map(|p| p.min_element()).fold(f32::MAX, f32::min);
+    let lo = film
+        .pixels
+        .iter()
+        .map(|p| p.min_element())
+        .fold(f32::MAX, f32::min);
     assert!(lo > 0.0, "a black pixel inside the lit box");
     // No pixel brighter than the brightest vertex.
     let hi = sol
@@ -404,3 +444,93 @@ fn the_view_shows_the_interpolated_solution() {
     );
 }
 
+#[test]
+fn area_light_sampling_matches_the_form_factor_and_softens_shadows() {
+    use emray::radiosity::area;
+    // A 1 × 1 emitter facing down, 1 above the origin of a floor facing up.
+    let mut s = Scene::new(camera());
+    s.materials.push(Material::DEFAULT);
+    s.materials.push(Material {
+        emission: Vec3::splat(2.0),
+        ..Material::DEFAULT
+    });
+    let light = [
+        Vec3::new(-0.5, 1.0, -0.5),
+        Vec3::new(0.5, 1.0, -0.5),
+        Vec3::new(0.5, 1.0, 0.5),
+        Vec3::new(-0.5, 1.0, 0.5),
+    ];
+    quad(&mut s, light, 1);
+    let lights = area::collect(&s);
+    assert_eq!(lights.len(), 2);
+    assert!(
+        lights.iter().all(|l| l.n.y < -0.99),
+        "the emitter faces down"
+    );
+    let accel = Bvh::build(&s);
+    let p = Vec3::new(0.1, 0.0, -0.2);
+    let (e, rays) = area::direct(&accel, &lights, p, Vec3::ZERO, Vec3::Y, Vec3::Y, 8);
+    assert_eq!(rays, 2 * 64);
+    // Irradiance/π = E × F(point → light).
+    let f = point_to_polygon(p, Vec3::Y, &light);
+    assert!(
+        (e.x / (2.0 * f) - 1.0).abs() < 0.02,
+        "{} vs {}",
+        e.x,
+        2.0 * f
+    );
+    // A blocker over half of the light: a penumbra, between none and all.
+    let mut blocked = s.clone();
+    quad(
+        &mut blocked,
+        [
+            Vec3::new(-2.0, 0.5, -2.0),
+            Vec3::new(0.1, 0.5, -2.0),
+            Vec3::new(0.1, 0.5, 2.0),
+            Vec3::new(-2.0, 0.5, 2.0),
+        ],
+        0,
+    );
+    let accel = Bvh::build(&blocked);
+    let (h, _) = area::direct(&accel, &lights, p, Vec3::ZERO, Vec3::Y, Vec3::Y, 8);
+    assert!(
+        h.x > 0.2 * e.x && h.x < 0.8 * e.x,
+        "penumbra {} of {}",
+        h.x,
+        e.x
+    );
+}
+
+#[test]
+fn two_pass_without_specular_paths_shows_the_radiosity_solution() {
+    let scene = cornellish();
+    let accel = Bvh::build(&scene);
+    let sol = radiosity::solve(
+        &scene,
+        &accel,
+        &RadiositySettings {
+            patch_size: Some(0.45),
+            ..Default::default()
+        },
+    )
+    .unwrap();
+    let view = radiosity::render_view(&scene, &accel, &sol, 16, 16, 1);
+    let mut settings = emray::RenderSettings::for_scene(&scene);
+    settings.width = 16;
+    settings.height = 16;
+    let (film, stats) = emray::render::render_with_gi(&scene, &accel, &settings, Some(&sol), None);
+    // Everything is diffuse and there are no point lights: one diffuse term, counted
+    // once, from the solution; no shadow rays.
+    assert_eq!(stats.rays.shadow, 0);
+    for (a, b) in film.pixels.iter().zip(&view.pixels) {
+        assert!((*a - *b).abs().max_element() <= 1e-6 * b.max_element().max(1.0));
+    }
+    // Without the solution the emitter still lights the room, through area-light
+    // sampling, with soft shadows: direct light only, so darker on average.
+    let (direct, stats) = emray::render::render(&scene, &accel, &settings, None);
+    assert!(stats.rays.shadow > 0);
+    let mean = |f: &emray::render::Film| {
+        f.pixels.iter().map(|p| p.x + p.y + p.z).sum::<f32>() / f.pixels.len() as f32
+    };
+    assert!(mean(&direct) > 0.0 && mean(&direct) < mean(&film));
+}

@@ -136,7 +136,11 @@ impl Mesh {
                 .iter()
                 .map(|m| (m.color * m.kd).min(Vec3::splat(0.999)))
                 .collect(),
-            emission: scene.materials.iter().map(|m: &Material| m.emission).collect(),
+            emission: scene
+                .materials
+                .iter()
+                .map(|m: &Material| m.emission)
+                .collect(),
             ..Default::default()
         };
         let mut welder: HashMap<VertexKey, u32> = HashMap::new();
@@ -281,7 +285,13 @@ mod tests {
     #[test]
     fn descend_inverts_children() {
         let t = [Vec3::ZERO, Vec3::X, Vec3::Y];
-        for &(u, v) in &[(0.1f32, 0.2f32), (0.7, 0.1), (0.1, 0.8), (0.3, 0.3), (0.45, 0.4)] {
+        for &(u, v) in &[
+            (0.1f32, 0.2f32),
+            (0.7, 0.1),
+            (0.1, 0.8),
+            (0.3, 0.3),
+            (0.45, 0.4),
+        ] {
             let (c, cu, cv) = descend(u, v);
             let child = children(t)[c];
             let q = child[0] * (1.0 - cu - cv) + child[1] * cu + child[2] * cv;

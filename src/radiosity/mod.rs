@@ -13,6 +13,7 @@
 //! Elements are one-sided: they emit and receive on the side their triangle's winding
 //! makes the front (counterclockwise seen from the front); the back side shows black.
 
+pub mod area;
 pub mod formfactor;
 pub mod mesh;
 pub mod solver;
@@ -58,7 +59,7 @@ pub enum SolverKind {
 /// How to solve.
 #[derive(Clone, Debug, PartialEq)]
 pub struct RadiositySettings {
-    /// Longest element edge; `None`: 1/24 of the diagonal of the meshed triangles'
+    /// Longest element edge; `None`: 1/12 of the diagonal of the meshed triangles'
     /// bounds.
     pub patch_size: Option<f32>,
     /// Shooter sample points per element: `4^shooter_level`.
@@ -210,25 +211,17 @@ pub fn solve<A: Accel>(
     }
     let s = Sampling::new(settings.shooter_level, settings.visibility_level);
     let solve = match settings.solver {
-        SolverKind::Progressive => solver::progressive(
-            &mesh,
-            accel,
-            &s,
-            settings.epsilon,
-            settings.max_iterations,
-        )?,
-        SolverKind::GaussSeidel => solver::gauss_seidel(
-            &mesh,
-            accel,
-            &s,
-            settings.epsilon,
-            settings.max_iterations,
-        )?,
+        SolverKind::Progressive => {
+            solver::progressive(&mesh, accel, &s, settings.epsilon, settings.max_iterations)?
+        }
+        SolverKind::GaussSeidel => {
+            solver::gauss_seidel(&mesh, accel, &s, settings.epsilon, settings.max_iterations)?
+        }
     };
     Ok(Solution::new(mesh, solve))
 }
 
-/// 1/24 of the diagonal of the bounds of the scene's top-level and instanced
+/// 1/12 of the diagonal of the bounds of the scene's top-level and instanced
 /// triangles.
 pub fn default_patch_size(scene: &Scene) -> f32 {
     let mut b = crate::math::Aabb::EMPTY;
@@ -242,7 +235,7 @@ pub fn default_patch_size(scene: &Scene) -> f32 {
     }
     let d = b.extent().length();
     if d.is_finite() && d > 0.0 {
-        d / 24.0
+        d / 12.0
     } else {
         1.0
     }

@@ -79,9 +79,7 @@ pub fn progressive<A: Accel>(
     };
     let mut ff_ms = 0.0;
     loop {
-        let unshot_power: f64 = (0..n)
-            .map(|i| power(out.unshot[i]) * area[i] as f64)
-            .sum();
+        let unshot_power: f64 = (0..n).map(|i| power(out.unshot[i]) * area[i] as f64).sum();
         let residual = unshot_power / total_emitted;
         out.residuals.push(residual);
         if residual < epsilon || out.iterations >= max_shots {
@@ -134,9 +132,7 @@ pub fn gauss_seidel<A: Accel>(
     }
     let t = Instant::now();
     // f[i][j] = F_ij, from i to j.
-    let f: Vec<Vec<f32>> = (0..n)
-        .map(|i| form_factor_row(mesh, accel, s, i))
-        .collect();
+    let f: Vec<Vec<f32>> = (0..n).map(|i| form_factor_row(mesh, accel, s, i)).collect();
     let ff_ms = t.elapsed().as_secs_f64() * 1e3;
     let scale = emission
         .iter()

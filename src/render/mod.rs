@@ -31,6 +31,8 @@ pub struct RenderSettings {
     pub spd: bool,
     /// Tile edge in pixels.
     pub tile: u32,
+    /// Shadow rays per emitting triangle (area light): `area_samples²`, stratified.
+    pub area_samples: u32,
 }
 
 impl RenderSettings {
@@ -43,6 +45,7 @@ impl RenderSettings {
             max_depth: 5,
             spd: false,
             tile: 16,
+            area_samples: 4,
         }
     }
 }
@@ -76,12 +79,24 @@ pub fn render<A: Accel>(
     settings: &RenderSettings,
     progress: Option<Progress<'_>>,
 ) -> (Film, RenderStats) {
+    render_with_gi(scene, accel, settings, None, progress)
+}
+
+/// [`render`], two-pass when `gi` is given: the diffuse term of the meshed surfaces
+/// comes from the radiosity solution, the Whitted recursion adds the specular paths.
+pub fn render_with_gi<A: Accel>(
+    scene: &Scene,
+    accel: &A,
+    settings: &RenderSettings,
+    gi: Option<&crate::radiosity::Solution>,
+    progress: Option<Progress<'_>>,
+) -> (Film, RenderStats) {
     let start = std::time::Instant::now();
     let (w, h) = (settings.width, settings.height);
     // In SPD mode the sample grid is the pixel corners: one more row and column.
     let (gw, gh) = if settings.spd { (w + 1, h + 1) } else { (w, h) };
     let gen = RayGen::new(&scene.camera, gw, gh);
-    let tracer = whitted::Tracer::new(scene, accel, settings);
+    let tracer = whitted::Tracer::new(scene, accel, settings).with_gi(gi);
     let ts = settings.tile.max(1);
     let tiles: Vec<(u32, u32)> = (0..gh.div_ceil(ts))
         .flat_map(|ty| (0..gw.div_ceil(ts)).map(move |tx| (tx * ts, ty * ts)))
