@@ -21,6 +21,12 @@ pub enum Command {
     Render(RenderArgs),
     /// Write a Standard Procedural Database as NFF, as the SPD 3.14 programs do.
     Gen(GenArgs),
+    /// Error metrics of an image against a reference (RMSE, PSNR, FLIP, ...); exit
+    /// status 0 within the thresholds, 1 beyond, 2 on a usage or I/O error.
+    Compare(crate::quality_cmd::CompareArgs),
+    /// Numerical stress cases (scale, translation, far/tiny spheres, watertightness)
+    /// with their measured numbers; exit status 1 if a bound is broken.
+    Stress(crate::quality_cmd::StressArgs),
     /// Solve a scene's diffuse interreflection by radiosity and render a view of it.
     Radiosity(RadiosityArgs),
 }
@@ -146,6 +152,15 @@ impl From<EncodingArg> for Encoding {
     }
 }
 
+/// Antialiasing modes as named on the command line.
+#[derive(Clone, Copy, Debug, ValueEnum, PartialEq, Eq)]
+pub enum AaArg {
+    /// `--spp` stratified samples per pixel.
+    Uniform,
+    /// Adaptive corner subdivision (`--aa-threshold`, `--aa-depth`).
+    Adaptive,
+}
+
 /// `emray render`.
 #[derive(Args, Debug, Clone)]
 pub struct RenderArgs {
@@ -176,6 +191,32 @@ pub struct RenderArgs {
     /// SPD testing mode: 513x513 corner rays for 512x512, depth 5, ray statistics.
     #[arg(long)]
     pub spd: bool,
+    /// Antialiasing: `uniform` (`--spp` stratified samples) or `adaptive` (corner rays
+    /// shared by neighbouring pixels, subdivided where the corners differ).
+    #[arg(long, value_enum, default_value_t = AaArg::Uniform)]
+    pub aa: AaArg,
+    /// Adaptive AA: largest corner difference (linear, any channel) left unsplit.
+    #[arg(long, value_name = "T", default_value_t = emray::render::DEFAULT_AA_THRESHOLD)]
+    pub aa_threshold: f32,
+    /// Adaptive AA: most subdivision levels per pixel (0 = the four corners only).
+    #[arg(long, value_name = "D", default_value_t = emray::render::DEFAULT_AA_DEPTH,
+          value_parser = clap::value_parser!(u32).range(0..=8))]
+    pub aa_depth: u32,
+    /// No reflected/refracted ray whose accumulated weight (product of Ks, T and filter
+    /// colours from the eye) is below W; 0 = the full ray tree [default: 0.001, 0 with
+    /// --spd].
+    #[arg(long, value_name = "W")]
+    pub bailout: Option<f32>,
+    /// Render the f64 reference instead: everything in double precision, brute-force
+    /// traversal, N×N stratified samples per pixel with N = floor(sqrt(--spp))
+    /// [default --spp 256: 16×16]. Spheres, cones and triangles only; other scenes are
+    /// refused.
+    #[arg(long)]
+    pub reference: bool,
+    /// Cast the rays that cannot change the image too (shadow rays to lights behind the
+    /// surface, reflection rays off Ks = 0): only to measure what skipping them saves.
+    #[arg(long)]
+    pub no_skip: bool,
     /// Print primitives, timings, ray counts and Mrays/s.
     #[arg(long)]
     pub stats: bool,
@@ -224,6 +265,12 @@ impl RenderArgs {
             max_depth: None,
             threads: None,
             spd: false,
+            aa: AaArg::Uniform,
+            aa_threshold: emray::render::DEFAULT_AA_THRESHOLD,
+            aa_depth: emray::render::DEFAULT_AA_DEPTH,
+            bailout: None,
+            no_skip: false,
+            reference: false,
             stats: false,
             stats_json: None,
             encoding: EncodingArg::Srgb,

@@ -12,11 +12,13 @@ pub mod gen;
 pub mod geometry;
 pub mod load;
 pub mod math;
+pub mod metrics;
 pub mod output;
 pub mod radiosity;
 pub mod render;
 pub mod run;
 pub mod scene;
+pub mod stress;
 
 pub use accel::{Accel, Backend, Hit};
 pub use render::{RenderSettings, RenderStats};

@@ -1,6 +1,7 @@
 //! The `emray` command.
 
 mod cli;
+mod quality_cmd;
 
 use anyhow::{bail, Context, Result};
 use clap::Parser;
@@ -23,6 +24,8 @@ fn main() -> ExitCode {
     let args = match cli.command {
         Some(Command::Render(a)) => a,
         Some(Command::Gen(g)) => return gen(&g),
+        Some(Command::Compare(c)) => return quality_cmd::compare(&c),
+        Some(Command::Stress(s)) => return quality_cmd::stress(&s),
         Some(Command::Radiosity(r)) => return radiosity(&r),
         None => RenderArgs::default_scene(),
     };
@@ -173,6 +176,20 @@ type Job = (Option<PathBuf>, PathBuf);
 
 /// The jobs, or a usage error (exit status 2) found before any work is done.
 fn plan(args: &RenderArgs) -> Result<Vec<Job>, String> {
+    if args.reference && (args.spd || args.aa != cli::AaArg::Uniform) {
+        return Err(
+            "--reference samples N×N stratified: it cannot be combined with --spd or --aa adaptive"
+                .into(),
+        );
+    }
+    for (name, v) in [
+        ("--bailout", args.bailout.unwrap_or(0.0)),
+        ("--aa-threshold", args.aa_threshold),
+    ] {
+        if !v.is_finite() || v < 0.0 {
+            return Err(format!("{name} must be a finite number >= 0, not {v}"));
+        }
+    }
     if args.scenes.len() > 1 {
         if let Some(o) = &args.output {
             if !o.contains("{stem}") {
@@ -259,6 +276,18 @@ fn render_one(args: &RenderArgs, scene_path: Option<&Path>, out: &Path) -> Resul
         settings.spp = 1;
         settings.max_depth = 5;
     }
+    settings.bailout = args.bailout.unwrap_or(if args.spd {
+        0.0
+    } else {
+        emray::render::DEFAULT_BAILOUT
+    });
+    if args.aa == cli::AaArg::Adaptive {
+        settings.aa = emray::render::Aa::Adaptive {
+            threshold: args.aa_threshold,
+            depth: args.aa_depth,
+        };
+    }
+    settings.skip = !args.no_skip;
     let backend: Backend = args
         .backend
         .map(Backend::from)
@@ -284,25 +313,26 @@ fn render_one(args: &RenderArgs, scene_path: Option<&Path>, out: &Path) -> Resul
         }
     };
     settings.area_samples = (args.area_samples as f32).sqrt().floor().max(1.0) as u32;
-    let (film, report) = match args.gi {
-        None => {
-            emray::run::render_scene(&name, &scene, backend, &settings, load_ms, Some(&progress))?
-        }
-        Some(cli::GiArg::Radiosity) => {
-            let rad = emray::radiosity::RadiositySettings {
-                patch_size: args.patch_size,
-                ..Default::default()
-            };
-            emray::run::render_two_pass(
-                &name,
-                &scene,
-                backend,
-                &settings,
-                &rad,
-                load_ms,
-                Some(&progress),
-            )?
-        }
+    let (film, report) = if args.reference {
+        let strata = (args.spp.unwrap_or(256) as f64).sqrt().floor() as u32;
+        emray::run::render_reference(&name, &scene, &settings, strata, load_ms)
+            .map_err(|why| anyhow::anyhow!("{name}: {why}"))?
+    } else if let Some(cli::GiArg::Radiosity) = args.gi {
+        let rad = emray::radiosity::RadiositySettings {
+            patch_size: args.patch_size,
+            ..Default::default()
+        };
+        emray::run::render_two_pass(
+            &name,
+            &scene,
+            backend,
+            &settings,
+            &rad,
+            load_ms,
+            Some(&progress),
+        )?
+    } else {
+        emray::run::render_scene(&name, &scene, backend, &settings, load_ms, Some(&progress))?
     };
     if let Some(b) = &bar {
         b.finish_and_clear();

@@ -40,10 +40,16 @@ pub struct Report {
     pub spd: bool,
     /// Maximum ray depth.
     pub max_depth: u32,
+    /// Antialiasing (`uniform` or `adaptive T D`).
+    pub aa: String,
+    /// `--bailout` weight (0 = full ray tree).
+    pub bailout: f32,
     /// Primitives by kind (`triangles`, `spheres`, `cones`).
     pub prims: BTreeMap<&'static str, usize>,
     /// Lights.
     pub lights: usize,
+    /// Whether any material transmits (T > 0); without, no refraction work is done.
+    pub transmitters: bool,
     /// Degenerate polygons dropped at load.
     pub degenerate_dropped: usize,
     /// Phase times.
@@ -75,11 +81,19 @@ impl Report {
             spp: settings.spp,
             spd: settings.spd,
             max_depth: settings.max_depth,
+            aa: match settings.aa {
+                crate::render::Aa::Uniform => "uniform".into(),
+                crate::render::Aa::Adaptive { threshold, depth } => {
+                    format!("adaptive {threshold} {depth}")
+                }
+            },
+            bailout: settings.bailout,
             prims: Kind::ALL
                 .iter()
                 .map(|&k| (k.name(), scene.count(k)))
                 .collect(),
             lights: scene.lights.len(),
+            transmitters: scene.materials.iter().any(|m| m.t > 0.0),
             degenerate_dropped: scene.load_stats.degenerate_dropped,
             time_ms,
             rays: BTreeMap::from([
@@ -89,6 +103,9 @@ impl Report {
                 ("refraction", r.refraction),
                 ("shadow", r.shadow),
                 ("tir", r.tir),
+                ("bailed", r.bailed),
+                ("skipped_shadow", r.skipped_shadow),
+                ("skipped_reflection", r.skipped_reflection),
                 ("total", r.total()),
             ]),
             mrays_per_s: stats.mrays_per_s(),
@@ -118,6 +135,7 @@ impl Report {
              time       load {:.1} ms, build {:.1} ms, render {:.1} ms\n\
              rays       eye {} (hit {}), reflection {}, refraction {}, shadow {}, total {}\n\
              tir        {}\n\
+             skipped    shadow {}, reflection {}, bailout {} (aa {}, bailout {}){}\n\
              speed      {:.2} Mrays/s",
             self.scene,
             self.accel,
@@ -148,6 +166,16 @@ impl Report {
             r["shadow"],
             r["total"],
             r["tir"],
+            r["skipped_shadow"],
+            r["skipped_reflection"],
+            r["bailed"],
+            self.aa,
+            self.bailout,
+            if self.transmitters {
+                ""
+            } else {
+                "; no transmitter: no refraction rays"
+            },
             self.mrays_per_s,
         )
     }
@@ -267,4 +295,45 @@ pub fn render_two_pass(
         #[cfg(not(feature = "embree"))]
         Backend::Embree => Err(AccelError::Unavailable("embree").into()),
     }
+}
+
+/// Render `scene` with the f64 reference renderer ([`render::reference`]) using
+/// `strata × strata` samples per pixel; `Err` names what the reference does not model.
+pub fn render_reference(
+    name: &str,
+    scene: &Scene,
+    settings: &RenderSettings,
+    strata: u32,
+    load_ms: f64,
+) -> Result<(Film, Report), String> {
+    if let Some(why) = render::reference::unsupported(scene) {
+        return Err(why);
+    }
+    let t0 = Instant::now();
+    let (film, rays) = render::reference::render(
+        scene,
+        settings.width,
+        settings.height,
+        strata,
+        settings.max_depth,
+    );
+    let stats = RenderStats {
+        rays,
+        render_ms: t0.elapsed().as_secs_f64() * 1e3,
+    };
+    let accel = AccelStats {
+        backend: "reference",
+        prims: scene.prim_count(),
+        nodes: 0,
+        bytes: 0,
+        detail: format!("f64, brute force, {strata}x{strata} stratified samples"),
+    };
+    let mut st = settings.clone();
+    st.spp = strata * strata;
+    let t = Timings {
+        load: load_ms,
+        build: 0.0,
+        render: stats.render_ms,
+    };
+    Ok((film, Report::new(name, scene, &st, &accel, t, &stats)))
 }

@@ -4,6 +4,7 @@
 
 mod camera;
 mod film;
+pub mod reference;
 mod whitted;
 
 pub use camera::RayGen;
@@ -33,10 +34,46 @@ pub struct RenderSettings {
     pub tile: u32,
     /// Shadow rays per emitting triangle (area light): `area_samples²`, stratified.
     pub area_samples: u32,
+    /// Antialiasing: uniform `spp` samples per pixel, or adaptive subdivision.
+    pub aa: Aa,
+    /// Hall & Greenberg's adaptive ray-tree depth: a reflected or refracted ray whose
+    /// accumulated weight (the product of Ks, T and filter colours from the eye, largest
+    /// channel) is below this is not cast. 0 turns it off.
+    pub bailout: f32,
+    /// Skip work that cannot change the image: shadow rays towards lights behind the
+    /// shading normal or that send nothing, reflection rays off surfaces with Ks = 0.
+    /// Off only to measure what it saves.
+    pub skip: bool,
 }
 
+/// Antialiasing modes.
+#[derive(Clone, Copy, Debug, PartialEq)]
+pub enum Aa {
+    /// `spp` stratified samples per pixel (1 = the pixel centre).
+    Uniform,
+    /// Whitted's adaptive supersampling: rays through every pixel corner (shared
+    /// between neighbouring pixels), a pixel whose four corners differ by more than
+    /// `threshold` (in any channel) split into four, recursively down to `depth`
+    /// levels; a square's value is the mean of its corners. Deterministic.
+    Adaptive {
+        /// Largest corner difference left unsplit.
+        threshold: f32,
+        /// Most subdivision levels (0 = the corners only).
+        depth: u32,
+    },
+}
+
+/// Default `--bailout` outside SPD mode: a ray contributing less than this share of
+/// its radiance cannot move an 8-bit pixel of radiance up to about 2.
+pub const DEFAULT_BAILOUT: f32 = 1e-3;
+/// Default adaptive threshold (largest corner difference, linear).
+pub const DEFAULT_AA_THRESHOLD: f32 = 0.05;
+/// Default adaptive depth.
+pub const DEFAULT_AA_DEPTH: u32 = 2;
+
 impl RenderSettings {
-    /// Defaults for `scene`: its resolution, 1 spp, depth 5, 16×16 tiles.
+    /// Defaults for `scene`: its resolution, 1 spp, depth 5, 16×16 tiles, uniform
+    /// sampling, no bailout (the full ray tree), skips on.
     pub fn for_scene(scene: &Scene) -> Self {
         RenderSettings {
             width: scene.camera.width,
@@ -46,6 +83,9 @@ impl RenderSettings {
             spd: false,
             tile: 16,
             area_samples: 4,
+            aa: Aa::Uniform,
+            bailout: 0.0,
+            skip: true,
         }
     }
 }
@@ -93,11 +133,58 @@ pub fn render_with_gi<A: Accel>(
 ) -> (Film, RenderStats) {
     let start = std::time::Instant::now();
     let (w, h) = (settings.width, settings.height);
+    let tracer = whitted::Tracer::new(scene, accel, settings).with_gi(gi);
+    if let (Aa::Adaptive { threshold, depth }, false) = (settings.aa, settings.spd) {
+        // The rays through every pixel corner, then each pixel refined from its four.
+        let gen = RayGen::new(&scene.camera, w, h);
+        let (corners, mut rays) = sample_grid(w + 1, h + 1, settings.tile, None, |i, j, c| {
+            tracer.sample(&gen, i as f32, j as f32, c)
+        });
+        let (film, more) = sample_grid(w, h, settings.tile, progress, |i, j, c| {
+            let k = [
+                corners.get(i, j),
+                corners.get(i + 1, j),
+                corners.get(i, j + 1),
+                corners.get(i + 1, j + 1),
+            ];
+            let s = |x: f32, y: f32, c: &mut RayCounts| tracer.sample(&gen, x, y, c);
+            adaptive(&s, i as f32, j as f32, 1.0, k, threshold, depth, c)
+        });
+        rays += more;
+        let render_ms = start.elapsed().as_secs_f64() * 1e3;
+        return (film, RenderStats { rays, render_ms });
+    }
     // In SPD mode the sample grid is the pixel corners: one more row and column.
     let (gw, gh) = if settings.spd { (w + 1, h + 1) } else { (w, h) };
     let gen = RayGen::new(&scene.camera, gw, gh);
-    let tracer = whitted::Tracer::new(scene, accel, settings).with_gi(gi);
-    let ts = settings.tile.max(1);
+    let (grid, rays) = sample_grid(gw, gh, settings.tile, progress, |i, j, c| {
+        tracer.pixel(&gen, i, j, c)
+    });
+    let film = if settings.spd {
+        grid.average_corners()
+    } else {
+        grid
+    };
+    let stats = RenderStats {
+        rays,
+        render_ms: start.elapsed().as_secs_f64() * 1e3,
+    };
+    (film, stats)
+}
+
+/// Evaluate `f(i, j)` over a `gw × gh` grid in parallel square tiles of edge `tile`,
+/// the result independent of the schedule.
+fn sample_grid<F>(
+    gw: u32,
+    gh: u32,
+    tile: u32,
+    progress: Option<Progress<'_>>,
+    f: F,
+) -> (Film, RayCounts)
+where
+    F: Fn(u32, u32, &mut RayCounts) -> glam::Vec3 + Sync,
+{
+    let ts = tile.max(1);
     let tiles: Vec<(u32, u32)> = (0..gh.div_ceil(ts))
         .flat_map(|ty| (0..gw.div_ceil(ts)).map(move |tx| (tx * ts, ty * ts)))
         .collect();
@@ -112,7 +199,7 @@ pub fn render_with_gi<A: Accel>(
             let mut px = Vec::with_capacity(((x1 - x0) * (y1 - y0)) as usize);
             for j in y0..y1 {
                 for i in x0..x1 {
-                    px.push(tracer.pixel(&gen, i, j, &mut counts));
+                    px.push(f(i, j, &mut counts));
                 }
             }
             if let Some(p) = progress {
@@ -133,14 +220,72 @@ pub fn render_with_gi<A: Accel>(
             }
         }
     }
-    let film = if settings.spd {
-        grid.average_corners()
-    } else {
-        grid
-    };
-    let stats = RenderStats {
-        rays,
-        render_ms: start.elapsed().as_secs_f64() * 1e3,
-    };
-    (film, stats)
+    (grid, rays)
+}
+
+/// Whitted's adaptive refinement of the square at `(x, y)` of edge `size` whose corner
+/// values are `k` (top-left, top-right, bottom-left, bottom-right): their mean if they
+/// agree within `threshold` or `depth` is exhausted, else the mean of its four
+/// quarters, the five new points sampled with `sample`.
+#[allow(clippy::too_many_arguments)]
+fn adaptive<S>(
+    sample: &S,
+    x: f32,
+    y: f32,
+    size: f32,
+    k: [glam::Vec3; 4],
+    threshold: f32,
+    depth: u32,
+    c: &mut RayCounts,
+) -> glam::Vec3
+where
+    S: Fn(f32, f32, &mut RayCounts) -> glam::Vec3,
+{
+    let lo = k[0].min(k[1]).min(k[2].min(k[3]));
+    let hi = k[0].max(k[1]).max(k[2].max(k[3]));
+    // A NaN corner compares false: it is not refined (and shows as NaN).
+    if depth == 0 || (hi - lo).max_element() <= threshold {
+        return (k[0] + k[1] + k[2] + k[3]) * 0.25;
+    }
+    let hs = size * 0.5;
+    let top = sample(x + hs, y, c);
+    let left = sample(x, y + hs, c);
+    let mid = sample(x + hs, y + hs, c);
+    let right = sample(x + size, y + hs, c);
+    let bottom = sample(x + hs, y + size, c);
+    let d = depth - 1;
+    let q = [
+        adaptive(sample, x, y, hs, [k[0], top, left, mid], threshold, d, c),
+        adaptive(
+            sample,
+            x + hs,
+            y,
+            hs,
+            [top, k[1], mid, right],
+            threshold,
+            d,
+            c,
+        ),
+        adaptive(
+            sample,
+            x,
+            y + hs,
+            hs,
+            [left, mid, k[2], bottom],
+            threshold,
+            d,
+            c,
+        ),
+        adaptive(
+            sample,
+            x + hs,
+            y + hs,
+            hs,
+            [mid, right, bottom, k[3]],
+            threshold,
+            d,
+            c,
+        ),
+    ];
+    (q[0] + q[1] + q[2] + q[3]) * 0.25
 }

@@ -21,6 +21,14 @@ pub struct RayCounts {
     pub shadow: u64,
     /// Total internal reflection events (no refraction ray was cast).
     pub tir: u64,
+    /// Reflection or refraction rays not spawned because their accumulated weight was
+    /// below the `--bailout` threshold.
+    pub bailed: u64,
+    /// Shadow rays not cast: the light is behind the shading normal or sends nothing.
+    pub skipped_shadow: u64,
+    /// Reflection rays not cast at hits on non-reflective (`Ks = 0`) surfaces below
+    /// the depth limit.
+    pub skipped_reflection: u64,
 }
 
 impl RayCounts {
@@ -38,6 +46,9 @@ impl std::ops::AddAssign for RayCounts {
         self.refraction += o.refraction;
         self.shadow += o.shadow;
         self.tir += o.tir;
+        self.bailed += o.bailed;
+        self.skipped_shadow += o.skipped_shadow;
+        self.skipped_reflection += o.skipped_reflection;
     }
 }
 
@@ -52,6 +63,11 @@ pub(super) struct Tracer<'a, A: Accel> {
     area_samples: u32,
     /// Two-pass mode: the diffuse term of meshed surfaces from this solution.
     gi: Option<&'a Solution>,
+    /// Hall & Greenberg's adaptive tree depth: no secondary ray whose weight (largest
+    /// channel) is below this; 0 = off.
+    bailout: f32,
+    /// Skip work that cannot change the image (see [`RenderSettings::skip`]).
+    skip: bool,
 }
 
 /// A 32-bit integer hash (Wellons' lowbias32) for per-pixel sample offsets.
@@ -104,6 +120,12 @@ impl<'a, A: Accel> Tracer<'a, A> {
             area_lights: area::collect(scene),
             area_samples: s.area_samples,
             gi: None,
+            bailout: if s.bailout.is_finite() {
+                s.bailout.max(0.0)
+            } else {
+                0.0
+            },
+            skip: s.skip,
         }
     }
 
@@ -132,14 +154,37 @@ impl<'a, A: Accel> Tracer<'a, A> {
         sum / n as f32
     }
 
+    /// The value of the eye ray through continuous film position `(px, py)`.
+    pub(super) fn sample(&self, gen: &RayGen, px: f32, py: f32, counts: &mut RayCounts) -> Vec3 {
+        self.eye(gen.ray(px, py), counts)
+    }
+
     fn eye(&self, ray: Ray, counts: &mut RayCounts) -> Vec3 {
         counts.eye += 1;
-        self.trace(&ray, 1, Media::AIR, counts)
+        self.trace(&ray, 1, Media::AIR, Vec3::ONE, counts)
+    }
+
+    /// Whether a secondary ray of accumulated `weight` is worth casting.
+    #[inline]
+    fn worth(&self, weight: Vec3, counts: &mut RayCounts) -> bool {
+        if weight.max_element() < self.bailout {
+            counts.bailed += 1;
+            return false;
+        }
+        true
     }
 
     /// Radiance along `ray` at ray-tree depth `depth` (the eye ray is depth 1), which
-    /// travels inside `media`.
-    fn trace(&self, ray: &Ray, depth: u32, media: Media, counts: &mut RayCounts) -> Vec3 {
+    /// travels inside `media`; `weight` is the product of the coefficients between this
+    /// ray and the eye (what its radiance is multiplied by in the pixel).
+    fn trace(
+        &self,
+        ray: &Ray,
+        depth: u32,
+        media: Media,
+        weight: Vec3,
+        counts: &mut RayCounts,
+    ) -> Vec3 {
         let scene = self.scene;
         let mut ray = *ray;
         let mut media = media;
@@ -179,7 +224,7 @@ impl<'a, A: Accel> Tracer<'a, A> {
                 counts.eye_hit += 1;
             }
             let gi = self.gi.and_then(|g| g.radiosity_at(&hit, d));
-            return self.shade(&surf, d, entering, depth, media, gi, counts);
+            return self.shade(&surf, d, entering, depth, media, weight, gi, counts);
         }
     }
 
@@ -195,6 +240,7 @@ impl<'a, A: Accel> Tracer<'a, A> {
         entering: bool,
         depth: u32,
         media: Media,
+        weight: Vec3,
         gi: Option<Vec3>,
         counts: &mut RayCounts,
     ) -> Vec3 {
@@ -219,19 +265,20 @@ impl<'a, A: Accel> Tracer<'a, A> {
         let view = -d;
         for light in &scene.lights {
             let to_light = light.pos - p;
-            // No shadow ray when the shading normal faces away from the light.
-            if ns.dot(to_light) <= 0.0 {
-                continue;
-            }
+            // No shadow ray when the shading normal faces away from the light or the
+            // light sends nothing here (with `skip` off the ray is cast and ignored,
+            // to measure what skipping saves).
             let intensity = light.intensity_at(p);
-            if intensity == Vec3::ZERO {
+            let useless = ns.dot(to_light) <= 0.0 || intensity == Vec3::ZERO;
+            if useless && self.skip {
+                counts.skipped_shadow += 1;
                 continue;
             }
             counts.shadow += 1;
             let mut shadow = spawn(to_light);
             shadow.dir = light.pos - shadow.org;
             shadow.tmax = next_float_down(1.0);
-            if self.accel.occluded(&shadow) {
+            if self.accel.occluded(&shadow) || useless {
                 continue;
             }
             let l = to_light.normalize();
@@ -260,12 +307,16 @@ impl<'a, A: Accel> Tracer<'a, A> {
             };
             match refract(d, ns, n1 / n2) {
                 Some(dir) => {
-                    counts.refraction += 1;
                     // Light is filtered by the medium it goes into.
                     let filter = inside
                         .current(scene)
                         .map_or(Vec3::ONE, |id| scene.materials[id as usize].filter);
-                    color += m.t * filter * self.trace(&spawn(dir), depth + 1, inside, counts);
+                    let w = m.t * filter;
+                    if self.worth(weight * w, counts) {
+                        counts.refraction += 1;
+                        let ray = spawn(dir);
+                        color += w * self.trace(&ray, depth + 1, inside, weight * w, counts);
+                    }
                 }
                 None => {
                     // Total internal reflection: the transmitted energy is reflected.
@@ -274,10 +325,19 @@ impl<'a, A: Accel> Tracer<'a, A> {
                 }
             }
         }
-        if reflect_weight > 0.0 {
+        let w = weight * reflect_weight;
+        if reflect_weight <= 0.0 {
+            if self.skip {
+                counts.skipped_reflection += 1;
+            } else {
+                // Cast and thrown away: only to measure what skipping saves.
+                counts.reflection += 1;
+                self.trace(&spawn(reflect(d, ns)), depth + 1, media, w, counts);
+            }
+        } else if self.worth(w, counts) {
             counts.reflection += 1;
-            let dir = reflect(d, ns);
-            color += reflect_weight * self.trace(&spawn(dir), depth + 1, media, counts);
+            let ray = spawn(reflect(d, ns));
+            color += reflect_weight * self.trace(&ray, depth + 1, media, w, counts);
         }
         color
     }

@@ -1,0 +1,115 @@
+//! Numerical stress cases, each asserting a bound (small counts for the debug build;
+//! `emray stress` runs the full counts and prints the numbers).
+
+use emray::accel::bvh::Bvh;
+use emray::accel::Accel;
+use emray::load::nff::parse_str;
+use emray::math::{Ray, Vec3};
+use emray::stress::{self, acne, convex_scene, differing_share, floor_scene, render};
+use emray::Backend;
+use std::path::Path;
+
+fn backends() -> Vec<Backend> {
+    if cfg!(feature = "embree") {
+        vec![Backend::Bvh, Backend::Embree]
+    } else {
+        vec![Backend::Bvh]
+    }
+}
+
+#[test]
+fn scaled_scenes_render_the_same_image_without_acne() {
+    let base = floor_scene(1.0, 48);
+    for b in backends() {
+        let want = render(&base, b);
+        for e in [-4, -2, 2, 4] {
+            let s = floor_scene(10f64.powi(e), 48);
+            let share = differing_share(&render(&s, b), &want);
+            assert!(share <= 1e-3, "{b:?} scale 1e{e}: {share}");
+            let c = convex_scene(10f64.powi(e), 0.0, 24);
+            let (lit, bad) = acne(&c, &Bvh::build(&c));
+            assert!(lit > 100 && bad == 0, "scale 1e{e}: {bad} of {lit}");
+        }
+    }
+}
+
+#[test]
+fn translated_scenes_have_no_acne_and_a_bounded_change() {
+    let base = convex_scene(1.0, 0.0, 24);
+    let want = render(&base, Backend::Bvh);
+    for e in [3, 4, 5] {
+        let s = convex_scene(1.0, 10f64.powi(e), 24);
+        let (lit, bad) = acne(&s, &Bvh::build(&s));
+        assert!(lit > 100 && bad == 0, "offset 1e{e}: {bad} of {lit}");
+        let share = differing_share(&render(&s, Backend::Bvh), &want);
+        // The camera itself moves in f32 steps of 1e-7 × offset: edges shift.
+        assert!(share < 0.1, "offset 1e{e}: {share}");
+    }
+}
+
+#[test]
+fn rays_at_shared_edges_and_vertices_never_miss_on_the_bvh() {
+    let (scene, targets) = stress::tessellated_sphere(2);
+    let bvh = Bvh::build(&scene);
+    let (rays, misses) = stress::watertight(&bvh, &targets, &stress::origins(6, 3.0));
+    assert!(rays > 300, "{rays}");
+    assert_eq!(misses, 0, "{misses} of {rays}");
+}
+
+#[test]
+fn far_and_tiny_spheres_match_the_f64_distance() {
+    for (dist, radius) in [(1e4f32, 1.0f32), (1e2, 1e-4), (1e6, 1e3)] {
+        let (worst, miss, extra) = stress::far_sphere(dist, radius, 2000, 7);
+        assert!(worst < 1e-5, "{dist} {radius}: {worst}");
+        // Silhouette disagreements are rays within f32 rounding of the rim: few.
+        assert!(miss + extra <= 4, "{dist} {radius}: {miss} {extra}");
+    }
+}
+
+/// Grazing rays along the floor, eye rays starting on a surface, a camera inside a
+/// glass sphere, degenerate polygons, NaN and infinite directions: no panic, no NaN.
+#[test]
+fn hostile_rays_give_no_nan_and_no_panic() {
+    let src = "v\nfrom 0 -6 0\nat 0 0 0\nup 0 0 1\nangle 40\nhither 0\nresolution 16 16\n\
+        b 0.1 0.1 0.1\nl 2 -3 4\nf 0.8 0.8 0.8 0.9 0.2 10 0 1\np 4 -5 -5 0 5 -5 0 5 5 0 -5 5 0\n\
+        p 3 0 0 1 1 1 2 2 2 3\nf 1 1 1 0.1 0.1 10 0.9 1.5\ns 0 -6 0 0.5\ns 0 0 1 1\n";
+    let s = parse_str(src, Path::new("<t>")).unwrap();
+    assert_eq!(s.triangles.len(), 2, "the collinear triangle is dropped");
+    for b in backends() {
+        let f = render(&s, b);
+        assert!(f.pixels.iter().all(|p| p.is_finite()), "{b:?}");
+    }
+    let bvh = Bvh::build(&s);
+    for d in [
+        Vec3::new(f32::NAN, 0.0, 1.0),
+        Vec3::new(f32::INFINITY, 0.0, 0.0),
+        Vec3::new(f32::NEG_INFINITY, 1.0, 0.0),
+        Vec3::ZERO,
+    ] {
+        let r = Ray::new(Vec3::new(0.0, -3.0, 0.5), d);
+        let _ = bvh.intersect(&r);
+        let _ = bvh.occluded(&r);
+    }
+}
+
+/// Total internal reflection at the critical angle ± 1 ULP: the centre eye ray meets
+/// a glass plane from its inside (normal +z, the ray goes up) at that angle.
+#[test]
+fn critical_angle_is_finite_either_side() {
+    let crit = (1.0f64 / 1.5).asin();
+    for k in [-1i32, 0, 1] {
+        let a = f32::from_bits((crit as f32).to_bits().wrapping_add_signed(k));
+        let (dy, dz) = (a.sin(), a.cos());
+        let src = format!(
+            "v\nfrom 0 0 -1\nat 0 {dy} {}\nup 1 0 0\nangle 1\nhither 0\nresolution 3 3\n\
+             b 1 0 0\nl 0 0 -5\nf 1 1 1 0 0 0 1 1.5\n\
+             p 4 -100 -100 0 100 -100 0 100 100 0 -100 100 0\n",
+            -1.0 + dz
+        );
+        let s = parse_str(&src, Path::new("<t>")).unwrap();
+        for b in backends() {
+            let f = render(&s, b);
+            assert!(f.pixels.iter().all(|p| p.is_finite()), "{b:?} ulp {k}");
+        }
+    }
+}
