@@ -1,7 +1,7 @@
 //! Command-line arguments and their conversion into library settings.
 
 use clap::{Args, Parser, Subcommand, ValueEnum};
-use emray::accel::Backend;
+use emray::accel::{Backend, EmbreeQuality};
 use emray::output::Encoding;
 use std::path::PathBuf;
 
@@ -21,6 +21,9 @@ pub enum Command {
     Render(RenderArgs),
     /// Write a Standard Procedural Database as NFF, as the SPD 3.14 programs do.
     Gen(GenArgs),
+    /// Benchmark suite: SPD scenes on both backends, 1 and all threads, raw casting,
+    /// Tachyon as a peer; markdown to standard output.
+    Bench(BenchArgs),
     /// Error metrics of an image against a reference (RMSE, PSNR, FLIP, ...); exit
     /// status 0 within the thresholds, 1 beyond, 2 on a usage or I/O error.
     Compare(crate::quality_cmd::CompareArgs),
@@ -101,6 +104,52 @@ fn parse_power_of_four(s: &str) -> Result<u32, String> {
     }
 }
 
+/// `emray bench`.
+#[derive(Args, Debug, Clone)]
+pub struct BenchArgs {
+    /// Scenes (`spd:NAME[?size=N]` or NFF files) [default: the SPD suite: balls, gears,
+    /// jacks, mount, rings, teapot, tetra, tree, plus balls at sizes 2, 3, 5 and jacks at
+    /// 2, 3].
+    #[arg(value_name = "SCENE")]
+    pub scenes: Vec<String>,
+    /// Backends to compare [default: both, or the BVH alone without Embree].
+    #[arg(long, value_enum, value_delimiter = ',')]
+    pub backend: Vec<BackendArg>,
+    /// Thread counts [default: 1 and all cores].
+    #[arg(short, long, value_delimiter = ',', value_parser = clap::value_parser!(u32).range(1..=4096))]
+    pub threads: Vec<u32>,
+    /// Repetitions of every run (median and spread are reported).
+    #[arg(long, default_value_t = 3, value_parser = clap::value_parser!(u32).range(1..=1000))]
+    pub reps: u32,
+    /// Image size.
+    #[arg(long, value_name = "WxH", value_parser = parse_res, default_value = "512x512")]
+    pub res: (u32, u32),
+    /// Render with one ray per pixel centre instead of SPD mode's corner rays.
+    #[arg(long)]
+    pub no_spd: bool,
+    /// Embree build quality (RTC_BUILD_QUALITY_*).
+    #[arg(long, value_enum, default_value_t = QualityArg::Medium)]
+    pub embree_quality: QualityArg,
+    /// Skip the raw-casting runs.
+    #[arg(long)]
+    pub no_raw: bool,
+    /// Skip Tachyon.
+    #[arg(long)]
+    pub no_peer: bool,
+    /// Write the rows as CSV to FILE.
+    #[arg(long, value_name = "FILE")]
+    pub csv: Option<PathBuf>,
+    /// Write everything (machine, rows, summary, samples) as JSON to FILE.
+    #[arg(long, value_name = "FILE")]
+    pub json: Option<PathBuf>,
+    /// Compare with a JSON file of an earlier run: per-row ratios.
+    #[arg(long, value_name = "FILE.json")]
+    pub baseline: Option<PathBuf>,
+    /// Run one measurement in this process (used by the suite itself).
+    #[arg(long, hide = true, value_name = "JSON")]
+    pub child: Option<String>,
+}
+
 /// `emray gen`.
 #[derive(Args, Debug, Clone)]
 pub struct GenArgs {
@@ -130,6 +179,27 @@ impl From<BackendArg> for Backend {
         match b {
             BackendArg::Embree => Backend::Embree,
             BackendArg::Bvh => Backend::Bvh,
+        }
+    }
+}
+
+/// Embree build qualities as named on the command line.
+#[derive(Clone, Copy, Debug, ValueEnum, PartialEq, Eq)]
+pub enum QualityArg {
+    /// Morton-code build: fastest to build.
+    Low,
+    /// Binned SAH (Embree's default).
+    Medium,
+    /// SAH with spatial splits: slowest to build, fastest to trace.
+    High,
+}
+
+impl From<QualityArg> for EmbreeQuality {
+    fn from(q: QualityArg) -> Self {
+        match q {
+            QualityArg::Low => EmbreeQuality::Low,
+            QualityArg::Medium => EmbreeQuality::Medium,
+            QualityArg::High => EmbreeQuality::High,
         }
     }
 }
@@ -191,6 +261,9 @@ pub struct RenderArgs {
     /// SPD testing mode: 513x513 corner rays for 512x512, depth 5, ray statistics.
     #[arg(long)]
     pub spd: bool,
+    /// Embree build quality (RTC_BUILD_QUALITY_*).
+    #[arg(long, value_enum, default_value_t = QualityArg::Medium)]
+    pub embree_quality: QualityArg,
     /// Antialiasing: `uniform` (`--spp` stratified samples) or `adaptive` (corner rays
     /// shared by neighbouring pixels, subdivided where the corners differ).
     #[arg(long, value_enum, default_value_t = AaArg::Uniform)]
@@ -265,6 +338,7 @@ impl RenderArgs {
             max_depth: None,
             threads: None,
             spd: false,
+            embree_quality: QualityArg::Medium,
             aa: AaArg::Uniform,
             aa_threshold: emray::render::DEFAULT_AA_THRESHOLD,
             aa_depth: emray::render::DEFAULT_AA_DEPTH,

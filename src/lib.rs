@@ -8,6 +8,7 @@
 #![warn(missing_docs)]
 
 pub mod accel;
+pub mod bench;
 pub mod gen;
 pub mod geometry;
 pub mod load;

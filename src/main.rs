@@ -24,6 +24,7 @@ fn main() -> ExitCode {
     let args = match cli.command {
         Some(Command::Render(a)) => a,
         Some(Command::Gen(g)) => return gen(&g),
+        Some(Command::Bench(b)) => return bench(&b),
         Some(Command::Compare(c)) => return quality_cmd::compare(&c),
         Some(Command::Stress(s)) => return quality_cmd::stress(&s),
         Some(Command::Radiosity(r)) => return radiosity(&r),
@@ -83,6 +84,84 @@ fn gen(g: &cli::GenArgs) -> ExitCode {
         Ok(()) => ExitCode::SUCCESS,
         Err(e) => {
             eprintln!("emray: error: {e:#}");
+            ExitCode::from(1)
+        }
+    }
+}
+
+/// `emray bench`: exit 2 on bad arguments, 1 when a run fails.
+fn bench(b: &cli::BenchArgs) -> ExitCode {
+    use emray::bench;
+    if let Some(json) = &b.child {
+        let answer = serde_json::from_str::<bench::RunSpec>(json)
+            .map_err(|e| format!("bad run description: {e}"))
+            .and_then(|spec| bench::run_child(&spec));
+        return match answer {
+            Ok(r) => {
+                println!("{}", serde_json::to_string(&r).expect("result serialises"));
+                ExitCode::SUCCESS
+            }
+            Err(e) => {
+                eprintln!("emray: error: {e}");
+                ExitCode::from(1)
+            }
+        };
+    }
+    let mut backends: Vec<Backend> = b.backend.iter().map(|&x| Backend::from(x)).collect();
+    if backends.is_empty() {
+        backends = if cfg!(feature = "embree") {
+            vec![Backend::Embree, Backend::Bvh]
+        } else {
+            vec![Backend::Bvh]
+        };
+    }
+    let mut threads: Vec<usize> = b.threads.iter().map(|&t| t as usize).collect();
+    if threads.is_empty() {
+        let all = std::thread::available_parallelism().map_or(1, |n| n.get());
+        threads = if all > 1 { vec![1, all] } else { vec![1] };
+    }
+    let cfg = bench::Config {
+        scenes: if b.scenes.is_empty() {
+            bench::default_scenes()
+        } else {
+            b.scenes.clone()
+        },
+        backends,
+        threads,
+        reps: b.reps as usize,
+        width: b.res.0,
+        height: b.res.1,
+        spd: !b.no_spd,
+        raw: !b.no_raw,
+        peer: !b.no_peer,
+        embree_quality: b.embree_quality.into(),
+    };
+    for s in &cfg.scenes {
+        if let Err(e) = Database::parse_spec(s) {
+            eprintln!("emray: error: {e}");
+            return ExitCode::from(2);
+        }
+    }
+    let outs = bench::Outputs {
+        csv: b.csv.clone(),
+        json: b.json.clone(),
+        baseline: b.baseline.clone(),
+    };
+    let exe = match std::env::current_exe() {
+        Ok(e) => e,
+        Err(e) => {
+            eprintln!("emray: error: cannot find the emray executable: {e}");
+            return ExitCode::from(1);
+        }
+    };
+    let mut log = |line: &str| eprintln!("{line}");
+    match bench::bench(&cfg, &outs, &exe, &mut log) {
+        Ok(md) => {
+            print!("{md}");
+            ExitCode::SUCCESS
+        }
+        Err(e) => {
+            eprintln!("emray: error: {e}");
             ExitCode::from(1)
         }
     }
@@ -276,6 +355,7 @@ fn render_one(args: &RenderArgs, scene_path: Option<&Path>, out: &Path) -> Resul
         settings.spp = 1;
         settings.max_depth = 5;
     }
+    settings.embree_quality = args.embree_quality.into();
     settings.bailout = args.bailout.unwrap_or(if args.spd {
         0.0
     } else {

@@ -63,7 +63,8 @@ pub struct Report {
 }
 
 impl Report {
-    fn new(
+    /// The report of a render of `scene` named `name`.
+    pub fn new(
         name: &str,
         scene: &Scene,
         settings: &RenderSettings,
@@ -181,27 +182,82 @@ impl Report {
     }
 }
 
-fn finish<A: Accel>(
-    name: &str,
-    scene: &Scene,
-    accel: &A,
-    settings: &RenderSettings,
-    load_ms: f64,
-    build_ms: f64,
-    progress: Option<Progress<'_>>,
-) -> (Film, Report) {
-    let (film, stats) = render::render(scene, accel, settings, progress);
-    let t = Timings {
-        load: load_ms,
-        build: build_ms,
-        render: stats.render_ms,
-    };
-    let report = Report::new(name, scene, settings, &accel.stats(), t, &stats);
-    (film, report)
+/// Work to do with a built backend, generic over it: [`with_accel`] builds the backend
+/// and hands it over, so that everything below is monomorphised per backend.
+pub trait WithAccel {
+    /// What the work returns.
+    type Output;
+    /// Do the work with `accel`, built in `build_ms` milliseconds.
+    fn run<A: Accel>(self, accel: &A, build_ms: f64) -> Self::Output;
 }
 
-/// Build `backend` over `scene` and render it on the current rayon pool. This is the
-/// one place the backend is chosen: everything below is monomorphised per backend.
+/// Build `backend` over `scene` (timed, with the build options of `settings`) and run
+/// `work` with it on the current rayon pool. This is the one place the backend is chosen.
+pub fn with_accel<W: WithAccel>(
+    scene: &Scene,
+    backend: Backend,
+    settings: &RenderSettings,
+    work: W,
+) -> Result<W::Output, AccelError> {
+    let t0 = Instant::now();
+    let ms = |t: Instant| t.elapsed().as_secs_f64() * 1e3;
+    match backend {
+        Backend::Bvh => {
+            let accel = crate::accel::bvh::Bvh::build(scene);
+            let build = ms(t0);
+            Ok(work.run(&accel, build))
+        }
+        #[cfg(feature = "embree")]
+        Backend::Embree => {
+            // Embree builds with as many threads as the pool renders with.
+            let config = format!("threads={}", rayon::current_num_threads());
+            let accel = crate::accel::embree::EmbreeAccel::build_with(
+                scene,
+                &config,
+                settings.embree_quality,
+            )?;
+            let build = ms(t0);
+            Ok(work.run(&accel, build))
+        }
+        #[cfg(not(feature = "embree"))]
+        Backend::Embree => {
+            let _ = settings;
+            Err(AccelError::Unavailable("embree"))
+        }
+    }
+}
+
+/// A full render with its report.
+struct RenderWork<'a> {
+    name: &'a str,
+    scene: &'a Scene,
+    settings: &'a RenderSettings,
+    load_ms: f64,
+    progress: Option<Progress<'a>>,
+}
+
+impl WithAccel for RenderWork<'_> {
+    type Output = (Film, Report);
+    fn run<A: Accel>(self, accel: &A, build_ms: f64) -> (Film, Report) {
+        let (film, stats) = render::render(self.scene, accel, self.settings, self.progress);
+        let t = Timings {
+            load: self.load_ms,
+            build: build_ms,
+            render: stats.render_ms,
+        };
+        let report = Report::new(
+            self.name,
+            self.scene,
+            self.settings,
+            &accel.stats(),
+            t,
+            &stats,
+        );
+        (film, report)
+    }
+}
+
+/// Build `backend` over `scene` and render it on the current rayon pool.
 pub fn render_scene(
     name: &str,
     scene: &Scene,
@@ -210,27 +266,18 @@ pub fn render_scene(
     load_ms: f64,
     progress: Option<Progress<'_>>,
 ) -> Result<(Film, Report), AccelError> {
-    let t0 = Instant::now();
-    let ms = |t: Instant| t.elapsed().as_secs_f64() * 1e3;
-    match backend {
-        Backend::Bvh => {
-            let accel = crate::accel::bvh::Bvh::build(scene);
-            let build = ms(t0);
-            Ok(finish(
-                name, scene, &accel, settings, load_ms, build, progress,
-            ))
-        }
-        #[cfg(feature = "embree")]
-        Backend::Embree => {
-            let accel = crate::accel::embree::EmbreeAccel::build(scene)?;
-            let build = ms(t0);
-            Ok(finish(
-                name, scene, &accel, settings, load_ms, build, progress,
-            ))
-        }
-        #[cfg(not(feature = "embree"))]
-        Backend::Embree => Err(AccelError::Unavailable("embree")),
-    }
+    with_accel(
+        scene,
+        backend,
+        settings,
+        RenderWork {
+            name,
+            scene,
+            settings,
+            load_ms,
+            progress,
+        },
+    )
 }
 
 #[allow(clippy::too_many_arguments)]

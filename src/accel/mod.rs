@@ -93,6 +93,33 @@ impl Backend {
     }
 }
 
+/// Embree's build quality (`RTC_BUILD_QUALITY_*`): a faster build against a faster
+/// hierarchy. The BVH backend ignores it.
+#[derive(
+    Clone, Copy, Debug, Default, PartialEq, Eq, Hash, serde::Serialize, serde::Deserialize,
+)]
+#[serde(rename_all = "lowercase")]
+pub enum EmbreeQuality {
+    /// `RTC_BUILD_QUALITY_LOW`: a Morton-code build, fastest to build.
+    Low,
+    /// `RTC_BUILD_QUALITY_MEDIUM`: binned SAH, Embree's default.
+    #[default]
+    Medium,
+    /// `RTC_BUILD_QUALITY_HIGH`: SAH with spatial splits of triangles.
+    High,
+}
+
+impl EmbreeQuality {
+    /// The name used on the command line.
+    pub fn name(self) -> &'static str {
+        match self {
+            EmbreeQuality::Low => "low",
+            EmbreeQuality::Medium => "medium",
+            EmbreeQuality::High => "high",
+        }
+    }
+}
+
 /// Errors from building a backend.
 #[derive(Debug, thiserror::Error)]
 pub enum AccelError {

@@ -34,6 +34,8 @@ pub struct RenderSettings {
     pub tile: u32,
     /// Shadow rays per emitting triangle (area light): `area_samples²`, stratified.
     pub area_samples: u32,
+    /// Embree build quality (the BVH backend ignores it).
+    pub embree_quality: crate::accel::EmbreeQuality,
     /// Antialiasing: uniform `spp` samples per pixel, or adaptive subdivision.
     pub aa: Aa,
     /// Hall & Greenberg's adaptive ray-tree depth: a reflected or refracted ray whose
@@ -83,6 +85,7 @@ impl RenderSettings {
             spd: false,
             tile: 16,
             area_samples: 4,
+            embree_quality: crate::accel::EmbreeQuality::Medium,
             aa: Aa::Uniform,
             bailout: 0.0,
             skip: true,

@@ -26,7 +26,7 @@ mod tests;
 
 pub use error::EmbreeError;
 
-use crate::accel::{Accel, AccelStats, Hit};
+use crate::accel::{Accel, AccelStats, EmbreeQuality, Hit};
 use crate::math::Ray;
 use crate::scene::Scene;
 use device::Device;
@@ -56,13 +56,23 @@ impl EmbreeAccel {
     /// Build with an Embree device configuration string, e.g. `"threads=2"` (see
     /// `rtcNewDevice`).
     pub fn build_with_config(scene: &Scene, config: &str) -> Result<EmbreeAccel, EmbreeError> {
+        EmbreeAccel::build_with(scene, config, EmbreeQuality::default())
+    }
+
+    /// Build with a device configuration string and a build quality.
+    pub fn build_with(
+        scene: &Scene,
+        config: &str,
+        quality: EmbreeQuality,
+    ) -> Result<EmbreeAccel, EmbreeError> {
         let device = Device::new(config)?;
-        let committed = CommittedScene::build(&device, scene)?;
+        let committed = CommittedScene::build(&device, scene, quality)?;
         let api = if cfg!(embree4) { "embree4" } else { "embree3" };
         let detail = format!(
-            "{}, {api} API (headers {}), robust traversal",
+            "{}, {api} API (headers {}), robust traversal, {} build quality",
             device.describe(),
             env!("EMRAY_EMBREE_HEADER_VERSION"),
+            quality.name(),
         );
         Ok(EmbreeAccel {
             bytes: device.allocated_bytes(),

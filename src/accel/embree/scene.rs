@@ -193,8 +193,11 @@ impl Level {
         Ok(unbounded)
     }
 
-    /// Commit after every geometry is attached.
-    fn commit(&self, device: &Device) -> Result<(), EmbreeError> {
+    /// Commit after every geometry is attached, building at `quality`.
+    fn commit(&self, device: &Device, quality: sys::RTCBuildQuality) -> Result<(), EmbreeError> {
+        // SAFETY: `raw` is a live, uncommitted scene; any quality constant is valid.
+        unsafe { sys::rtcSetSceneBuildQuality(self.raw, quality) };
+        device.check("rtcSetSceneBuildQuality")?;
         // SAFETY: `raw` is live; every attached geometry is committed and its user data
         // is boxed in `self.user` (or an object level's), which lives as long as the
         // scene.
@@ -204,17 +207,24 @@ impl Level {
 }
 
 impl CommittedScene {
-    /// Build and commit the scene of `scene`'s primitives.
+    /// Build and commit the scene of `scene`'s primitives at build quality `quality`.
     pub(super) fn build(
         device: &Device,
         scene: &crate::scene::Scene,
+        quality: crate::accel::EmbreeQuality,
     ) -> Result<CommittedScene, EmbreeError> {
+        use crate::accel::EmbreeQuality as Q;
+        let quality = match quality {
+            Q::Low => sys::RTCBuildQuality::RTC_BUILD_QUALITY_LOW,
+            Q::Medium => sys::RTCBuildQuality::RTC_BUILD_QUALITY_MEDIUM,
+            Q::High => sys::RTCBuildQuality::RTC_BUILD_QUALITY_HIGH,
+        };
         let mut objects = Vec::with_capacity(scene.objects.len());
         let mut object_unbounded = Vec::with_capacity(scene.objects.len());
         for object in &scene.objects {
             let mut level = Level::new(device)?;
             object_unbounded.push(level.attach_geometry(device, object)?);
-            level.commit(device)?;
+            level.commit(device, quality)?;
             objects.push(level);
         }
         let mut top = Level::new(device)?;
@@ -243,7 +253,7 @@ impl CommittedScene {
             })?;
             attach_instance(device, &top, &objects[object], &inst.xform, id)?;
         }
-        top.commit(device)?;
+        top.commit(device, quality)?;
         Ok(CommittedScene {
             top,
             _objects: objects,

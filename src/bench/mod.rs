@@ -1,0 +1,569 @@
+//! `emray bench`: the SPD suite rendered on both backends, with 1 and all threads, each
+//! run in a child process of its own (so that its peak memory is its own), repeated and
+//! interleaved (every backend and thread count of a scene side by side in each
+//! repetition), with raw-casting runs for the renderer's overhead and Tachyon as a peer.
+
+pub mod peer;
+pub mod raw;
+pub mod report;
+
+use crate::accel::Backend;
+use crate::gen::Database;
+use crate::render::RenderSettings;
+use crate::run::{with_accel, WithAccel};
+use crate::scene::Scene;
+use serde::{Deserialize, Serialize};
+use std::path::Path;
+use std::process::Command;
+use std::time::Instant;
+
+/// What a run measures.
+#[derive(Clone, Copy, Debug, PartialEq, Eq, Hash, Serialize, Deserialize)]
+#[serde(rename_all = "lowercase")]
+pub enum Mode {
+    /// A full render.
+    Render,
+    /// The render's rays cast again with no shading.
+    Raw,
+}
+
+/// One run, as passed to the child process.
+#[derive(Clone, Debug, PartialEq, Serialize, Deserialize)]
+pub struct RunSpec {
+    /// Scene: `spd:NAME[?size=N]` or a scene file.
+    pub scene: String,
+    /// Backend name (`embree` or `bvh`).
+    pub backend: String,
+    /// Worker threads.
+    pub threads: usize,
+    /// Image width.
+    pub width: u32,
+    /// Image height.
+    pub height: u32,
+    /// SPD testing mode.
+    pub spd: bool,
+    /// What to measure.
+    pub mode: Mode,
+    /// Embree build quality.
+    #[serde(default)]
+    pub embree_quality: crate::accel::EmbreeQuality,
+}
+
+/// Rays by type, as the render counted them.
+#[derive(Clone, Copy, Debug, Default, PartialEq, Serialize, Deserialize)]
+pub struct Rays {
+    /// Eye rays.
+    pub eye: u64,
+    /// Reflection rays.
+    pub reflection: u64,
+    /// Refraction rays.
+    pub refraction: u64,
+    /// Shadow rays.
+    pub shadow: u64,
+    /// Every ray.
+    pub total: u64,
+}
+
+impl From<crate::render::RayCounts> for Rays {
+    fn from(c: crate::render::RayCounts) -> Rays {
+        Rays {
+            eye: c.eye,
+            reflection: c.reflection,
+            refraction: c.refraction,
+            shadow: c.shadow,
+            total: c.total(),
+        }
+    }
+}
+
+/// What one child run measured.
+#[derive(Clone, Debug, PartialEq, Serialize, Deserialize)]
+pub struct RunResult {
+    /// Primitives in the scene.
+    pub prims: usize,
+    /// Load (generate and parse) time, ms.
+    pub load_ms: f64,
+    /// Acceleration-structure build time, ms.
+    pub build_ms: f64,
+    /// Render time (mode `render`) or raw casting time (mode `raw`), ms.
+    pub ms: f64,
+    /// Rays by type.
+    pub rays: Rays,
+    /// Peak resident memory of the process in KiB (`VmHWM`), when the system says.
+    pub peak_kib: Option<u64>,
+    /// The backend's description (Embree version and ISA, BVH nodes).
+    pub accel: String,
+}
+
+/// Load a scene named as on the command line.
+pub fn load_scene(name: &str) -> Result<Scene, String> {
+    match Database::parse_spec(name)? {
+        Some((db, size)) => crate::load::nff::parse_str(&db.generate(size), Path::new(name))
+            .map_err(|e| e.to_string()),
+        None => crate::load::load_path(Path::new(name)).map_err(|e| e.to_string()),
+    }
+}
+
+fn backend_named(name: &str) -> Result<Backend, String> {
+    match name {
+        "embree" => Ok(Backend::Embree),
+        "bvh" => Ok(Backend::Bvh),
+        _ => Err(format!("unknown backend '{name}' (embree or bvh)")),
+    }
+}
+
+/// The raw-casting work: record the render's queries, then cast them timed.
+struct RawWork<'a> {
+    scene: &'a Scene,
+    settings: &'a RenderSettings,
+}
+
+impl WithAccel for RawWork<'_> {
+    type Output = (f64, raw::RawCast, crate::render::RayCounts, String);
+    fn run<A: crate::Accel>(self, accel: &A, build_ms: f64) -> Self::Output {
+        let (queries, counts) = raw::record(self.scene, accel, self.settings);
+        let cast = raw::cast(accel, &queries);
+        (build_ms, cast, counts, accel.stats().detail)
+    }
+}
+
+/// Do one run in this process (the child side of `emray bench`).
+pub fn run_child(spec: &RunSpec) -> Result<RunResult, String> {
+    let backend = backend_named(&spec.backend)?;
+    let pool = rayon::ThreadPoolBuilder::new()
+        .num_threads(spec.threads.max(1))
+        .build()
+        .map_err(|e| format!("cannot start {} threads: {e}", spec.threads))?;
+    let t0 = Instant::now();
+    let scene = load_scene(&spec.scene)?;
+    let load_ms = t0.elapsed().as_secs_f64() * 1e3;
+    let mut settings = RenderSettings::for_scene(&scene);
+    settings.width = spec.width;
+    settings.height = spec.height;
+    if spec.spd {
+        settings.spd = true;
+        settings.spp = 1;
+        settings.max_depth = 5;
+    }
+    settings.embree_quality = spec.embree_quality;
+    let (build_ms, ms, rays, accel) = pool.install(|| match spec.mode {
+        Mode::Render => {
+            let (_, rep) =
+                crate::run::render_scene(&spec.scene, &scene, backend, &settings, load_ms, None)
+                    .map_err(|e| e.to_string())?;
+            let r = |k: &str| rep.rays.get(k).copied().unwrap_or(0);
+            let rays = Rays {
+                eye: r("eye"),
+                reflection: r("reflection"),
+                refraction: r("refraction"),
+                shadow: r("shadow"),
+                total: r("total"),
+            };
+            Ok::<_, String>((rep.time_ms.build, rep.time_ms.render, rays, rep.accel))
+        }
+        Mode::Raw => {
+            let work = RawWork {
+                scene: &scene,
+                settings: &settings,
+            };
+            let (build_ms, cast, counts, detail) =
+                with_accel(&scene, backend, &settings, work).map_err(|e| e.to_string())?;
+            Ok((build_ms, cast.ms, Rays::from(counts), detail))
+        }
+    })?;
+    Ok(RunResult {
+        prims: scene.prim_count(),
+        load_ms,
+        build_ms,
+        ms,
+        rays,
+        peak_kib: peak_rss_kib(),
+        accel,
+    })
+}
+
+/// This process's peak resident set size in KiB, from `/proc/self/status` (Linux).
+pub fn peak_rss_kib() -> Option<u64> {
+    let status = std::fs::read_to_string("/proc/self/status").ok()?;
+    status
+        .lines()
+        .find_map(|l| l.strip_prefix("VmHWM:"))
+        .and_then(|v| v.trim().trim_end_matches("kB").trim().parse().ok())
+}
+
+/// Run `spec` in a child process `exe bench --child JSON` and parse its answer.
+pub fn run_in_child(exe: &Path, spec: &RunSpec) -> Result<RunResult, String> {
+    let json = serde_json::to_string(spec).expect("spec serialises");
+    let out = Command::new(exe)
+        .args(["bench", "--child", &json])
+        .output()
+        .map_err(|e| format!("cannot run {}: {e}", exe.display()))?;
+    let stdout = String::from_utf8_lossy(&out.stdout);
+    if !out.status.success() {
+        return Err(format!(
+            "{} on {} ({} threads, {:?}) failed ({}): {}",
+            spec.scene,
+            spec.backend,
+            spec.threads,
+            spec.mode,
+            out.status,
+            String::from_utf8_lossy(&out.stderr).trim()
+        ));
+    }
+    // The answer is the last line (a library may print above it).
+    let line = stdout.lines().last().unwrap_or("");
+    serde_json::from_str(line).map_err(|e| format!("bad answer from a bench run ({e}): {line}"))
+}
+
+/// What to benchmark.
+#[derive(Clone, Debug, PartialEq)]
+pub struct Config {
+    /// Scenes, as on the command line.
+    pub scenes: Vec<String>,
+    /// Backends.
+    pub backends: Vec<Backend>,
+    /// Thread counts.
+    pub threads: Vec<usize>,
+    /// Repetitions of every run.
+    pub reps: usize,
+    /// Image width.
+    pub width: u32,
+    /// Image height.
+    pub height: u32,
+    /// SPD testing mode.
+    pub spd: bool,
+    /// Also measure raw casting.
+    pub raw: bool,
+    /// Also run the Tachyon peer when installed.
+    pub peer: bool,
+    /// Embree build quality.
+    pub embree_quality: crate::accel::EmbreeQuality,
+}
+
+/// The default suite: the eight SPD scenes at their default sizes, then balls and jacks
+/// at other size factors to show how the cost grows.
+pub fn default_scenes() -> Vec<String> {
+    let mut v: Vec<String> = [
+        "balls", "gears", "jacks", "mount", "rings", "teapot", "tetra", "tree",
+    ]
+    .iter()
+    .map(|n| format!("spd:{n}"))
+    .collect();
+    for s in [2, 3, 5] {
+        v.push(format!("spd:balls?size={s}"));
+    }
+    for s in [2, 3] {
+        v.push(format!("spd:jacks?size={s}"));
+    }
+    v
+}
+
+/// One measured sample.
+#[derive(Clone, Debug, PartialEq, Serialize, Deserialize)]
+pub struct Sample {
+    /// What was run.
+    pub spec: RunSpec,
+    /// Repetition index.
+    pub rep: usize,
+    /// What it measured.
+    pub result: RunResult,
+}
+
+/// One Tachyon measurement.
+#[derive(Clone, Debug, PartialEq, Serialize, Deserialize)]
+pub struct PeerSample {
+    /// Scene name.
+    pub scene: String,
+    /// Threads.
+    pub threads: usize,
+    /// Repetition index.
+    pub rep: usize,
+    /// Tachyon's ray-tracing time, ms.
+    pub trace_ms: f64,
+}
+
+/// NFF files of the suite's scenes for Tachyon, in a private directory removed on drop.
+struct PeerFiles {
+    dir: std::path::PathBuf,
+    files: std::collections::BTreeMap<String, (std::path::PathBuf, String)>,
+}
+
+impl PeerFiles {
+    fn new(scenes: &[String]) -> Result<PeerFiles, String> {
+        let dir = std::env::temp_dir().join(format!("emray-bench-{}", std::process::id()));
+        std::fs::create_dir_all(&dir)
+            .map_err(|e| format!("{}: cannot create: {e}", dir.display()))?;
+        let mut files = std::collections::BTreeMap::new();
+        for (k, name) in scenes.iter().enumerate() {
+            let text = match Database::parse_spec(name)? {
+                Some((db, size)) => db.generate(size),
+                // Tachyon reads NFF only.
+                None if name.ends_with(".nff") => std::fs::read_to_string(name)
+                    .map_err(|e| format!("{name}: cannot read: {e}"))?,
+                None => continue,
+            };
+            let path = dir.join(format!("scene{k}.nff"));
+            std::fs::write(&path, &text)
+                .map_err(|e| format!("{}: cannot write: {e}", path.display()))?;
+            let scene = load_scene(name)?;
+            files.insert(name.clone(), (path, peer::differences(&scene)));
+        }
+        Ok(PeerFiles { dir, files })
+    }
+}
+
+impl Drop for PeerFiles {
+    fn drop(&mut self) {
+        let _ = std::fs::remove_dir_all(&self.dir);
+    }
+}
+
+/// Everything a suite run measured.
+#[derive(Clone, Debug, Default, PartialEq)]
+pub struct Measured {
+    /// emray runs.
+    pub samples: Vec<Sample>,
+    /// Tachyon runs.
+    pub peers: Vec<PeerSample>,
+    /// Scene → how Tachyon's picture differs.
+    pub peer_notes: std::collections::BTreeMap<String, String>,
+    /// Why there are no Tachyon runs, if there are none.
+    pub peer_missing: String,
+}
+
+/// Run the suite: for every repetition, every scene, every thread count, every backend
+/// and then Tachyon (interleaved, so that load changes on the machine hit every row
+/// alike). `log` is told of every finished run.
+pub fn run_suite(cfg: &Config, exe: &Path, log: &mut dyn FnMut(&str)) -> Result<Measured, String> {
+    for s in &cfg.scenes {
+        if Database::parse_spec(s)?.is_none() && !Path::new(s).is_file() {
+            return Err(format!("{s}: no such scene file"));
+        }
+    }
+    let mut m = Measured::default();
+    let peer_files = if !cfg.peer {
+        m.peer_missing = "Tachyon not run (--no-peer).".into();
+        None
+    } else if !peer::available() {
+        m.peer_missing =
+            "Tachyon skipped: `tachyon` is not installed (Debian: apt-get install tachyon).".into();
+        None
+    } else {
+        Some(PeerFiles::new(&cfg.scenes)?)
+    };
+    let modes: &[Mode] = if cfg.raw {
+        &[Mode::Render, Mode::Raw]
+    } else {
+        &[Mode::Render]
+    };
+    for rep in 0..cfg.reps {
+        for scene in &cfg.scenes {
+            for &threads in &cfg.threads {
+                for &backend in &cfg.backends {
+                    for &mode in modes {
+                        let spec = RunSpec {
+                            scene: scene.clone(),
+                            backend: backend.name().to_string(),
+                            threads,
+                            width: cfg.width,
+                            height: cfg.height,
+                            spd: cfg.spd,
+                            mode,
+                            embree_quality: cfg.embree_quality,
+                        };
+                        let result = run_in_child(exe, &spec)?;
+                        log(&format!(
+                            "rep {} {scene} {} {threads}t {mode:?}: {:.1} ms",
+                            rep + 1,
+                            spec.backend,
+                            result.ms
+                        ));
+                        m.samples.push(Sample { spec, rep, result });
+                    }
+                }
+                let Some((nff, note)) = peer_files.as_ref().and_then(|p| p.files.get(scene)) else {
+                    continue;
+                };
+                let image = nff.with_extension("ppm");
+                let t = peer::run(nff, &image, cfg.width, cfg.height, threads)?;
+                log(&format!(
+                    "rep {} {scene} tachyon {threads}t: {:.1} ms",
+                    rep + 1,
+                    t.trace_ms
+                ));
+                m.peer_notes.insert(scene.clone(), note.clone());
+                m.peers.push(PeerSample {
+                    scene: scene.clone(),
+                    threads,
+                    rep,
+                    trace_ms: t.trace_ms,
+                });
+            }
+        }
+    }
+    Ok(m)
+}
+
+/// Where the report goes besides standard output.
+#[derive(Clone, Debug, Default, PartialEq)]
+pub struct Outputs {
+    /// CSV file of the rows.
+    pub csv: Option<std::path::PathBuf>,
+    /// JSON file of everything (machine, rows, summary, peers, samples).
+    pub json: Option<std::path::PathBuf>,
+    /// A JSON file of an earlier run to compare with.
+    pub baseline: Option<std::path::PathBuf>,
+}
+
+/// Read a JSON file written by `emray bench --json`.
+pub fn read_saved(path: &Path) -> Result<report::Saved, String> {
+    let text = std::fs::read_to_string(path)
+        .map_err(|e| format!("{}: cannot read: {e}", path.display()))?;
+    serde_json::from_str(&text).map_err(|e| {
+        format!(
+            "{}:{}:{}: not an `emray bench --json` file: {e}",
+            path.display(),
+            e.line(),
+            e.column()
+        )
+    })
+}
+
+/// Run the suite and return the markdown report, writing the files of `outs`.
+pub fn bench(
+    cfg: &Config,
+    outs: &Outputs,
+    exe: &Path,
+    log: &mut dyn FnMut(&str),
+) -> Result<String, String> {
+    let base = outs.baseline.as_deref().map(read_saved).transpose()?;
+    let mut machine = Machine::probe();
+    let m = run_suite(cfg, exe, log)?;
+    machine.load_after = load_average();
+    let rows = report::rows(&m.samples);
+    let summary = report::summary(&rows);
+    let peers = report::peer_rows(&m, &rows);
+    let mut md = report::markdown(&machine, &rows, &summary, &peers, &m.peer_missing);
+    if let Some(b) = base {
+        md.push_str("\n## Against the baseline\n\n");
+        md.push_str(&report::compare(&rows, &b.rows));
+    }
+    if let Some(p) = &outs.csv {
+        crate::output::write_text(p, &report::csv(&rows)).map_err(|e| e.to_string())?;
+    }
+    if let Some(p) = &outs.json {
+        let saved = report::Saved {
+            machine,
+            rows,
+            summary,
+            peers,
+            samples: m.samples,
+        };
+        let text = serde_json::to_string_pretty(&saved).expect("report serialises");
+        crate::output::write_text(p, &text).map_err(|e| e.to_string())?;
+    }
+    Ok(md)
+}
+
+/// The machine: CPU model, logical CPUs, load average.
+#[derive(Clone, Debug, Default, PartialEq, Serialize, Deserialize)]
+pub struct Machine {
+    /// CPU model name.
+    pub cpu: String,
+    /// Logical CPUs.
+    pub cpus: usize,
+    /// The ISA-relevant CPU flags (the best of sse4_2, avx, avx2, avx512f present).
+    pub isa: String,
+    /// `/proc/loadavg` when the suite started.
+    pub load_before: String,
+    /// `/proc/loadavg` when it ended.
+    pub load_after: String,
+}
+
+impl Machine {
+    /// What the system says about itself now (`load_after` left empty).
+    pub fn probe() -> Machine {
+        let info = std::fs::read_to_string("/proc/cpuinfo").unwrap_or_default();
+        let field = |k: &str| {
+            info.lines()
+                .find(|l| l.starts_with(k))
+                .and_then(|l| l.split_once(':'))
+                .map(|(_, v)| v.trim().to_string())
+                .unwrap_or_default()
+        };
+        let flags = field("flags");
+        let has = |f: &str| flags.split_whitespace().any(|x| x == f);
+        let isa = ["avx512f", "avx2", "avx", "sse4_2"]
+            .into_iter()
+            .find(|f| has(f))
+            .unwrap_or("unknown")
+            .to_string();
+        Machine {
+            cpu: if info.is_empty() {
+                "unknown".into()
+            } else {
+                field("model name")
+            },
+            cpus: std::thread::available_parallelism().map_or(1, |n| n.get()),
+            isa,
+            load_before: load_average(),
+            load_after: String::new(),
+        }
+    }
+}
+
+/// The first three fields of `/proc/loadavg`, or `unknown`.
+pub fn load_average() -> String {
+    std::fs::read_to_string("/proc/loadavg")
+        .ok()
+        .map(|s| s.split_whitespace().take(3).collect::<Vec<_>>().join(" "))
+        .unwrap_or_else(|| "unknown".into())
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+
+    #[test]
+    fn default_suite_names_parse() {
+        for s in default_scenes() {
+            assert!(Database::parse_spec(&s).unwrap().is_some(), "{s}");
+        }
+    }
+
+    #[test]
+    fn child_run_measures_and_counts() {
+        let spec = RunSpec {
+            scene: "spd:balls?size=1".into(),
+            backend: "bvh".into(),
+            threads: 1,
+            width: 16,
+            height: 16,
+            spd: true,
+            mode: Mode::Render,
+            embree_quality: Default::default(),
+        };
+        let r = run_child(&spec).unwrap();
+        assert_eq!(r.rays.eye, 17 * 17);
+        assert_eq!(
+            r.rays.total,
+            r.rays.eye + r.rays.reflection + r.rays.refraction + r.rays.shadow
+        );
+        assert!(r.rays.reflection > 0 && r.rays.shadow > 0);
+        assert_eq!(
+            r.prims,
+            load_scene("spd:balls?size=1").unwrap().prim_count()
+        );
+        let raw = run_child(&RunSpec {
+            mode: Mode::Raw,
+            ..spec.clone()
+        })
+        .unwrap();
+        assert_eq!(raw.rays, r.rays, "the raw run casts the render's rays");
+        assert!(run_child(&RunSpec {
+            backend: "nope".into(),
+            ..spec
+        })
+        .is_err());
+    }
+}

@@ -1,0 +1,128 @@
+//! Raw casting: the rays a render casts, recorded once and cast again with no shading,
+//! so that render time ÷ raw time is the renderer's overhead over pure ray casting.
+
+use crate::accel::{Accel, AccelStats, Hit};
+use crate::math::Ray;
+use crate::render::{self, RenderSettings};
+use crate::scene::Scene;
+use rayon::prelude::*;
+use std::sync::Mutex;
+use std::time::Instant;
+
+/// One recorded query: the ray and whether it was an any-hit (shadow) query.
+#[derive(Clone, Copy, Debug, PartialEq)]
+pub struct Query {
+    /// The ray as the renderer passed it.
+    pub ray: Ray,
+    /// `true` for [`Accel::occluded`], `false` for [`Accel::intersect`].
+    pub occluded: bool,
+}
+
+/// A backend that records every query passed through it, per worker thread (one
+/// buffer per rayon worker, so the order within a thread is the order of tracing).
+pub struct Recorder<'a, A: Accel> {
+    inner: &'a A,
+    buffers: Vec<Mutex<Vec<Query>>>,
+}
+
+impl<'a, A: Accel> Recorder<'a, A> {
+    /// Record the queries made through `inner` on the current rayon pool.
+    pub fn new(inner: &'a A) -> Self {
+        let n = rayon::current_num_threads() + 1;
+        Recorder {
+            inner,
+            buffers: (0..n).map(|_| Mutex::new(Vec::new())).collect(),
+        }
+    }
+
+    fn push(&self, q: Query) {
+        // Threads outside the pool share the last buffer.
+        let k = rayon::current_thread_index()
+            .map_or(self.buffers.len() - 1, |i| i.min(self.buffers.len() - 1));
+        // A poisoned buffer only means another thread panicked; its data is intact.
+        let mut b = self.buffers[k].lock().unwrap_or_else(|e| e.into_inner());
+        b.push(q);
+    }
+
+    /// The recorded queries, thread by thread.
+    pub fn into_queries(self) -> Vec<Query> {
+        self.buffers
+            .into_iter()
+            .flat_map(|m| m.into_inner().unwrap_or_else(|e| e.into_inner()))
+            .collect()
+    }
+}
+
+impl<A: Accel> Accel for Recorder<'_, A> {
+    fn intersect(&self, ray: &Ray) -> Option<Hit> {
+        self.push(Query {
+            ray: *ray,
+            occluded: false,
+        });
+        self.inner.intersect(ray)
+    }
+
+    fn occluded(&self, ray: &Ray) -> bool {
+        self.push(Query {
+            ray: *ray,
+            occluded: true,
+        });
+        self.inner.occluded(ray)
+    }
+
+    fn stats(&self) -> AccelStats {
+        self.inner.stats()
+    }
+}
+
+/// What casting the recorded rays again found.
+#[derive(Clone, Copy, Debug, Default, PartialEq)]
+pub struct RawCast {
+    /// Queries cast.
+    pub queries: u64,
+    /// Nearest-hit queries that hit plus shadow queries that were occluded.
+    pub hits: u64,
+    /// Wall time in milliseconds.
+    pub ms: f64,
+}
+
+/// Rays per parallel work item: large enough that scheduling costs nothing, small
+/// enough to balance two threads.
+const CHUNK: usize = 4096;
+
+/// Cast `queries` through `accel` on the current rayon pool, with no shading at all.
+pub fn cast<A: Accel>(accel: &A, queries: &[Query]) -> RawCast {
+    let start = Instant::now();
+    let hits: u64 = queries
+        .par_chunks(CHUNK)
+        .map(|chunk| {
+            let mut n = 0u64;
+            for q in chunk {
+                let hit = if q.occluded {
+                    accel.occluded(&q.ray)
+                } else {
+                    accel.intersect(&q.ray).is_some()
+                };
+                n += u64::from(hit);
+            }
+            n
+        })
+        .sum();
+    RawCast {
+        queries: queries.len() as u64,
+        hits,
+        ms: start.elapsed().as_secs_f64() * 1e3,
+    }
+}
+
+/// Render `scene` once through a [`Recorder`] (untimed) and return the queries it made
+/// with the render's ray counts.
+pub fn record<A: Accel>(
+    scene: &Scene,
+    accel: &A,
+    settings: &RenderSettings,
+) -> (Vec<Query>, render::RayCounts) {
+    let rec = Recorder::new(accel);
+    let (_, stats) = render::render(scene, &rec, settings, None);
+    (rec.into_queries(), stats.rays)
+}

@@ -1,0 +1,587 @@
+//! The bench report: samples folded into rows (medians and spread), the targets'
+//! summary figures, markdown for the terminal, CSV and JSON for files, and per-row
+//! ratios against a saved run.
+
+use super::peer::PeerRow;
+use super::{Machine, Mode, Rays, Sample};
+use crate::gen::Database;
+use serde::{Deserialize, Serialize};
+use std::collections::BTreeMap;
+use std::fmt::Write;
+
+/// One scene × backend × thread count, over the repetitions.
+#[derive(Clone, Debug, PartialEq, Serialize, Deserialize)]
+pub struct Row {
+    /// Scene name.
+    pub scene: String,
+    /// Primitives.
+    pub prims: usize,
+    /// Backend.
+    pub backend: String,
+    /// Threads.
+    pub threads: usize,
+    /// Median load time, ms.
+    pub load_ms: f64,
+    /// Median build time, ms.
+    pub build_ms: f64,
+    /// Median render time, ms.
+    pub render_ms: f64,
+    /// Render-time spread: (max − min) / median, percent.
+    pub spread_pct: f64,
+    /// Median raw-casting time of the same rays, ms.
+    pub raw_ms: Option<f64>,
+    /// Rays by type.
+    pub rays: Rays,
+    /// Millions of rays per second of median render time.
+    pub mrays_per_s: f64,
+    /// Largest peak resident memory over the render runs, MiB.
+    pub peak_mib: Option<f64>,
+    /// This row's render time ÷ Embree's for the same scene and threads.
+    pub vs_embree: Option<f64>,
+    /// Repetitions.
+    pub reps: usize,
+    /// The backend's description.
+    pub accel: String,
+}
+
+impl Row {
+    /// Render time ÷ raw casting time.
+    pub fn overhead(&self) -> Option<f64> {
+        self.raw_ms.filter(|&r| r > 0.0).map(|r| self.render_ms / r)
+    }
+}
+
+/// The median of `v` (the mean of the middle two for an even count); 0 when empty.
+pub fn median(v: &[f64]) -> f64 {
+    if v.is_empty() {
+        return 0.0;
+    }
+    let mut s = v.to_vec();
+    s.sort_by(f64::total_cmp);
+    let n = s.len();
+    if n % 2 == 1 {
+        s[n / 2]
+    } else {
+        (s[n / 2 - 1] + s[n / 2]) / 2.0
+    }
+}
+
+/// The geometric mean of positive values; `None` when there are none.
+pub fn geomean(v: &[f64]) -> Option<f64> {
+    let p: Vec<f64> = v.iter().copied().filter(|x| *x > 0.0).collect();
+    (!p.is_empty()).then(|| (p.iter().map(|x| x.ln()).sum::<f64>() / p.len() as f64).exp())
+}
+
+/// Fold samples into rows, in the order the runs were first made.
+pub fn rows(samples: &[Sample]) -> Vec<Row> {
+    let mut order: Vec<(String, String, usize)> = Vec::new();
+    let mut groups: BTreeMap<(String, String, usize), Vec<&Sample>> = BTreeMap::new();
+    for s in samples {
+        let key = (s.spec.scene.clone(), s.spec.backend.clone(), s.spec.threads);
+        if !groups.contains_key(&key) {
+            order.push(key.clone());
+        }
+        groups.entry(key).or_default().push(s);
+    }
+    let mut rows: Vec<Row> = order
+        .iter()
+        .map(|key| {
+            let g = &groups[key];
+            let render: Vec<&Sample> = g
+                .iter()
+                .copied()
+                .filter(|s| s.spec.mode == Mode::Render)
+                .collect();
+            let raw: Vec<f64> = g
+                .iter()
+                .filter(|s| s.spec.mode == Mode::Raw)
+                .map(|s| s.result.ms)
+                .collect();
+            let pick =
+                |f: fn(&Sample) -> f64| median(&render.iter().map(|s| f(s)).collect::<Vec<_>>());
+            let times: Vec<f64> = render.iter().map(|s| s.result.ms).collect();
+            let render_ms = median(&times);
+            let spread_pct = if render_ms > 0.0 {
+                let max = times.iter().copied().fold(f64::MIN, f64::max);
+                let min = times.iter().copied().fold(f64::MAX, f64::min);
+                100.0 * (max - min) / render_ms
+            } else {
+                0.0
+            };
+            let first = render.first().map(|s| &s.result);
+            let rays = first.map(|r| r.rays).unwrap_or_default();
+            Row {
+                scene: key.0.clone(),
+                prims: g[0].result.prims,
+                backend: key.1.clone(),
+                threads: key.2,
+                load_ms: pick(|s| s.result.load_ms),
+                build_ms: pick(|s| s.result.build_ms),
+                render_ms,
+                spread_pct,
+                raw_ms: (!raw.is_empty()).then(|| median(&raw)),
+                rays,
+                mrays_per_s: if render_ms > 0.0 {
+                    rays.total as f64 / (render_ms * 1e3)
+                } else {
+                    0.0
+                },
+                peak_mib: render
+                    .iter()
+                    .filter_map(|s| s.result.peak_kib)
+                    .max()
+                    .map(|k| k as f64 / 1024.0),
+                vs_embree: None,
+                reps: render.len(),
+                accel: first.map(|r| r.accel.clone()).unwrap_or_default(),
+            }
+        })
+        .collect();
+    let embree: BTreeMap<(String, usize), f64> = rows
+        .iter()
+        .filter(|r| r.backend == "embree")
+        .map(|r| ((r.scene.clone(), r.threads), r.render_ms))
+        .collect();
+    for r in &mut rows {
+        if r.backend != "embree" {
+            r.vs_embree = embree
+                .get(&(r.scene.clone(), r.threads))
+                .filter(|&&e| e > 0.0)
+                .map(|e| r.render_ms / e);
+        }
+    }
+    rows
+}
+
+/// The figures the performance targets are stated in.
+#[derive(Clone, Debug, Default, PartialEq, Serialize, Deserialize)]
+pub struct Summary {
+    /// Geometric mean of BVH ÷ Embree render time over the default-size SPD scenes,
+    /// per thread count.
+    pub bvh_vs_embree: BTreeMap<usize, f64>,
+    /// Geometric mean of render ÷ raw casting, per backend, at the most threads.
+    pub overhead: BTreeMap<String, f64>,
+    /// Per backend: the smallest speed-up of the most threads over one thread, and the
+    /// scene it was on.
+    pub scaling_min: BTreeMap<String, (f64, String)>,
+    /// Per `"BACKEND, N thread(s)"`: exponent `k` in render time ∝ primitives^k
+    /// between the smallest and largest balls of the suite.
+    pub balls_exponent: BTreeMap<String, f64>,
+}
+
+fn is_default_size(scene: &str) -> bool {
+    scene.starts_with("spd:") && !scene.contains('?')
+}
+
+/// Tachyon's samples folded into rows (median), next to emray's Embree render time
+/// for the same scene and threads.
+pub fn peer_rows(m: &super::Measured, rows: &[Row]) -> Vec<PeerRow> {
+    let mut out: Vec<PeerRow> = Vec::new();
+    for p in &m.peers {
+        if out
+            .iter()
+            .any(|r| r.scene == p.scene && r.threads == p.threads)
+        {
+            continue;
+        }
+        let times: Vec<f64> = m
+            .peers
+            .iter()
+            .filter(|q| q.scene == p.scene && q.threads == p.threads)
+            .map(|q| q.trace_ms)
+            .collect();
+        out.push(PeerRow {
+            scene: p.scene.clone(),
+            threads: p.threads,
+            tachyon_ms: median(&times),
+            emray_ms: rows
+                .iter()
+                .find(|r| r.backend == "embree" && r.scene == p.scene && r.threads == p.threads)
+                .map(|r| r.render_ms),
+            note: m.peer_notes.get(&p.scene).cloned().unwrap_or_default(),
+        });
+    }
+    out
+}
+
+/// The summary of `rows`.
+pub fn summary(rows: &[Row]) -> Summary {
+    let mut s = Summary::default();
+    let max_t = rows.iter().map(|r| r.threads).max().unwrap_or(1);
+    let threads: std::collections::BTreeSet<usize> = rows.iter().map(|r| r.threads).collect();
+    for &t in &threads {
+        let v: Vec<f64> = rows
+            .iter()
+            .filter(|r| r.backend == "bvh" && r.threads == t && is_default_size(&r.scene))
+            .filter_map(|r| r.vs_embree)
+            .collect();
+        if let Some(g) = geomean(&v) {
+            s.bvh_vs_embree.insert(t, g);
+        }
+    }
+    let backends: std::collections::BTreeSet<&str> =
+        rows.iter().map(|r| r.backend.as_str()).collect();
+    for b in backends {
+        let of = |r: &&Row| r.backend == b;
+        let v: Vec<f64> = rows
+            .iter()
+            .filter(of)
+            .filter(|r| r.threads == max_t && is_default_size(&r.scene))
+            .filter_map(Row::overhead)
+            .collect();
+        if let Some(g) = geomean(&v) {
+            s.overhead.insert(b.to_string(), g);
+        }
+        if max_t > 1 {
+            let mut worst: Option<(f64, String)> = None;
+            for r in rows.iter().filter(of).filter(|r| r.threads == 1) {
+                let Some(m) = rows
+                    .iter()
+                    .find(|x| x.backend == b && x.threads == max_t && x.scene == r.scene)
+                else {
+                    continue;
+                };
+                if m.render_ms > 0.0 {
+                    let k = r.render_ms / m.render_ms;
+                    if !matches!(&worst, Some((w, _)) if *w <= k) {
+                        worst = Some((k, r.scene.clone()));
+                    }
+                }
+            }
+            if let Some(w) = worst {
+                s.scaling_min.insert(b.to_string(), w);
+            }
+        }
+        for &t in &threads {
+            let mut balls: Vec<(u32, &Row)> = rows
+                .iter()
+                .filter(|r| r.backend == b && r.threads == t)
+                .filter_map(|r| match Database::parse_spec(&r.scene) {
+                    Ok(Some((Database::Balls, size))) => Some((size, r)),
+                    _ => None,
+                })
+                .collect();
+            balls.sort_by_key(|(size, _)| *size);
+            if let (Some((s0, a)), Some((s1, z))) = (balls.first(), balls.last()) {
+                if s1 > s0 && a.prims > 0 && a.render_ms > 0.0 {
+                    let k =
+                        (z.render_ms / a.render_ms).ln() / (z.prims as f64 / a.prims as f64).ln();
+                    s.balls_exponent.insert(format!("{b}, {t} thread(s)"), k);
+                }
+            }
+        }
+    }
+    s
+}
+
+fn opt(v: Option<f64>, prec: usize) -> String {
+    v.map_or("–".to_string(), |x| format!("{x:.prec$}"))
+}
+
+/// The whole report as markdown.
+pub fn markdown(
+    machine: &Machine,
+    rows: &[Row],
+    sum: &Summary,
+    peers: &[PeerRow],
+    peer_note: &str,
+) -> String {
+    let mut o = String::new();
+    let accel = rows
+        .iter()
+        .find(|r| r.backend == "embree")
+        .map(|r| r.accel.clone())
+        .unwrap_or_else(|| "not measured".into());
+    let _ = writeln!(o, "# emray bench\n");
+    let _ = writeln!(
+        o,
+        "- CPU: {} ({} logical CPUs, best ISA {})\n- Embree: {accel}\n- load average: {} at the start, {} at the end",
+        machine.cpu, machine.cpus, machine.isa, machine.load_before, machine.load_after
+    );
+    let reps = rows.iter().map(|r| r.reps).max().unwrap_or(0);
+    let _ = writeln!(o, "- {reps} repetitions per row, interleaved; times are medians, spread = (max − min) / median\n");
+    let _ = writeln!(
+        o,
+        "| scene | prims | backend | thr | load ms | build ms | render ms | spread | raw ms | render/raw | rays | Mrays/s | peak MiB | ÷ embree |"
+    );
+    let _ = writeln!(
+        o,
+        "|---|---:|---|---:|---:|---:|---:|---:|---:|---:|---:|---:|---:|---:|"
+    );
+    for r in rows {
+        let _ = writeln!(
+            o,
+            "| {} | {} | {} | {} | {:.1} | {:.1} | {:.1} | {:.0}% | {} | {} | {} | {:.2} | {} | {} |",
+            r.scene,
+            r.prims,
+            r.backend,
+            r.threads,
+            r.load_ms,
+            r.build_ms,
+            r.render_ms,
+            r.spread_pct,
+            opt(r.raw_ms, 1),
+            opt(r.overhead(), 2),
+            r.rays.total,
+            r.mrays_per_s,
+            opt(r.peak_mib, 0),
+            opt(r.vs_embree, 2),
+        );
+    }
+    let _ = writeln!(
+        o,
+        "\nRays by type (eye / reflection / refraction / shadow):\n"
+    );
+    let mut seen = std::collections::BTreeSet::new();
+    for r in rows {
+        if seen.insert(r.scene.clone()) {
+            let _ = writeln!(
+                o,
+                "- {}: {} / {} / {} / {}",
+                r.scene, r.rays.eye, r.rays.reflection, r.rays.refraction, r.rays.shadow
+            );
+        }
+    }
+    let _ = writeln!(o, "\n## Targets\n");
+    for (t, g) in &sum.bvh_vs_embree {
+        let _ = writeln!(o, "- BVH ÷ Embree render time, geometric mean over the default-size SPD scenes, {t} thread(s): {g:.2} (target ≤ 1.5)");
+    }
+    for (b, g) in &sum.overhead {
+        let _ = writeln!(o, "- render ÷ raw casting on {b}, geometric mean (most threads): {g:.2} (target ≤ 1.25 on embree)");
+    }
+    for (b, (k, scene)) in &sum.scaling_min {
+        let _ = writeln!(
+            o,
+            "- smallest speed-up of all threads over one on {b}: {k:.2}× ({scene}) (target ≥ 1.85)"
+        );
+    }
+    for (b, k) in &sum.balls_exponent {
+        let _ = writeln!(
+            o,
+            "- balls render time ∝ primitives^{k:.2} ({b}) (target < 1)"
+        );
+    }
+    let _ = writeln!(o, "\n## Peer: Tachyon\n");
+    if peers.is_empty() {
+        let _ = writeln!(o, "{peer_note}");
+    } else {
+        let _ = writeln!(o, "| scene | thr | tachyon ms | emray embree ms | tachyon ÷ emray | note |\n|---|---:|---:|---:|---:|---|");
+        for p in peers {
+            let _ = writeln!(
+                o,
+                "| {} | {} | {:.1} | {} | {} | {} |",
+                p.scene,
+                p.threads,
+                p.tachyon_ms,
+                opt(p.emray_ms, 1),
+                opt(p.emray_ms.filter(|&e| e > 0.0).map(|e| p.tachyon_ms / e), 2),
+                p.note
+            );
+        }
+        let _ = writeln!(
+            o,
+            "\nTachyon's ray-tracing time (its own report) against emray's render time on Embree. \
+             Tachyon traces one ray per pixel centre; in SPD mode emray traces the (W+1)×(H+1) \
+             pixel corners."
+        );
+    }
+    o
+}
+
+/// The rows as CSV, one line per row.
+pub fn csv(rows: &[Row]) -> String {
+    let mut o = String::from(
+        "scene,prims,backend,threads,reps,load_ms,build_ms,render_ms,spread_pct,raw_ms,render_over_raw,eye,reflection,refraction,shadow,total_rays,mrays_per_s,peak_mib,vs_embree\n",
+    );
+    let f = |v: Option<f64>| v.map_or(String::new(), |x| format!("{x:.4}"));
+    for r in rows {
+        let _ = writeln!(
+            o,
+            "{},{},{},{},{},{:.3},{:.3},{:.3},{:.2},{},{},{},{},{},{},{},{:.4},{},{}",
+            r.scene,
+            r.prims,
+            r.backend,
+            r.threads,
+            r.reps,
+            r.load_ms,
+            r.build_ms,
+            r.render_ms,
+            r.spread_pct,
+            f(r.raw_ms),
+            f(r.overhead()),
+            r.rays.eye,
+            r.rays.reflection,
+            r.rays.refraction,
+            r.rays.shadow,
+            r.rays.total,
+            r.mrays_per_s,
+            f(r.peak_mib),
+            f(r.vs_embree),
+        );
+    }
+    o
+}
+
+/// Everything one run of the suite produced, as saved to a JSON file.
+#[derive(Clone, Debug, PartialEq, Serialize, Deserialize)]
+pub struct Saved {
+    /// The machine.
+    pub machine: Machine,
+    /// The rows.
+    pub rows: Vec<Row>,
+    /// The summary.
+    pub summary: Summary,
+    /// Tachyon rows.
+    pub peers: Vec<PeerRow>,
+    /// Every sample.
+    pub samples: Vec<Sample>,
+}
+
+/// Per-row ratios (this run ÷ the baseline) of render, build and raw time, for the
+/// rows present in both, as markdown.
+pub fn compare(rows: &[Row], base: &[Row]) -> String {
+    let mut o = String::from(
+        "| scene | backend | thr | render ms | baseline ms | render ratio | build ratio | raw ratio |\n|---|---|---:|---:|---:|---:|---:|---:|\n",
+    );
+    let mut ratios = Vec::new();
+    for r in rows {
+        let Some(b) = base
+            .iter()
+            .find(|b| b.scene == r.scene && b.backend == r.backend && b.threads == r.threads)
+        else {
+            continue;
+        };
+        let ratio = |a: f64, b: f64| (b > 0.0).then(|| a / b);
+        let rr = ratio(r.render_ms, b.render_ms);
+        ratios.extend(rr);
+        let raw = r.raw_ms.zip(b.raw_ms).and_then(|(a, b)| ratio(a, b));
+        let _ = writeln!(
+            o,
+            "| {} | {} | {} | {:.1} | {:.1} | {} | {} | {} |",
+            r.scene,
+            r.backend,
+            r.threads,
+            r.render_ms,
+            b.render_ms,
+            opt(rr, 3),
+            opt(ratio(r.build_ms, b.build_ms), 3),
+            opt(raw, 3),
+        );
+    }
+    match geomean(&ratios) {
+        Some(g) => {
+            let _ = writeln!(
+                o,
+                "\nGeometric mean render ratio (this run ÷ baseline): {g:.3} over {} rows",
+                ratios.len()
+            );
+        }
+        None => o.push_str("\nNo row of this run is in the baseline.\n"),
+    }
+    o
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+    use crate::bench::{RunResult, RunSpec};
+
+    fn sample(
+        scene: &str,
+        backend: &str,
+        threads: usize,
+        mode: Mode,
+        ms: f64,
+        prims: usize,
+    ) -> Sample {
+        Sample {
+            spec: RunSpec {
+                scene: scene.into(),
+                backend: backend.into(),
+                threads,
+                width: 8,
+                height: 8,
+                spd: false,
+                mode,
+                embree_quality: Default::default(),
+            },
+            rep: 0,
+            result: RunResult {
+                prims,
+                load_ms: 1.0,
+                build_ms: 2.0,
+                ms,
+                rays: Rays {
+                    eye: 64,
+                    total: 100,
+                    ..Default::default()
+                },
+                peak_kib: Some(2048),
+                accel: backend.into(),
+            },
+        }
+    }
+
+    #[test]
+    fn medians_and_geomeans() {
+        assert_eq!(median(&[3.0, 1.0, 2.0]), 2.0);
+        assert_eq!(median(&[4.0, 1.0, 2.0, 3.0]), 2.5);
+        assert_eq!(median(&[]), 0.0);
+        assert!((geomean(&[2.0, 8.0]).unwrap() - 4.0).abs() < 1e-12);
+        assert_eq!(geomean(&[]), None);
+    }
+
+    #[test]
+    fn rows_fold_repetitions_and_ratios() {
+        let s = vec![
+            sample("spd:balls", "embree", 1, Mode::Render, 10.0, 100),
+            sample("spd:balls", "bvh", 1, Mode::Render, 30.0, 100),
+            sample("spd:balls", "embree", 1, Mode::Render, 12.0, 100),
+            sample("spd:balls", "bvh", 1, Mode::Render, 14.0, 100),
+            sample("spd:balls", "embree", 1, Mode::Raw, 8.0, 100),
+            sample("spd:balls", "embree", 1, Mode::Raw, 8.0, 100),
+            sample("spd:balls", "embree", 2, Mode::Render, 5.5, 100),
+            sample("spd:balls?size=2", "embree", 2, Mode::Render, 1.0, 10),
+        ];
+        let r = rows(&s);
+        assert_eq!(r.len(), 4);
+        assert_eq!(
+            (r[0].backend.as_str(), r[0].render_ms, r[0].reps),
+            ("embree", 11.0, 2)
+        );
+        assert!((r[0].spread_pct - 100.0 * 2.0 / 11.0).abs() < 1e-9);
+        assert_eq!(r[0].raw_ms, Some(8.0));
+        assert_eq!(r[0].overhead(), Some(11.0 / 8.0));
+        assert_eq!(r[1].vs_embree, Some(22.0 / 11.0));
+        assert_eq!(r[0].peak_mib, Some(2.0));
+        let sum = summary(&r);
+        assert_eq!(sum.bvh_vs_embree.get(&1), Some(&2.0));
+        assert_eq!(sum.scaling_min["embree"], (2.0, "spd:balls".to_string()));
+        // 10 -> 100 primitives, 1 ms -> 5.5 ms: exponent log10(5.5).
+        let k = sum.balls_exponent["embree, 2 thread(s)"];
+        assert!((k - 5.5f64.log10()).abs() < 1e-12, "{k}");
+        let md = markdown(&Machine::default(), &r, &sum, &[], "tachyon not installed");
+        assert!(md.contains("| spd:balls | 100 | bvh | 1 |"));
+        assert!(md.contains("tachyon not installed"));
+        let c = csv(&r);
+        assert_eq!(c.lines().count(), 5);
+        assert!(c.lines().nth(2).unwrap().ends_with(",2.0000"));
+    }
+
+    #[test]
+    fn baseline_ratios_match_rows() {
+        let new = rows(&[sample("spd:tetra", "bvh", 2, Mode::Render, 20.0, 10)]);
+        let old = rows(&[
+            sample("spd:tetra", "bvh", 2, Mode::Render, 40.0, 10),
+            sample("spd:gears", "bvh", 2, Mode::Render, 40.0, 10),
+        ]);
+        let c = compare(&new, &old);
+        assert!(
+            c.contains("| spd:tetra | bvh | 2 | 20.0 | 40.0 | 0.500 |"),
+            "{c}"
+        );
+        assert!(!c.contains("gears"));
+        assert!(c.contains("0.500 over 1 rows"));
+        assert!(compare(&new, &[]).contains("No row"));
+    }
+}

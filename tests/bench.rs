@@ -1,0 +1,165 @@
+//! `emray bench`: a tiny suite end to end (child processes, markdown, CSV, JSON,
+//! baseline), raw casting against the render's own ray counts, and bad input.
+
+use emray::bench::{self, raw, Mode, RunSpec};
+use emray::render::RenderSettings;
+use std::path::Path;
+use std::process::{Command, Output};
+
+fn emray(args: &[&str], cwd: &Path) -> Output {
+    Command::new(env!("CARGO_BIN_EXE_emray"))
+        .args(args)
+        .current_dir(cwd)
+        .output()
+        .expect("emray runs")
+}
+
+fn backends() -> &'static str {
+    if cfg!(feature = "embree") {
+        "embree,bvh"
+    } else {
+        "bvh"
+    }
+}
+
+#[test]
+fn tiny_suite_writes_its_reports_and_compares_with_a_baseline() {
+    let dir = tempfile::tempdir().unwrap();
+    let d = dir.path();
+    let args = [
+        "bench",
+        "spd:tetra?size=1",
+        "--backend",
+        backends(),
+        "-t",
+        "1",
+        "--reps",
+        "1",
+        "--res",
+        "16x16",
+        "--no-peer",
+        "--json",
+        "base.json",
+        "--csv",
+        "base.csv",
+    ];
+    let o = emray(&args, d);
+    let md = String::from_utf8_lossy(&o.stdout);
+    assert!(o.status.success(), "{}", String::from_utf8_lossy(&o.stderr));
+    assert!(md.contains("| spd:tetra?size=1 | 4 | bvh | 1 |"), "{md}");
+    assert!(md.contains("Tachyon not run"), "{md}");
+    // 17 x 17 corner rays, all of them eye rays.
+    assert!(md.contains("- spd:tetra?size=1: 289 / 0 / 0 /"), "{md}");
+    let csv = std::fs::read_to_string(d.join("base.csv")).unwrap();
+    let n_backends = backends().split(',').count();
+    assert_eq!(csv.lines().count(), 1 + n_backends);
+    let saved = bench::read_saved(&d.join("base.json")).unwrap();
+    assert_eq!(saved.rows.len(), n_backends);
+    // One render and one raw run per row.
+    assert_eq!(saved.samples.len(), 2 * n_backends);
+    for r in &saved.rows {
+        assert_eq!(r.rays.eye, 289);
+        assert!(r.render_ms > 0.0 && r.raw_ms.unwrap() > 0.0);
+        assert!(r.peak_mib.unwrap() > 1.0);
+    }
+
+    let o = emray(
+        &[
+            "bench",
+            "spd:tetra?size=1",
+            "--backend",
+            "bvh",
+            "-t",
+            "1",
+            "--reps",
+            "1",
+            "--res",
+            "16x16",
+            "--no-peer",
+            "--no-raw",
+            "--baseline",
+            "base.json",
+        ],
+        d,
+    );
+    let md = String::from_utf8_lossy(&o.stdout);
+    assert!(o.status.success(), "{}", String::from_utf8_lossy(&o.stderr));
+    assert!(md.contains("## Against the baseline"), "{md}");
+    assert!(md.contains("over 1 rows"), "{md}");
+}
+
+#[test]
+fn bad_input_is_refused_clearly() {
+    let dir = tempfile::tempdir().unwrap();
+    let d = dir.path();
+    std::fs::write(d.join("bad.json"), "{\"rows\": 3}").unwrap();
+    let o = emray(&["bench", "spd:tetra?size=1", "--baseline", "bad.json"], d);
+    assert_eq!(o.status.code(), Some(1));
+    let err = String::from_utf8_lossy(&o.stderr);
+    assert!(err.contains("bad.json:1:"), "{err}");
+    assert!(err.contains("not an `emray bench --json` file"), "{err}");
+    let o = emray(&["bench", "spd:nosuch"], d);
+    assert_eq!(o.status.code(), Some(2));
+    assert!(String::from_utf8_lossy(&o.stderr).contains("unknown database"));
+    let o = emray(&["bench", "missing.nff", "--no-peer"], d);
+    assert_eq!(o.status.code(), Some(1));
+    assert!(String::from_utf8_lossy(&o.stderr).contains("missing.nff: no such scene file"));
+    assert!(!d.join("missing.json").exists());
+}
+
+#[test]
+fn raw_casting_replays_exactly_the_rays_of_the_render() {
+    // A sphereflake without transmitters: every query is a counted ray.
+    let scene = bench::load_scene("spd:balls?size=1").unwrap();
+    let accel = emray::accel::bvh::Bvh::build(&scene);
+    let mut s = RenderSettings::for_scene(&scene);
+    s.width = 12;
+    s.height = 12;
+    s.spd = true;
+    let pool = rayon::ThreadPoolBuilder::new()
+        .num_threads(2)
+        .build()
+        .unwrap();
+    let (queries, counts) = pool.install(|| raw::record(&scene, &accel, &s));
+    assert_eq!(queries.len() as u64, counts.total());
+    let shadow = queries.iter().filter(|q| q.occluded).count() as u64;
+    assert_eq!(shadow, counts.shadow);
+    let cast = pool.install(|| raw::cast(&accel, &queries));
+    assert_eq!(cast.queries, counts.total());
+    // Eye rays that hit, reflection rays that hit and occluded shadow rays, found again
+    // one by one.
+    let expected = queries
+        .iter()
+        .filter(|q| {
+            if q.occluded {
+                emray::Accel::occluded(&accel, &q.ray)
+            } else {
+                emray::Accel::intersect(&accel, &q.ray).is_some()
+            }
+        })
+        .count() as u64;
+    assert_eq!(cast.hits, expected);
+    assert!(cast.hits >= counts.eye_hit);
+}
+
+#[test]
+fn child_runs_report_the_same_rays_on_both_modes() {
+    let spec = RunSpec {
+        scene: "spd:jacks?size=1".into(),
+        backend: "bvh".into(),
+        threads: 1,
+        width: 10,
+        height: 10,
+        spd: false,
+        mode: Mode::Raw,
+        embree_quality: Default::default(),
+    };
+    let raw = bench::run_child(&spec).unwrap();
+    let render = bench::run_child(&RunSpec {
+        mode: Mode::Render,
+        ..spec
+    })
+    .unwrap();
+    assert_eq!(raw.rays, render.rays);
+    assert_eq!(render.rays.eye, 100);
+}
