@@ -30,6 +30,9 @@ pub enum Command {
     /// Numerical stress cases (scale, translation, far/tiny spheres, watertightness)
     /// with their measured numbers; exit status 1 if a bound is broken.
     Stress(crate::quality_cmd::StressArgs),
+    /// Error against time: the f64 reference once, then a sweep of spp, adaptive AA,
+    /// bailout, depth and backends, to DIR/study.csv and DIR/study.svg.
+    Study(crate::quality_cmd::StudyArgs),
     /// Solve a scene's diffuse interreflection by radiosity and render a view of it.
     Radiosity(RadiosityArgs),
 }
@@ -299,6 +302,10 @@ pub struct RenderArgs {
     /// PNG value encoding.
     #[arg(long, value_enum, default_value_t = EncodingArg::Srgb)]
     pub encoding: EncodingArg,
+    /// Environment map for rays that leave the scene (PNG/JPEG: 2:1 latitude-longitude
+    /// or a 4:3 cube cross), replacing the scene's own.
+    #[arg(long, value_name = "FILE")]
+    pub envmap: Option<PathBuf>,
     /// No progress bar and no messages but errors.
     #[arg(short, long)]
     pub quiet: bool,
@@ -348,6 +355,7 @@ impl RenderArgs {
             stats: false,
             stats_json: None,
             encoding: EncodingArg::Srgb,
+            envmap: None,
             quiet: false,
             verbose: 0,
             gi: None,
@@ -362,7 +370,7 @@ pub const MAX_SIDE: u32 = 65536;
 /// Largest accepted pixel count (2^28, 268 megapixels).
 pub const MAX_PIXELS: u64 = 1 << 28;
 
-fn parse_res(s: &str) -> Result<(u32, u32), String> {
+pub fn parse_res(s: &str) -> Result<(u32, u32), String> {
     let (w, h) = s
         .split_once(['x', 'X'])
         .ok_or_else(|| format!("'{s}' is not WxH (e.g. 640x480)"))?;

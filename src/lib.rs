@@ -20,6 +20,7 @@ pub mod render;
 pub mod run;
 pub mod scene;
 pub mod stress;
+pub mod study;
 
 pub use accel::{Accel, Backend, Hit};
 pub use render::{RenderSettings, RenderStats};

@@ -10,6 +10,7 @@ use emray::accel::Backend;
 use emray::gen::Database;
 use emray::load;
 use emray::render::RenderSettings;
+use emray::scene::Environment;
 use emray::Scene;
 use std::io::{IsTerminal, Write};
 use std::path::{Path, PathBuf};
@@ -28,6 +29,7 @@ fn main() -> ExitCode {
         Some(Command::Compare(c)) => return quality_cmd::compare(&c),
         Some(Command::Stress(s)) => return quality_cmd::stress(&s),
         Some(Command::Radiosity(r)) => return radiosity(&r),
+        Some(Command::Study(s)) => return quality_cmd::study(&s),
         None => RenderArgs::default_scene(),
     };
     let level = match (args.quiet, args.verbose) {
@@ -321,7 +323,7 @@ fn render_all(args: &RenderArgs, jobs: &[Job]) -> Result<()> {
 
 fn render_one(args: &RenderArgs, scene_path: Option<&Path>, out: &Path) -> Result<()> {
     let t0 = Instant::now();
-    let (name, scene): (String, Scene) = match scene_path {
+    let (name, mut scene): (String, Scene) = match scene_path {
         Some(p) => {
             let name = p.display().to_string();
             match Database::parse_spec(&name).map_err(anyhow::Error::msg)? {
@@ -337,6 +339,9 @@ fn render_one(args: &RenderArgs, scene_path: Option<&Path>, out: &Path) -> Resul
             load::nff::parse_str(DEFAULT_SCENE, Path::new("<default scene>"))?,
         ),
     };
+    if let Some(env) = &args.envmap {
+        scene.environment = Some(Environment::load(env).map_err(anyhow::Error::msg)?);
+    }
     let load_ms = t0.elapsed().as_secs_f64() * 1e3;
     let mut settings = RenderSettings::for_scene(&scene);
     if let Some((w, h)) = args.res {

@@ -377,6 +377,9 @@ pub fn render_reference(
     };
     let mut st = settings.clone();
     st.spp = strata * strata;
+    // The reference casts the full ray tree with uniform stratified samples.
+    st.bailout = 0.0;
+    st.aa = render::Aa::Uniform;
     let t = Timings {
         load: load_ms,
         build: 0.0,

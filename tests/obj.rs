@@ -422,7 +422,7 @@ illum 0
         .iter()
         .any(|w| w.contains("'tr'") && w.contains("Ni 0")));
     // `Kd 0.7` is grey 0.7; `Kd 0.1 0.2` is malformed and ignored with its line; the
-    // texture is ignored with a warning; illum 0 turns the ambient term off.
+    // texture file is missing (a warning); illum 0 turns the ambient term off.
     assert_eq!(m[2].color, Vec3::splat(0.7));
     assert_eq!((m[2].ka, m[2].ks), (0.0, 0.0));
     let w = data

@@ -218,3 +218,26 @@ fn the_reference_refuses_what_it_does_not_model() {
         .unwrap();
     assert_eq!(out.status.code(), Some(2));
 }
+
+#[test]
+fn study_writes_a_row_per_setting_and_a_curve_per_knob() {
+    let s = scene(ANALYTIC);
+    let dir = tempfile::tempdir().unwrap();
+    let rows = emray::study::write(&s, "analytic", dir.path(), 8, 8, 2, &[Backend::Bvh]).unwrap();
+    let csv = std::fs::read_to_string(dir.path().join("study.csv")).unwrap();
+    assert_eq!(csv.lines().count(), rows.len() + 1);
+    assert!(csv.starts_with("knob,setting,render_ms,rays,rmse,psnr"));
+    // More samples, less error: 64 spp beats 1 spp against the reference.
+    let spp = |k: &str| {
+        rows.iter()
+            .find(|r| r.knob == "spp" && r.setting == k)
+            .unwrap()
+    };
+    assert!(spp("64").m.rmse < spp("1").m.rmse);
+    let svg = std::fs::read_to_string(dir.path().join("study.svg")).unwrap();
+    for knob in ["spp", "adaptive", "bailout", "depth", "backend", "f64"] {
+        assert!(rows.iter().any(|r| r.knob == knob), "{knob}");
+        assert!(svg.contains(&format!(">{knob}</text>")), "{knob}");
+    }
+    assert_eq!(svg.matches("<polyline").count(), 6);
+}

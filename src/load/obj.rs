@@ -21,8 +21,8 @@
 //!   one warning naming the first one's line. [`LoadStats::polygons`] counts the faces
 //!   read, degenerate or not.
 //! - Lines (`l`) are skipped with a warning; points, curves and surfaces are ignored.
-//!   Groups and objects (`g`, `o`) do not matter: every face keeps the material of the
-//!   `usemtl` in force where it appears.
+//!   Groups and objects (`g`, `o`) do not split materials: every face keeps the
+//!   material of the `usemtl` in force where it appears, whatever group it is in.
 //!
 //! # Errors
 //!
@@ -51,12 +51,38 @@
 //!   a name drops the statements up to the next `newmtl`. A colour given as one number
 //!   (`Kd 0.8`) is grey, as the MTL format specifies.
 //!
-//! Faces before any `usemtl` also get [`DEFAULT_MATERIAL`], without a warning. Texture
-//! maps (`map_*`, `bump`, `disp`, `decal`, `refl`) are not supported: they are skipped
-//! with one warning per library. Emission (`Ke`), `Tf` and other statements are
-//! ignored. Material indices in [`ObjData`] are local to [`ObjData::materials`]: one
-//! per material defined by the libraries, in the order read, then the default material
-//! if some face uses it.
+//! Faces before any `usemtl` also get [`DEFAULT_MATERIAL`], without a warning.
+//! Emission (`Ke`), `Tf` and other statements are ignored. Material indices in
+//! [`ObjData`] are local to [`ObjData::materials`]: one per material defined by the
+//! libraries, in the order read, then the default material if some face uses it.
+//!
+//! # Texture maps
+//!
+//! File names are relative to the library's directory; each image is read once.
+//!
+//! - `map_Kd` multiplies the colour (sRGB-decoded), `map_Ks` the highlight and mirror
+//!   weights by its mean (sRGB-decoded), `bump`/`map_bump`/`map_Bump` is a height
+//!   field (read linearly, scaled by `-bm`), `norm`/`map_Kn` a tangent-space normal map
+//!   (linear). Options: `-bm`, `-clamp on|off` and `-s u v` (texture coordinates are
+//!   multiplied by it; the material keeps the last one given) are used; the others
+//!   (`-o`, `-t`, `-mm`, `-blendu`, ...) are skipped with a warning.
+//! - `refl` with a 2:1 latitude-longitude or 4:3 cube-cross image becomes the scene's
+//!   environment map (the first one that loads; a command-line `--envmap` wins).
+//! - Other maps (`map_Ka`, `map_d`, `map_Ns`, `disp`, `decal`) are skipped with one
+//!   warning per library.
+//! - A map whose file cannot be read is a warning naming the file and the library's
+//!   line. A missing colour map shows as [`MISSING_TEXTURE`], a magenta and black
+//!   checkerboard (8 × 8 squares per unit of texture coordinates), so the problem is
+//!   visible; a missing specular, bump or normal map is left out.
+//!
+//! Faces with `vt` on every vertex carry their texture coordinates (interpolated
+//! barycentrically, triangles of larger faces keeping their corners'). Without `vt` a
+//! triangle's texture coordinates are its barycentric coordinates.
+//!
+//! Faces without `vn` in a smoothing group (`s 1`, `s 2`, ...; `s off` and `s 0` end
+//! it) are smooth: each vertex gets the normalised sum of the area-weighted normals of
+//! the group's faces at that position (positions are matched exactly, across `g`
+//! and `o`). Outside smoothing groups such faces are flat.
 //!
 //! An MTL material becomes a Whitted [`Material`] as follows (means are over r, g, b;
 //! colours are clamped to be non-negative, `Ns` too, `d` to [0, 1]):
@@ -111,7 +137,9 @@ use super::LoadError;
 use crate::geometry::polygon::Triangulator;
 use crate::geometry::Triangle;
 use crate::math::{Aabb, DVec3, Vec3};
-use crate::scene::{Camera, Geometry, Light, LoadStats, Material, Scene};
+use crate::scene::texture::{Image, Wrap};
+use crate::scene::{Camera, Environment, Geometry, Light, LoadStats, Material, Scene, Texture};
+use glam::Vec2;
 use std::cell::RefCell;
 use std::collections::HashMap;
 use std::io::Cursor;
@@ -122,6 +150,14 @@ use std::path::Path;
 pub const DEFAULT_MATERIAL: Material = Material {
     color: Vec3::splat(0.5),
     ..Material::DEFAULT
+};
+
+/// What a colour map that cannot be read shows: a magenta and black checkerboard,
+/// 8 × 8 squares over the unit square of texture coordinates.
+pub const MISSING_TEXTURE: Texture = Texture::Checker {
+    a: Vec3::new(1.0, 0.0, 1.0),
+    b: Vec3::ZERO,
+    scale: 8.0,
 };
 
 /// Full vertical field of view of the automatic camera, in degrees.
@@ -146,6 +182,10 @@ pub struct ObjData {
     /// The materials of the libraries, in the order read, then [`DEFAULT_MATERIAL`] if
     /// a face uses it.
     pub materials: Vec<Material>,
+    /// The textures the materials' maps index.
+    pub textures: Vec<Texture>,
+    /// The environment from the first usable reflection map (`refl`), if any.
+    pub environment: Option<Environment>,
     /// Bounds of the triangles ([`Aabb::EMPTY`] when there are none).
     pub bounds: Aabb,
     /// Problems that did not stop the load, each naming its file (and line when known).
@@ -182,6 +222,8 @@ pub fn load(path: &Path) -> Result<Scene, LoadError> {
     scene.lights = vec![light];
     scene.ambient = Vec3::splat(AUTO_AMBIENT);
     scene.materials = data.materials;
+    scene.textures = data.textures;
+    scene.environment = data.environment;
     scene.geometry = data.geometry;
     scene.load_stats = data.stats;
     Ok(scene)
@@ -234,8 +276,10 @@ pub fn frame(bounds: &Aabb) -> Option<(Camera, Light)> {
 /// are replaced, which leaves line numbers intact. Problems with material libraries are
 /// warnings, not errors.
 pub fn load_geometry(path: &Path) -> Result<ObjData, LoadError> {
+    let t0 = std::time::Instant::now();
     let bytes = std::fs::read(path).map_err(|e| whole_file(path, format!("cannot read: {e}")))?;
     let text = String::from_utf8_lossy(&bytes);
+    let t_read = t0.elapsed();
     let scan = match scan(&text) {
         Ok(s) => s,
         Err(e) => {
@@ -252,8 +296,10 @@ pub fn load_geometry(path: &Path) -> Result<ObjData, LoadError> {
         calls: Default::default(),
         read: Default::default(),
         warnings: Default::default(),
+        maps: Default::default(),
     };
     let options = tobj_options();
+    let t_scan = t0.elapsed();
     let parsed = tobj::load_obj_buf(&mut Cursor::new(text.as_bytes()), &options, |p| {
         libs.load(p)
     });
@@ -303,12 +349,26 @@ pub fn load_geometry(path: &Path) -> Result<ObjData, LoadError> {
 
     let mut warnings = libs.warnings.into_inner();
     let read_libs = libs.read.into_inner();
+    let maps = libs.maps.into_inner();
     let mut b = Builder::new(path, &mtl, &mut warnings);
+    b.load_maps(&maps);
     let runs = b.resolve_usemtl(&scan, &read_libs);
+    let t_parse = t0.elapsed();
     b.build(&models, &scan, &runs)?;
+    let t_build = t0.elapsed();
+    log::info!(
+        "{}: read {:.0} ms, scan {:.0} ms, parse (tobj) {:.0} ms, conversion {:.0} ms",
+        path.display(),
+        t_read.as_secs_f64() * 1e3,
+        (t_scan - t_read).as_secs_f64() * 1e3,
+        (t_parse - t_scan).as_secs_f64() * 1e3,
+        (t_build - t_parse).as_secs_f64() * 1e3
+    );
     let Builder {
         geometry,
         materials,
+        textures,
+        environment,
         bounds,
         stats,
         first_degenerate,
@@ -344,6 +404,8 @@ pub fn load_geometry(path: &Path) -> Result<ObjData, LoadError> {
     Ok(ObjData {
         geometry,
         materials,
+        textures,
+        environment,
         bounds,
         warnings,
         stats,
@@ -430,6 +492,8 @@ fn comment_hint(tok: &str) -> &'static str {
 const FACE_IS_LINE: u8 = 1;
 /// Face flag: every vertex of the face has a normal index.
 const FACE_ALL_NORMALS: u8 = 2;
+/// Face flag: every vertex of the face has a texture coordinate index.
+const FACE_ALL_TEXCOORDS: u8 = 4;
 
 /// What the scan learns about the file that tobj does not say.
 #[derive(Debug, Default)]
@@ -442,6 +506,9 @@ struct Scan {
     mtllib_lines: Vec<usize>,
     /// Number of `l` statements.
     lines: usize,
+    /// Smoothing-group statements (`s`) as (index of the first face after it, group;
+    /// 0 = off), in file order.
+    smoothing: Vec<(usize, u32)>,
     /// The first `v` whose colour (x y z r g b) is present where the first `v`'s is
     /// not, or the other way round: tobj refuses faces on such vertices.
     colour_mismatch: Option<Located>,
@@ -567,6 +634,7 @@ fn scan(text: &str) -> Result<Scan, Located> {
             "f" | "l" => {
                 let mut n = 0;
                 let mut all_normals = true;
+                let mut all_texcoords = true;
                 for tok in words {
                     n += 1;
                     let mut parts = 0;
@@ -634,6 +702,9 @@ fn scan(text: &str) -> Result<Scan, Located> {
                     if parts < 3 || tok.rsplit('/').next().is_some_and(str::is_empty) {
                         all_normals = false;
                     }
+                    if tok.split('/').nth(1).map_or(true, str::is_empty) {
+                        all_texcoords = false;
+                    }
                 }
                 if kw == "l" {
                     s.lines += 1;
@@ -642,7 +713,14 @@ fn scan(text: &str) -> Result<Scan, Located> {
                     if n == 0 {
                         return Err(err(None, "face without vertices".into()));
                     }
-                    s.faces.push(if all_normals { FACE_ALL_NORMALS } else { 0 });
+                    let mut flags = 0;
+                    if all_normals {
+                        flags |= FACE_ALL_NORMALS;
+                    }
+                    if all_texcoords {
+                        flags |= FACE_ALL_TEXCOORDS;
+                    }
+                    s.faces.push(flags);
                 }
             }
             "usemtl" => {
@@ -661,6 +739,14 @@ fn scan(text: &str) -> Result<Scan, Located> {
                 });
             }
             "mtllib" => s.mtllib_lines.push(ln),
+            "s" => {
+                // `s off`, `s 0` or no number: off; any other word names a group.
+                let group = match words.next() {
+                    None | Some("off") | Some("0") => 0,
+                    Some(w) => w.parse::<u32>().unwrap_or(u32::MAX).max(1),
+                };
+                s.smoothing.push((s.faces.len(), group));
+            }
             _ => {}
         }
     }
@@ -848,6 +934,8 @@ struct MtlLibs<'a> {
     /// Libraries read, as named in the file.
     read: RefCell<Vec<String>>,
     warnings: RefCell<Vec<String>>,
+    /// Texture statements of the libraries read, in order.
+    maps: RefCell<Vec<TexStmt>>,
 }
 
 impl MtlLibs<'_> {
@@ -890,7 +978,12 @@ impl MtlLibs<'_> {
                 }
             };
             let mut warnings = Vec::new();
-            let text = sanitize_mtl(&String::from_utf8_lossy(&bytes), &full, &mut warnings);
+            let text = sanitize_mtl(
+                &String::from_utf8_lossy(&bytes),
+                &full,
+                &mut warnings,
+                &mut self.maps.borrow_mut(),
+            );
             self.warnings.borrow_mut().extend(warnings);
             match tobj::load_mtl_buf(&mut Cursor::new(text.as_bytes())) {
                 Ok((mats, names)) => {
@@ -918,18 +1011,132 @@ impl MtlLibs<'_> {
     }
 }
 
-/// Statements of texture maps, which are not supported.
+/// Statements of texture maps.
 fn is_texture_statement(kw: &str) -> bool {
-    kw.starts_with("map_") || matches!(kw, "bump" | "disp" | "decal" | "refl")
+    kw.starts_with("map_") || matches!(kw, "bump" | "disp" | "decal" | "refl" | "norm")
+}
+
+/// The texture maps emray uses.
+#[derive(Clone, Copy, Debug, PartialEq, Eq)]
+enum MapKind {
+    /// `map_Kd`.
+    Color,
+    /// `map_Ks`.
+    Specular,
+    /// `bump`, `map_bump`, `map_Bump`.
+    Bump,
+    /// `norm`, `map_Kn`: a tangent-space normal map.
+    Normal,
+    /// `refl`: a reflection map, used as the scene's environment.
+    Reflection,
+}
+
+/// A texture statement of a material.
+#[derive(Clone, Debug)]
+struct TexStmt {
+    material: String,
+    kind: MapKind,
+    /// The file name as written.
+    name: String,
+    /// The file, relative to the library's directory.
+    file: std::path::PathBuf,
+    /// `-bm`.
+    bump_scale: f32,
+    /// `-clamp on`.
+    clamp: bool,
+    /// `-s u v`.
+    scale: [f32; 2],
+    /// Where: `library:line`.
+    at: String,
+}
+
+/// Parse the options and file name of a texture statement (everything after the
+/// keyword). Options emray does not use are skipped with their arguments.
+fn parse_map(words: &[&str]) -> Result<MapOptions, String> {
+    let mut bm = 1.0;
+    let mut scale = [1.0f32, 1.0];
+    let mut clamp = false;
+    let mut ignored = Vec::new();
+    let mut i = 0;
+    let number = |t: &str| t.parse::<f32>().ok().filter(|v| v.is_finite());
+    while i < words.len() && words[i].starts_with('-') && number(words[i]).is_none() {
+        let opt = words[i];
+        i += 1;
+        let arg = |i: usize| words.get(i).copied();
+        match opt {
+            "-bm" => {
+                bm = arg(i)
+                    .and_then(number)
+                    .ok_or_else(|| "expected a number after '-bm'".to_string())?;
+                i += 1;
+            }
+            "-clamp" => {
+                clamp = arg(i) == Some("on");
+                i += 1;
+            }
+            "-blendu" | "-blendv" | "-boost" | "-cc" | "-imfchan" | "-texres" | "-type" => {
+                ignored.push(opt.to_string());
+                i += 1;
+            }
+            "-mm" => {
+                ignored.push(opt.to_string());
+                i += 2;
+            }
+            "-o" | "-s" | "-t" => {
+                let mut n = 0;
+                let mut got = [1.0f32; 3];
+                while n < 3 {
+                    let Some(x) = arg(i).and_then(number) else {
+                        break;
+                    };
+                    got[n] = x;
+                    i += 1;
+                    n += 1;
+                }
+                if opt == "-s" && n > 0 && got[0] != 0.0 && got[1] != 0.0 {
+                    scale = [got[0], got[1]];
+                } else {
+                    ignored.push(opt.to_string());
+                }
+            }
+            _ => return Err(format!("unknown texture option {}", show(opt))),
+        }
+    }
+    if i >= words.len() {
+        return Err("expected a file name".into());
+    }
+    Ok(MapOptions {
+        file: words[i..].join(" "),
+        bump_scale: bm,
+        clamp,
+        scale,
+        ignored,
+    })
+}
+
+/// A texture statement's file and options.
+struct MapOptions {
+    file: String,
+    bump_scale: f32,
+    clamp: bool,
+    scale: [f32; 2],
+    ignored: Vec<String>,
 }
 
 /// The MTL text with every statement tobj would reject, or panic on, removed (each
 /// with a warning `path:line:col`), one-number colours expanded to grey, and texture
 /// maps removed (one warning in all).
-fn sanitize_mtl(text: &str, path: &Path, warnings: &mut Vec<String>) -> String {
+fn sanitize_mtl(
+    text: &str,
+    path: &Path,
+    warnings: &mut Vec<String>,
+    maps: &mut Vec<TexStmt>,
+) -> String {
     let mut out = String::with_capacity(text.len() + 64);
     let mut skipping = false;
-    let mut textures = 0usize;
+    let mut unsupported: Vec<String> = Vec::new();
+    let mut material = String::new();
+    let mut option_notes = Vec::new();
     for (i, line) in text.lines().enumerate() {
         let ln = i + 1;
         let mut words = line.split_whitespace();
@@ -957,6 +1164,7 @@ fn sanitize_mtl(text: &str, path: &Path, warnings: &mut Vec<String>) -> String {
                     continue;
                 }
                 skipping = false;
+                material = name.to_string();
             }
             _ if skipping => continue,
             "Ka" | "Kd" | "Ks" | "Ke" => {
@@ -1002,7 +1210,48 @@ fn sanitize_mtl(text: &str, path: &Path, warnings: &mut Vec<String>) -> String {
                 }
             },
             k if is_texture_statement(k) => {
-                textures += 1;
+                let kind = match k {
+                    "map_Kd" => MapKind::Color,
+                    "map_Ks" => MapKind::Specular,
+                    "bump" | "map_bump" | "map_Bump" => MapKind::Bump,
+                    "norm" | "map_Kn" => MapKind::Normal,
+                    "refl" => MapKind::Reflection,
+                    other => {
+                        if !unsupported.iter().any(|u| u == other) {
+                            unsupported.push(other.to_string());
+                        }
+                        continue;
+                    }
+                };
+                let rest: Vec<&str> = words.collect();
+                match parse_map(&rest) {
+                    Ok(MapOptions {
+                        file: name,
+                        bump_scale,
+                        clamp,
+                        scale,
+                        ignored,
+                    }) => {
+                        if !ignored.is_empty() {
+                            option_notes.push(format!(
+                                "{}:{ln}: texture option(s) {} not supported; ignored",
+                                path.display(),
+                                ignored.join(" ")
+                            ));
+                        }
+                        maps.push(TexStmt {
+                            material: material.clone(),
+                            kind,
+                            file: path.parent().unwrap_or(Path::new("")).join(&name),
+                            name,
+                            bump_scale,
+                            clamp,
+                            scale,
+                            at: format!("{}:{ln}", path.display()),
+                        });
+                    }
+                    Err(e) => warn(rest.first().copied(), e),
+                }
                 continue;
             }
             _ => {}
@@ -1010,10 +1259,13 @@ fn sanitize_mtl(text: &str, path: &Path, warnings: &mut Vec<String>) -> String {
         out.push_str(line);
         out.push('\n');
     }
-    if textures > 0 {
+    warnings.extend(option_notes);
+    if !unsupported.is_empty() {
         warnings.push(format!(
-            "{}: ignored {textures} texture map statement(s): textures are not supported",
-            path.display()
+            "{}: ignored the texture map statement(s) {}: not supported (map_Kd, map_Ks, \
+             bump, map_bump, norm and refl are)",
+            path.display(),
+            unsupported.join(", ")
         ));
     }
     out
@@ -1109,6 +1361,8 @@ struct Builder<'a> {
     by_name: HashMap<&'a str, u32>,
     geometry: Geometry,
     materials: Vec<Material>,
+    textures: Vec<Texture>,
+    environment: Option<Environment>,
     default_index: Option<u32>,
     bounds: Aabb,
     stats: LoadStats,
@@ -1119,6 +1373,7 @@ struct Builder<'a> {
     pts: Vec<Vec3>,
     nrm: Vec<Vec3>,
     tris: Vec<[usize; 3]>,
+    uvs: Vec<Vec2>,
     triangulator: Triangulator,
 }
 
@@ -1140,6 +1395,8 @@ impl<'a> Builder<'a> {
             by_name,
             geometry: Geometry::default(),
             materials,
+            textures: Vec::new(),
+            environment: None,
             default_index: None,
             bounds: Aabb::EMPTY,
             stats: LoadStats::default(),
@@ -1149,7 +1406,83 @@ impl<'a> Builder<'a> {
             pts: Vec::new(),
             nrm: Vec::new(),
             tris: Vec::new(),
+            uvs: Vec::new(),
             triangulator: Triangulator::new(),
+        }
+    }
+
+    /// Load the texture maps of the materials (each image once) and set the materials'
+    /// maps; a file that cannot be read is a warning and gets the documented default.
+    fn load_maps(&mut self, maps: &[TexStmt]) {
+        let mut cache: HashMap<(std::path::PathBuf, bool, bool), u32> = HashMap::new();
+        let mut missing: Option<u32> = None;
+        for m in maps {
+            let Some(&i) = self.by_name.get(m.material.as_str()) else {
+                continue;
+            };
+            if m.kind == MapKind::Reflection {
+                if self.environment.is_none() {
+                    match Environment::load(&m.file) {
+                        Ok(env) => self.environment = Some(env),
+                        Err(e) => self.warnings.push(format!(
+                            "{}: reflection map '{}' not used: {e}; the background stays",
+                            m.at, m.name
+                        )),
+                    }
+                }
+                continue;
+            }
+            let srgb = matches!(m.kind, MapKind::Color | MapKind::Specular);
+            let key = (m.file.clone(), srgb, m.clamp);
+            let tex = match cache.get(&key) {
+                Some(&t) => Some(t),
+                None => match Image::load(&m.file, srgb) {
+                    Ok(mut img) => {
+                        if m.clamp {
+                            img.wrap = Wrap::Clamp;
+                        }
+                        self.textures.push(Texture::Image(std::sync::Arc::new(img)));
+                        let t = self.textures.len() as u32 - 1;
+                        cache.insert(key, t);
+                        Some(t)
+                    }
+                    Err(e) => {
+                        let what = if m.kind == MapKind::Color {
+                            "the colour becomes a magenta and black checkerboard"
+                        } else {
+                            "the map is left out"
+                        };
+                        self.warnings.push(format!(
+                            "{}: texture '{}' of material {} not found or unreadable ({e}); \
+                             {what}",
+                            m.at,
+                            m.name,
+                            show(&m.material)
+                        ));
+                        (m.kind == MapKind::Color).then(|| {
+                            *missing.get_or_insert_with(|| {
+                                self.textures.push(MISSING_TEXTURE);
+                                self.textures.len() as u32 - 1
+                            })
+                        })
+                    }
+                },
+            };
+            let Some(t) = tex else { continue };
+            let maps = &mut self.materials[i as usize].maps;
+            if m.scale != [1.0, 1.0] {
+                maps.uv_scale = m.scale;
+            }
+            match m.kind {
+                MapKind::Color => maps.color = t,
+                MapKind::Specular => maps.specular = t,
+                MapKind::Bump => {
+                    maps.bump = t;
+                    maps.bump_scale = m.bump_scale;
+                }
+                MapKind::Normal => maps.normal = t,
+                MapKind::Reflection => {}
+            }
         }
     }
 
@@ -1206,34 +1539,40 @@ impl<'a> Builder<'a> {
         self.geometry.triangles.items.reserve(total / 3);
         self.geometry.triangles.material.reserve(total / 3);
         self.geometry.triangle_normals.reserve(total / 3);
+        let group_normals = smoothing_group_normals(models, scan);
 
         let mut face = 0usize;
         let mut run = 0usize; // next `usemtl` to take effect
         let mut slot = DEFAULT_SLOT;
+        let mut srun = 0usize; // next `s` to take effect
+        let mut group = 0u32;
         for model in models {
             let mesh = &model.mesh;
             let smooth_mesh = !mesh.normal_indices.is_empty();
-            let pos = |i: u32| {
-                let i = i as usize * 3;
-                Vec3::new(
-                    mesh.positions[i],
-                    mesh.positions[i + 1],
-                    mesh.positions[i + 2],
-                )
-            };
+            let textured_mesh = !mesh.texcoord_indices.is_empty();
+            let pos = |i: u32| mesh_pos(mesh, i);
             let nrm = |i: u32| {
                 let i = i as usize * 3;
                 Vec3::new(mesh.normals[i], mesh.normals[i + 1], mesh.normals[i + 2])
+            };
+            let tex = |i: u32| {
+                let i = i as usize * 2;
+                Vec2::new(mesh.texcoords[i], mesh.texcoords[i + 1])
             };
             let mut off = 0usize;
             for f in 0..face_count(mesh) {
                 let arity = mesh.face_arities.get(f).map_or(3, |&a| a as usize);
                 let idx = &mesh.indices[off..off + arity];
                 let nidx = smooth_mesh.then(|| &mesh.normal_indices[off..off + arity]);
+                let tidx = textured_mesh.then(|| &mesh.texcoord_indices[off..off + arity]);
                 off += arity;
                 while run < scan.usemtl.len() && scan.usemtl[run].first_face <= face {
                     slot = slots[run];
                     run += 1;
+                }
+                while srun < scan.smoothing.len() && scan.smoothing[srun].0 <= face {
+                    group = scan.smoothing[srun].1;
+                    srun += 1;
                 }
                 let flags = scan.faces[face];
                 let k = face;
@@ -1243,54 +1582,64 @@ impl<'a> Builder<'a> {
                 }
                 self.stats.polygons += 1;
                 let normals = nidx.filter(|_| flags & FACE_ALL_NORMALS != 0);
+                let texcoords = tidx.filter(|_| flags & FACE_ALL_TEXCOORDS != 0);
+                // Without `vn`, a smoothing group gives averaged normals.
+                let grouped = |p: Vec3| {
+                    group_normals
+                        .get(&(p.to_array().map(f32::to_bits), group))
+                        .and_then(|n| unit(*n))
+                };
+                if arity < 3 {
+                    self.degenerate(k);
+                    continue;
+                }
+                self.pts.clear();
+                self.pts.extend(idx.iter().map(|&i| pos(i)));
+                self.nrm.clear();
+                let mut smooth = false;
+                if let Some(ni) = normals {
+                    self.nrm.extend(ni.iter().filter_map(|&i| unit(nrm(i))));
+                    smooth = self.nrm.len() == arity;
+                    if !smooth {
+                        self.zero_normal(k);
+                    }
+                } else if group != 0 {
+                    self.nrm.extend(self.pts.iter().filter_map(|&p| grouped(p)));
+                    smooth = self.nrm.len() == arity;
+                }
+                self.uvs.clear();
+                if let Some(ti) = texcoords {
+                    self.uvs.extend(ti.iter().map(|&i| tex(i)));
+                }
                 if arity == 3 {
-                    let p = [pos(idx[0]), pos(idx[1]), pos(idx[2])];
+                    let p = [self.pts[0], self.pts[1], self.pts[2]];
                     let ng = (p[1] - p[0]).cross(p[2] - p[0]);
                     if ng.is_nan() || ng == Vec3::ZERO {
                         self.degenerate(k);
                         continue;
                     }
-                    let n = normals.map(|ni| [nrm(ni[0]), nrm(ni[1]), nrm(ni[2])]);
-                    let n = match n.map(|n| n.map(unit)) {
-                        Some([Some(a), Some(b), Some(c)]) => Some([a, b, c]),
-                        Some(_) => {
-                            self.zero_normal(k);
-                            None
-                        }
-                        None => None,
-                    };
-                    let m = self.material_index(slot);
-                    self.push(Triangle { p }, n, m)?;
-                } else if arity < 3 {
+                    self.tris.clear();
+                    self.tris.push([0, 1, 2]);
+                } else if self
+                    .triangulator
+                    .triangulate(&self.pts, &mut self.tris)
+                    .is_err()
+                {
                     self.degenerate(k);
-                } else {
-                    self.pts.clear();
-                    self.pts.extend(idx.iter().map(|&i| pos(i)));
-                    self.nrm.clear();
-                    let mut smooth = false;
-                    if let Some(ni) = normals {
-                        self.nrm.extend(ni.iter().filter_map(|&i| unit(nrm(i))));
-                        smooth = self.nrm.len() == arity;
-                        if !smooth {
-                            self.zero_normal(k);
-                        }
-                    }
-                    if self
-                        .triangulator
-                        .triangulate(&self.pts, &mut self.tris)
-                        .is_err()
-                    {
-                        self.degenerate(k);
-                        continue;
-                    }
-                    let m = self.material_index(slot);
-                    for t in 0..self.tris.len() {
-                        let [a, b, c] = self.tris[t];
-                        let tri = Triangle {
-                            p: [self.pts[a], self.pts[b], self.pts[c]],
-                        };
-                        let n = smooth.then(|| [self.nrm[a], self.nrm[b], self.nrm[c]]);
-                        self.push(tri, n, m)?;
+                    continue;
+                }
+                let m = self.material_index(slot);
+                for t in 0..self.tris.len() {
+                    let [a, b, c] = self.tris[t];
+                    let tri = Triangle {
+                        p: [self.pts[a], self.pts[b], self.pts[c]],
+                    };
+                    let n = smooth.then(|| [self.nrm[a], self.nrm[b], self.nrm[c]]);
+                    self.push(tri, n, m)?;
+                    if !self.uvs.is_empty() {
+                        let i = self.geometry.triangles.len() - 1;
+                        self.geometry
+                            .set_triangle_uvs(i, [self.uvs[a], self.uvs[b], self.uvs[c]]);
                     }
                 }
             }
@@ -1324,6 +1673,62 @@ impl<'a> Builder<'a> {
         self.zero_normals += 1;
         self.first_zero_normal.get_or_insert(face);
     }
+}
+
+/// Position `i` of `mesh`.
+#[inline]
+fn mesh_pos(mesh: &tobj::Mesh, i: u32) -> Vec3 {
+    let i = i as usize * 3;
+    Vec3::new(
+        mesh.positions[i],
+        mesh.positions[i + 1],
+        mesh.positions[i + 2],
+    )
+}
+
+/// For faces without `vn` in a smoothing group: the sum of the area-weighted normals
+/// of the group's faces around each position (keyed by the position's bits, so groups
+/// join across `g`/`o` boundaries, and the group number).
+fn smoothing_group_normals(models: &[tobj::Model], scan: &Scan) -> HashMap<([u32; 3], u32), Vec3> {
+    let mut sums: HashMap<([u32; 3], u32), Vec3> = HashMap::new();
+    if scan.smoothing.iter().all(|&(_, g)| g == 0) {
+        return sums;
+    }
+    let mut face = 0usize;
+    let mut srun = 0usize;
+    let mut group = 0u32;
+    for model in models {
+        let mesh = &model.mesh;
+        let mut off = 0usize;
+        for f in 0..face_count(mesh) {
+            let arity = mesh.face_arities.get(f).map_or(3, |&a| a as usize);
+            let idx = &mesh.indices[off..off + arity];
+            off += arity;
+            while srun < scan.smoothing.len() && scan.smoothing[srun].0 <= face {
+                group = scan.smoothing[srun].1;
+                srun += 1;
+            }
+            let flags = scan.faces[face];
+            face += 1;
+            if group == 0 || flags & (FACE_IS_LINE | FACE_ALL_NORMALS) != 0 || arity < 3 {
+                continue;
+            }
+            // Newell's normal: twice the vector area of the polygon.
+            let mut n = Vec3::ZERO;
+            for k in 0..arity {
+                let (a, b) = (mesh_pos(mesh, idx[k]), mesh_pos(mesh, idx[(k + 1) % arity]));
+                n += a.cross(b);
+            }
+            if !n.is_finite() {
+                continue;
+            }
+            for &i in idx {
+                let key = (mesh_pos(mesh, i).to_array().map(f32::to_bits), group);
+                *sums.entry(key).or_insert(Vec3::ZERO) += n;
+            }
+        }
+    }
+    sums
 }
 
 /// `n` made unit length, or `None` when it is zero. Scaled first so that huge finite
@@ -1446,7 +1851,8 @@ Kd 0 1 0
 Ni 1.5
 ";
         let mut warnings = Vec::new();
-        let out = sanitize_mtl(src, Path::new("x.mtl"), &mut warnings);
+        let mut maps = Vec::new();
+        let out = sanitize_mtl(src, Path::new("x.mtl"), &mut warnings, &mut maps);
         let (mats, names) = tobj::load_mtl_buf(&mut Cursor::new(out.as_bytes())).unwrap();
         assert_eq!(mats.len(), 2);
         assert_eq!(mats[names["a"]].diffuse, Some([0.5; 3]));
@@ -1463,7 +1869,20 @@ Ni 1.5
             .collect();
         let at: Vec<&str> = lines.iter().map(|w| &w[..w.find(':').unwrap()]).collect();
         assert_eq!(at, ["3", "4", "5", "6", "7", "8", "11"], "{warnings:?}");
-        assert!(warnings.iter().any(|w| w.contains("2 texture map")));
+        // The texture statements are taken out for emray's own loader, with their
+        // material.
+        let kinds: Vec<(MapKind, &str, &str)> = maps
+            .iter()
+            .map(|m| (m.kind, m.material.as_str(), m.name.as_str()))
+            .collect();
+        assert_eq!(
+            kinds,
+            [
+                (MapKind::Color, "a", "tex.png"),
+                (MapKind::Bump, "a", "b.png")
+            ]
+        );
+        assert_eq!(maps[1].at, "x.mtl:10");
         assert!(lines[1].starts_with("4:7:"), "{}", lines[1]); // `Ks 1 1`: at its end
         assert!(lines[3].starts_with("6:3:"), "{}", lines[3]);
     }
@@ -1489,7 +1908,13 @@ f -3/-1/-1 -2/1/1 -1//1
         let s = scan(src).unwrap();
         assert_eq!(
             s.faces,
-            [0, FACE_ALL_NORMALS, 0, FACE_IS_LINE, FACE_ALL_NORMALS]
+            [
+                0,
+                FACE_ALL_NORMALS,
+                FACE_ALL_TEXCOORDS,
+                FACE_IS_LINE,
+                FACE_ALL_NORMALS
+            ]
         );
         assert_eq!(s.lines, 1);
         assert_eq!(s.mtllib_lines, [1, 12]);

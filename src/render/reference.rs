@@ -36,6 +36,9 @@ pub fn unsupported(scene: &Scene) -> Option<String> {
     if scene.materials.iter().any(|m| m.t > 0.0 && m.priority != 0) {
         return Some("the reference renderer does not support medium priorities".into());
     }
+    if scene.materials.iter().any(|m| m.maps.any()) || scene.environment.is_some() {
+        return Some("the reference renderer does not support textures or environment maps".into());
+    }
     None
 }
 

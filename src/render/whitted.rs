@@ -193,7 +193,7 @@ impl<'a, A: Accel> Tracer<'a, A> {
         let mut skips = 0;
         loop {
             let Some(hit) = self.accel.intersect(&ray) else {
-                return scene.background;
+                return scene.escape(ray.dir);
             };
             let surf = scene.surface(&hit, &ray);
             let m = &scene.materials[surf.material as usize];
@@ -245,16 +245,14 @@ impl<'a, A: Accel> Tracer<'a, A> {
         counts: &mut RayCounts,
     ) -> Vec3 {
         let scene = self.scene;
-        let m = &scene.materials[surf.material as usize];
+        // Textured inputs and the bumped shading normal (scene/texture.rs).
+        let (m, ns) = scene.shading(surf);
+        let m = &m;
         let p = surf.point.p;
         let ng_out = surf.point.ng;
         // Both sides are surfaces: face the normals towards the incoming ray.
         let ng = if entering { ng_out } else { -ng_out };
-        let ns = if surf.ns.dot(d) > 0.0 {
-            -surf.ns
-        } else {
-            surf.ns
-        };
+        let ns = if ns.dot(d) > 0.0 { -ns } else { ns };
         let spawn =
             |dir: Vec3| -> Ray { Ray::new(offset_ray_origin(p, surf.point.err, ng, dir), dir) };
 

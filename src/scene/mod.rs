@@ -3,10 +3,15 @@
 
 use crate::accel::NO_INSTANCE;
 use crate::geometry::{
-    Cone, Csg, Intersect, Kind, Shape, ShapeHit, Sphere, SurfacePoint, Triangle,
+    Cone, Csg, Intersect, Kind, Param, Shape, ShapeHit, Sphere, SurfacePoint, Triangle,
 };
 use crate::math::{Aabb, Ray, Vec3, Xform};
 use crate::Hit;
+use glam::Vec2;
+
+pub mod texture;
+
+pub use texture::{Environment, Maps, Texture, NO_TEXTURE};
 
 /// The NFF viewpoint (`v`): see DESIGN.md §3 for the exact ray construction.
 #[derive(Clone, Copy, Debug, PartialEq)]
@@ -119,6 +124,8 @@ pub struct Material {
     /// with a nonzero emission are the lights of the radiosity pass and area lights
     /// of the Whitted renderer. Black for everything else.
     pub emission: Vec3,
+    /// Texture, bump and normal maps ([`Maps::NONE`] for a plain material).
+    pub maps: Maps,
 }
 
 impl Material {
@@ -135,6 +142,7 @@ impl Material {
         filter: Vec3::ONE,
         priority: 0,
         emission: Vec3::ZERO,
+        maps: Maps::NONE,
     };
 
     /// Whether the material emits light.
@@ -203,6 +211,11 @@ pub struct Geometry {
     pub triangle_normals: Vec<u32>,
     /// Per-vertex shading normals of smooth triangles.
     pub vertex_normals: Vec<[Vec3; 3]>,
+    /// Per triangle: index into `vertex_uvs`, or `u32::MAX` for none; may be shorter
+    /// than `triangles` (the rest have none).
+    pub triangle_uvs: Vec<u32>,
+    /// Per-vertex texture coordinates of triangles that have them (OBJ `vt`).
+    pub vertex_uvs: Vec<[Vec2; 3]>,
     /// Spheres.
     pub spheres: Prims<Sphere>,
     /// Open cones and cylinders.
@@ -249,6 +262,10 @@ pub struct Scene {
     pub render: RenderHints,
     /// What the loader counted.
     pub load_stats: LoadStats,
+    /// Textures that materials' [`Maps`] index.
+    pub textures: Vec<Texture>,
+    /// Environment map for rays that leave the scene (replaces `background`).
+    pub environment: Option<Environment>,
 }
 
 /// Render settings a scene file may carry; `None` leaves the renderer's default.
@@ -283,6 +300,9 @@ pub struct Surface {
     pub ns: Vec3,
     /// Material index.
     pub material: u32,
+    /// Texture coordinates and tangents (world space), computed only when the
+    /// material has texture maps.
+    pub param: Option<Param>,
 }
 
 /// The NFF convention for lights given without a colour: `√n / (2n)` for `n` lights.
@@ -368,6 +388,34 @@ impl Geometry {
         b
     }
 
+    /// Add texture coordinates to triangle `tri` (an index into `triangles`).
+    pub fn set_triangle_uvs(&mut self, tri: usize, uv: [Vec2; 3]) {
+        if self.triangle_uvs.len() <= tri {
+            self.triangle_uvs.resize(tri + 1, u32::MAX);
+        }
+        self.triangle_uvs[tri] = self.vertex_uvs.len() as u32;
+        self.vertex_uvs.push(uv);
+    }
+
+    /// The texture coordinates and tangents at `surf`, a hit on these primitives (in
+    /// their space).
+    pub fn param(&self, hit: &Hit, surf: &Surface) -> Param {
+        let kind = Kind::from_id(hit.geom_id).unwrap_or(Kind::Triangle);
+        let i = hit.prim_id as usize;
+        match kind {
+            Kind::Triangle => {
+                let uv = match self.triangle_uvs.get(i) {
+                    Some(&k) if k != u32::MAX => Some(&self.vertex_uvs[k as usize]),
+                    _ => None,
+                };
+                self.triangles.items[i].param(hit.u, hit.v, uv)
+            }
+            Kind::Sphere => self.spheres.items[i].param(surf.point.p),
+            Kind::Cone => self.cones.items[i].param(surf.point.p),
+            _ => self.shapes.items[i].param(surf.point.p, surf.point.ng),
+        }
+    }
+
     /// The surface at a hit on these primitives, for `ray` in their space.
     pub fn surface(&self, hit: &Hit, ray: &Ray) -> Surface {
         let kind = Kind::from_id(hit.geom_id).expect("backend reported an unknown geometry");
@@ -386,6 +434,7 @@ impl Geometry {
                 point,
                 ns: point.ng,
                 material,
+                param: None,
             }
         };
         match kind {
@@ -404,6 +453,7 @@ impl Geometry {
                     point,
                     ns,
                     material: self.triangles.material[i],
+                    param: None,
                 }
             }
             Kind::Sphere => analytic(&self.spheres.items[i], self.spheres.material[i]),
@@ -440,6 +490,8 @@ impl Scene {
             instances: Vec::new(),
             render: RenderHints::default(),
             load_stats: LoadStats::default(),
+            textures: Vec::new(),
+            environment: None,
         }
     }
 
@@ -466,21 +518,96 @@ impl Scene {
     /// The surface at a hit reported by a backend for `ray` (world space).
     pub fn surface(&self, hit: &Hit, ray: &Ray) -> Surface {
         if hit.inst_id == NO_INSTANCE {
-            return self.geometry.surface(hit, ray);
+            let mut surf = self.geometry.surface(hit, ray);
+            if self.textured(surf.material) {
+                surf.param = Some(self.geometry.param(hit, &surf));
+            }
+            return surf;
         }
         let inst = &self.instances[hit.inst_id as usize];
         let object = &self.objects[inst.object as usize];
         let local = object.surface(hit, &inst.xform.ray_to_object(ray));
         let point = inst.xform.surface_to_world(&local.point);
         let ns = inst.xform.normal_to_world(local.ns).normalize_or(point.ng);
+        let material = if local.material == INHERIT {
+            inst.material
+        } else {
+            local.material
+        };
+        let param = self.textured(material).then(|| {
+            let p = object.param(hit, &local);
+            let to_world = |v: Vec3| inst.xform.to_world.transform_vector3(v);
+            Param {
+                uv: p.uv,
+                dpdu: to_world(p.dpdu),
+                dpdv: to_world(p.dpdv),
+            }
+        });
         Surface {
             point,
             ns,
-            material: if local.material == INHERIT {
-                inst.material
-            } else {
-                local.material
-            },
+            material,
+            param,
+        }
+    }
+
+    /// Whether material `m` has texture maps.
+    #[inline]
+    fn textured(&self, m: u32) -> bool {
+        self.materials.get(m as usize).is_some_and(|m| m.maps.any())
+    }
+
+    /// The material at `surf` with its textured inputs resolved (colour, highlight
+    /// and mirror weights) and the shading normal after its normal and bump maps
+    /// (not yet faced towards the ray). See [`texture`].
+    #[inline]
+    pub fn shading(&self, surf: &Surface) -> (Material, Vec3) {
+        let mut m = self.materials[surf.material as usize];
+        match surf.param {
+            Some(prm) => {
+                let ns = self.apply_maps(&mut m, &prm, surf);
+                (m, ns)
+            }
+            None => (m, surf.ns),
+        }
+    }
+
+    fn apply_maps(&self, m: &mut Material, prm: &Param, surf: &Surface) -> Vec3 {
+        let maps = m.maps;
+        let p = surf.point.p;
+        let [su, sv] = maps.uv_scale;
+        let prm = &Param {
+            uv: prm.uv * Vec2::new(su, sv),
+            dpdu: prm.dpdu / su,
+            dpdv: prm.dpdv / sv,
+        };
+        let tex = |i: u32| self.textures.get(i as usize);
+        if let Some(t) = tex(maps.color) {
+            m.color *= t.eval(prm.uv, p);
+        }
+        if let Some(t) = tex(maps.specular) {
+            let s = t.eval(prm.uv, p);
+            let s = (s.x + s.y + s.z) / 3.0;
+            m.ks *= s;
+            m.kr *= s;
+        }
+        let mut ns = surf.ns;
+        if let Some(t) = tex(maps.normal) {
+            ns = texture::normal_map(t.eval(prm.uv, p), ns, prm.dpdu, prm.dpdv);
+        }
+        if let Some(t) = tex(maps.bump) {
+            ns = texture::bump_normal(t, maps.bump_scale, prm.uv, p, ns, prm.dpdu, prm.dpdv);
+        }
+        ns
+    }
+
+    /// The radiance of a ray that leaves the scene in direction `dir`: the environment
+    /// map's, or the background colour.
+    #[inline]
+    pub fn escape(&self, dir: Vec3) -> Vec3 {
+        match &self.environment {
+            Some(env) => env.lookup(dir),
+            None => self.background,
         }
     }
 }

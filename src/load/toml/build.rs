@@ -16,7 +16,7 @@
 //!   content in place (following the same rules), which is where cycles are caught.
 
 use super::format::{
-    LightDef, MaterialDef, ObjectDef, Real, Scale, SceneFile, Spanned, TransformList,
+    LightDef, MaterialDef, ObjectDef, Real, Scale, SceneFile, Spanned, TextureDef, TransformList,
     TransformStep, V3,
 };
 use super::{suggest, SceneSettings, Source, MAX_SIDE};
@@ -28,7 +28,11 @@ use crate::geometry::{
 };
 use crate::load::{nff, obj, LoadError};
 use crate::math::{Aabb, Vec3, Xform};
-use crate::scene::{Camera, Geometry, Instance, Light, LoadStats, Material, Scene, Spot, INHERIT};
+use crate::scene::texture::{Image, Wrap};
+use crate::scene::{
+    Camera, Environment, Geometry, Instance, Light, LoadStats, Maps, Material, Scene, Spot,
+    Texture, INHERIT,
+};
 use glam::{Affine3A, DAffine3, DMat3, DMat4, DQuat, DVec3, Quat};
 use std::collections::HashMap;
 use std::ops::Range;
@@ -200,6 +204,10 @@ struct Builder<'a, 's> {
     file: &'a SceneFile,
     src: &'s Source<'s>,
     materials: Vec<Material>,
+    /// Textures the materials' maps index (the scene's and included OBJ files').
+    textures: Vec<Texture>,
+    /// Environment map (`[render] environment`, else an included OBJ's `refl`).
+    environment: Option<Environment>,
     material_names: HashMap<&'a str, u32>,
     default_material: Option<u32>,
     lights: Vec<Light>,
@@ -226,6 +234,8 @@ pub(super) fn build(file: &SceneFile, src: &Source) -> R<(Scene, SceneSettings)>
         file,
         src,
         materials: Vec::new(),
+        textures: Vec::new(),
+        environment: None,
         material_names: HashMap::new(),
         default_material: None,
         lights: Vec::new(),
@@ -248,7 +258,8 @@ pub(super) fn build(file: &SceneFile, src: &Source) -> R<(Scene, SceneSettings)>
     let mut materials: Vec<_> = file.materials.iter().collect();
     materials.sort_by_key(|(_, d)| d.span().start);
     for (name, def) in materials {
-        let m = b.material(def)?;
+        let mut m = b.material(def)?;
+        m.maps = b.maps(def)?;
         b.material_names.insert(name, b.materials.len() as u32);
         b.materials.push(m);
     }
@@ -294,6 +305,8 @@ pub(super) fn build(file: &SceneFile, src: &Source) -> R<(Scene, SceneSettings)>
         instances: b.instances,
         render: settings,
         load_stats: b.stats,
+        textures: b.textures,
+        environment: b.environment,
     };
     Ok((scene, settings))
 }
@@ -664,7 +677,7 @@ impl<'a, 's> Builder<'a, 's> {
         })
     }
 
-    fn render(&self) -> R<(Vec3, Vec3, SceneSettings)> {
+    fn render(&mut self) -> R<(Vec3, Vec3, SceneSettings)> {
         let mut background = Vec3::ZERO;
         let mut ambient = Vec3::splat(DEFAULT_AMBIENT);
         let mut settings = SceneSettings::default();
@@ -672,6 +685,16 @@ impl<'a, 's> Builder<'a, 's> {
             let r = r.get_ref();
             if let Some(b) = &r.background {
                 background = self.non_negative3(b, "`background`")?;
+            }
+            if let Some(e) = &r.environment {
+                let path = self
+                    .src
+                    .path
+                    .parent()
+                    .unwrap_or(Path::new(""))
+                    .join(e.get_ref());
+                self.environment =
+                    Some(Environment::load(&path).map_err(|m| self.err(e.span(), m))?);
             }
             if let Some(a) = &r.ambient {
                 ambient = self.non_negative3(a, "`ambient`")?;
@@ -698,6 +721,96 @@ impl<'a, 's> Builder<'a, 's> {
             }
         }
         Ok((background, ambient, settings))
+    }
+
+    /// The texture maps of a material definition (images read now).
+    fn maps(&mut self, def: &Spanned<MaterialDef>) -> R<Maps> {
+        let d = def.get_ref();
+        let mut maps = Maps::NONE;
+        for (t, slot, srgb) in [
+            (&d.texture, &mut maps.color, true),
+            (&d.specular_map, &mut maps.specular, true),
+            (&d.bump, &mut maps.bump, false),
+            (&d.normal_map, &mut maps.normal, false),
+        ] {
+            if let Some(t) = t {
+                let tex = self.texture(t, srgb)?;
+                self.textures.push(tex);
+                *slot = self.textures.len() as u32 - 1;
+            }
+        }
+        if let Some(s) = &d.bump_scale {
+            maps.bump_scale = s.get_ref().0 as f32;
+        }
+        if let Some(s) = &d.uv_scale {
+            let [a, b] = s.get_ref();
+            if !(a.0 != 0.0 && b.0 != 0.0) {
+                return Err(self.err(s.span(), "`uv_scale` must not be zero"));
+            }
+            maps.uv_scale = [a.0 as f32, b.0 as f32];
+        }
+        Ok(maps)
+    }
+
+    fn texture(&self, def: &Spanned<TextureDef>, srgb: bool) -> R<Texture> {
+        let t = def.get_ref();
+        let colour = |v: &Option<Spanned<V3>>, default: Vec3| -> R<Vec3> {
+            v.as_ref()
+                .map_or(Ok(default), |c| self.non_negative3(c, "a texture colour"))
+        };
+        let ty = t.ty.as_ref().map(|s| (s.get_ref().as_str(), s.span()));
+        match (ty, &t.file) {
+            (None | Some(("image", _)), Some(file)) => {
+                let path = self
+                    .src
+                    .path
+                    .parent()
+                    .unwrap_or(Path::new(""))
+                    .join(file.get_ref());
+                let mut img = Image::load(&path, srgb).map_err(|e| self.err(file.span(), e))?;
+                img.wrap = match t.wrap.as_ref().map(|w| (w.get_ref().as_str(), w.span())) {
+                    None | Some(("repeat", _)) => Wrap::Repeat,
+                    Some(("clamp", _)) => Wrap::Clamp,
+                    Some((w, span)) => {
+                        return Err(self.err(
+                            span,
+                            format!("unknown wrap mode `{w}` (expected `repeat` or `clamp`)"),
+                        ))
+                    }
+                };
+                Ok(Texture::Image(Arc::new(img)))
+            }
+            (Some((kind @ ("checker" | "marble"), _)), None) => {
+                let a = colour(&t.a, Vec3::ONE)?;
+                let b = colour(&t.b, Vec3::ZERO)?;
+                let default = if kind == "checker" { 8.0 } else { 4.0 };
+                let scale = match &t.scale {
+                    Some(s) => self.positive(s, "`scale`")? as f32,
+                    None => default,
+                };
+                Ok(if kind == "checker" {
+                    Texture::Checker { a, b, scale }
+                } else {
+                    Texture::Marble { a, b, scale }
+                })
+            }
+            (None | Some(("image", _)), None) => {
+                Err(self.err(def.span(), "an image texture needs a `file`"))
+            }
+            (Some((other, span)), _) if !matches!(other, "image" | "checker" | "marble") => {
+                Err(self.err(
+                    span,
+                    format!(
+                        "unknown texture type `{other}` (expected `image`, `checker` or `marble`)"
+                    ),
+                ))
+            }
+            (_, Some(file)) => Err(self.err(
+                file.span(),
+                "`file` is for image textures (remove `type` or set it to \"image\")",
+            )),
+            (Some((_, span)), None) => Err(self.err(span, "an image texture needs a `file`")),
+        }
     }
 
     fn material(&self, def: &Spanned<MaterialDef>) -> R<Material> {
@@ -735,6 +848,7 @@ impl<'a, 's> Builder<'a, 's> {
                 Some(e) => self.non_negative3(e, "`emission`")?,
                 None => Vec3::ZERO,
             },
+            ..Material::DEFAULT
         })
     }
 
@@ -1909,9 +2023,23 @@ impl<'a, 's> Builder<'a, 's> {
                     self.src.path.display()
                 );
             }
+            // The model's maps index its own textures: move them past the scene's.
+            let base = self.textures.len() as u32;
+            self.textures.extend(data.textures);
+            if self.environment.is_none() {
+                self.environment = data.environment;
+            }
+            let materials = data
+                .materials
+                .into_iter()
+                .map(|m| Material {
+                    maps: m.maps.offset(base),
+                    ..m
+                })
+                .collect();
             (
                 data.geometry,
-                data.materials,
+                materials,
                 Vec::new(),
                 data.stats,
                 Format::Obj,

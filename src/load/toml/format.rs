@@ -161,6 +161,9 @@ pub struct RenderDef {
     /// Samples per pixel.
     #[serde(default, skip_serializing_if = "Option::is_none")]
     pub spp: Option<Spanned<u32>>,
+    /// Environment map file for rays that leave the scene (relative to the scene file).
+    #[serde(default, skip_serializing_if = "Option::is_none")]
+    pub environment: Option<Spanned<String>>,
 }
 
 /// `[materials.NAME]`: every key optional.
@@ -201,6 +204,51 @@ pub struct MaterialDef {
     /// Emitted radiosity of an area light (default black).
     #[serde(default, skip_serializing_if = "Option::is_none")]
     pub emission: Option<Spanned<V3>>,
+    /// Texture multiplying `color`.
+    #[serde(default, skip_serializing_if = "Option::is_none")]
+    pub texture: Option<Spanned<TextureDef>>,
+    /// Texture multiplying `specular` and `reflectance` by its mean.
+    #[serde(default, skip_serializing_if = "Option::is_none")]
+    pub specular_map: Option<Spanned<TextureDef>>,
+    /// Height field for bump mapping (its mean, times `bump_scale`).
+    #[serde(default, skip_serializing_if = "Option::is_none")]
+    pub bump: Option<Spanned<TextureDef>>,
+    /// Height of a bump value of 1, in scene units (default 1).
+    #[serde(default, skip_serializing_if = "Option::is_none")]
+    pub bump_scale: Option<Spanned<Real>>,
+    /// Tangent-space normal map.
+    #[serde(default, skip_serializing_if = "Option::is_none")]
+    pub normal_map: Option<Spanned<TextureDef>>,
+    /// Texture coordinates are multiplied by `[su, sv]` before every lookup (default
+    /// `[1, 1]`).
+    #[serde(default, skip_serializing_if = "Option::is_none")]
+    pub uv_scale: Option<Spanned<[Real; 2]>>,
+}
+
+/// A texture: `{ file = "x.png" }` (with optional `wrap = "repeat" | "clamp"`),
+/// `{ type = "checker", a = [..], b = [..], scale = 8 }` or
+/// `{ type = "marble", a = [..], b = [..], scale = 4 }`.
+#[derive(Clone, Debug, Default, PartialEq, Serialize, Deserialize)]
+#[serde(deny_unknown_fields)]
+pub struct TextureDef {
+    /// `"image"` (default when `file` is given), `"checker"` or `"marble"`.
+    #[serde(rename = "type", default, skip_serializing_if = "Option::is_none")]
+    pub ty: Option<Spanned<String>>,
+    /// Image file (PNG or JPEG), relative to the scene file.
+    #[serde(default, skip_serializing_if = "Option::is_none")]
+    pub file: Option<Spanned<String>>,
+    /// `"repeat"` (default) or `"clamp"`.
+    #[serde(default, skip_serializing_if = "Option::is_none")]
+    pub wrap: Option<Spanned<String>>,
+    /// First colour of a procedural texture (default white).
+    #[serde(default, skip_serializing_if = "Option::is_none")]
+    pub a: Option<Spanned<V3>>,
+    /// Second colour of a procedural texture (default black).
+    #[serde(default, skip_serializing_if = "Option::is_none")]
+    pub b: Option<Spanned<V3>>,
+    /// Squares per unit (checker) or frequency (marble) (default 8 and 4).
+    #[serde(default, skip_serializing_if = "Option::is_none")]
+    pub scale: Option<Spanned<Real>>,
 }
 
 /// `[[lights]]`.

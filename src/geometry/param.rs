@@ -1,0 +1,431 @@
+//! Surface parameterisations for texturing and bump mapping: the `(u, v)` of a point on
+//! a primitive and the tangents `∂p/∂u`, `∂p/∂v` there.
+//!
+//! They are computed only when a textured material needs them (never in the
+//! intersectors), from the accurate hit point and the unit outward geometric normal.
+//! Every parameterisation is oriented so that `∂p/∂u × ∂p/∂v` points along the outward
+//! normal; that orientation is the tangent frame of normal maps. The world is taken as
+//! y-up where a shape has no axis of its own.
+//!
+//! | shape | (u, v) |
+//! |---|---|
+//! | sphere | `u = φ/2π` with `φ = atan2(x, z)` about the centre (u = 0 towards +z, growing towards +x), `v = 1 − θ/π` (1 at the +y pole, 0 at the −y pole) |
+//! | open and capped cones, cylinders | `u` the angle around the axis / 2π, `v` the height along the axis / its length (0 at the base); caps: the disk mapped onto `[0, 1]²` |
+//! | torus | `u` the angle around the axis / 2π (from [`Torus::frame`]'s first vector), `v` the angle around the tube / 2π (0 on the outer equator) |
+//! | box, oriented box | each face onto `[0, 1]²`, upright (`v` along +y) on the side faces |
+//! | plane, quadric, polyhedron, CSG | planar: world coordinates along two tangents of the normal's frame ([`Frame::from_z`]) |
+//! | triangle | the barycentric interpolation of its vertices' `vt` (without `vt`: the barycentric coordinates `(u, v)` themselves) |
+//!
+//! At the poles of the sphere and the apex of a cone `∂p/∂u` vanishes; there it is
+//! replaced by the tangent of the nearest regular point, so the frame never has a NaN.
+
+use super::{CappedCone, Cone, Shape, Sphere, Torus, Triangle};
+use crate::math::{Frame, Vec3};
+use glam::Vec2;
+use std::f32::consts::{PI, TAU};
+
+/// A point's texture coordinates and surface tangents.
+#[derive(Clone, Copy, Debug, PartialEq)]
+pub struct Param {
+    /// Texture coordinates.
+    pub uv: Vec2,
+    /// `∂p/∂u` (world units per unit of `u`).
+    pub dpdu: Vec3,
+    /// `∂p/∂v`.
+    pub dpdv: Vec3,
+}
+
+impl Param {
+    /// The planar parameterisation about unit normal `n`: `u`, `v` are the coordinates
+    /// of `p` along the first two vectors of [`Frame::from_z`]`(n)`.
+    pub fn planar(p: Vec3, n: Vec3) -> Param {
+        let f = Frame::from_z(n);
+        Param {
+            uv: Vec2::new(p.dot(f.x), p.dot(f.y)),
+            dpdu: f.x,
+            dpdv: f.y,
+        }
+    }
+}
+
+/// Smallest sine of the polar angle used for `∂p/∂u` (poles and apices).
+const MIN_SIN: f32 = 1e-4;
+
+/// `atan2(y, x) / 2π` in `[0, 1)`.
+#[inline]
+fn turn(y: f32, x: f32) -> f32 {
+    let a = y.atan2(x) / TAU;
+    if a < 0.0 {
+        (a + 1.0).min(next_below_one())
+    } else {
+        a
+    }
+}
+
+#[inline]
+fn next_below_one() -> f32 {
+    1.0 - f32::EPSILON / 2.0
+}
+
+/// Two unit vectors completing the unit `axis` to a right-handed frame `(e1, e2, axis)`.
+fn axis_frame(axis: Vec3) -> (Vec3, Vec3) {
+    let f = Frame::from_z(axis);
+    (f.x, f.y)
+}
+
+impl Sphere {
+    /// The spherical parameterisation at `p` (see the module documentation).
+    pub fn param(&self, p: Vec3) -> Param {
+        let q = ((p - self.center) / self.radius).clamp(Vec3::splat(-1.0), Vec3::splat(1.0));
+        let phi = q.x.atan2(q.z);
+        let u = turn(q.x, q.z);
+        let theta = q.y.clamp(-1.0, 1.0).acos();
+        let (sin_t, cos_t) = theta.sin_cos();
+        let (sin_p, cos_p) = phi.sin_cos();
+        let r = self.radius;
+        let dpdu = Vec3::new(cos_p, 0.0, -sin_p) * (TAU * r * sin_t.max(MIN_SIN));
+        // v = 1 − θ/π, so ∂p/∂v = −π ∂p/∂θ.
+        let dpdv = Vec3::new(cos_t * sin_p, -sin_t, cos_t * cos_p) * (-PI * r);
+        Param {
+            uv: Vec2::new(u, 1.0 - theta / PI),
+            dpdu,
+            dpdv,
+        }
+    }
+}
+
+/// The cylindrical parameterisation about the axis through `base` with unit `axis`,
+/// length `height` and radius growing by `slope` per unit of height.
+fn cylindrical(p: Vec3, base: Vec3, axis: Vec3, height: f32, slope: f32) -> Param {
+    let (e1, e2) = axis_frame(axis);
+    let q = p - base;
+    let h = q.dot(axis);
+    let (x, y) = (q.dot(e1), q.dot(e2));
+    let rho = x.hypot(y);
+    let phi = y.atan2(x);
+    let (s, c) = phi.sin_cos();
+    let radial = e1 * c + e2 * s;
+    let tangent = e2 * c - e1 * s;
+    Param {
+        uv: Vec2::new(turn(y, x), h / height),
+        dpdu: tangent * (TAU * rho.max(MIN_SIN * height)),
+        dpdv: (axis + radial * slope) * height,
+    }
+}
+
+impl Cone {
+    /// The cylindrical parameterisation at `p`.
+    pub fn param(&self, p: Vec3) -> Param {
+        let slope = (self.apex_radius - self.base_radius) / self.height();
+        cylindrical(p, self.base, self.axis(), self.height(), slope)
+    }
+}
+
+impl CappedCone {
+    /// The cylindrical parameterisation on the side, a disk onto `[0, 1]²` on the caps
+    /// (`ng` the unit outward normal tells them apart).
+    pub fn param(&self, p: Vec3, ng: Vec3) -> Param {
+        let axis = self.axis();
+        let h = (p - self.base()).dot(axis);
+        let on_cap = ng.dot(axis).abs() > 0.999
+            && (h.abs() < 1e-3 * self.height() || (h - self.height()).abs() < 1e-3 * self.height());
+        if !on_cap {
+            let slope = (self.top_radius() - self.base_radius()) / self.height();
+            return cylindrical(p, self.base(), axis, self.height(), slope);
+        }
+        let (e1, e2) = axis_frame(axis);
+        let top = h > 0.5 * self.height();
+        let (centre, r) = if top {
+            (self.top(), self.top_radius())
+        } else {
+            (self.base(), self.base_radius())
+        };
+        let r = r.max(f32::MIN_POSITIVE);
+        let q = p - centre;
+        // The base cap faces −axis: mirror u there so that ∂p/∂u × ∂p/∂v = −axis.
+        let su = if top { 1.0 } else { -1.0 };
+        Param {
+            uv: Vec2::new(
+                0.5 + su * q.dot(e1) / (2.0 * r),
+                0.5 + q.dot(e2) / (2.0 * r),
+            ),
+            dpdu: e1 * (su * 2.0 * r),
+            dpdv: e2 * (2.0 * r),
+        }
+    }
+}
+
+impl Torus {
+    /// The toroidal parameterisation at `p`.
+    pub fn param(&self, p: Vec3) -> Param {
+        let (ex, ey, a) = self.frame();
+        let (big, small) = (self.major_radius(), self.minor_radius());
+        let q = p - self.center();
+        let (x, y, z) = (q.dot(ex), q.dot(ey), q.dot(a));
+        let rho = x.hypot(y);
+        let phi = y.atan2(x);
+        let psi = z.atan2(rho - big);
+        let (sp, cp) = phi.sin_cos();
+        let (ss, cs) = psi.sin_cos();
+        let radial = ex * cp + ey * sp;
+        let tangent = ey * cp - ex * sp;
+        Param {
+            uv: Vec2::new(turn(y, x), turn(z, rho - big)),
+            dpdu: tangent * (TAU * (big + small * cs).max(MIN_SIN * small)),
+            dpdv: (a * cs - radial * ss) * (TAU * small),
+        }
+    }
+}
+
+/// The face parameterisation of a box with centre `c`, half extents `half` along the
+/// unit axes `axes`, at `p` with unit outward normal `ng`.
+fn box_param(p: Vec3, ng: Vec3, c: Vec3, half: Vec3, axes: [Vec3; 3]) -> Param {
+    let q = p - c;
+    let local = Vec3::new(q.dot(axes[0]), q.dot(axes[1]), q.dot(axes[2]));
+    let nl = Vec3::new(ng.dot(axes[0]), ng.dot(axes[1]), ng.dot(axes[2]));
+    let k = nl.abs().max_position();
+    let s = if nl[k] < 0.0 { -1.0 } else { 1.0 };
+    // (u axis, u sign, v axis, v sign) on the +k face; the −k face mirrors u.
+    let (ua, us, va, vs) = match k {
+        0 => (2, -1.0, 1, 1.0),
+        1 => (0, 1.0, 2, -1.0),
+        _ => (0, 1.0, 1, 1.0),
+    };
+    let us = us * s;
+    let (wu, wv) = (2.0 * half[ua], 2.0 * half[va]);
+    Param {
+        uv: Vec2::new(0.5 + us * local[ua] / wu, 0.5 + vs * local[va] / wv),
+        dpdu: axes[ua] * (us * wu),
+        dpdv: axes[va] * (vs * wv),
+    }
+}
+
+impl Shape {
+    /// The texture coordinates and tangents at `p`, a point on the shape with unit
+    /// outward geometric normal `ng` (see the module documentation).
+    pub fn param(&self, p: Vec3, ng: Vec3) -> Param {
+        match self {
+            Shape::Sphere(s) => s.param(p),
+            Shape::Cone(c) => c.param(p),
+            Shape::CappedCone(c) => c.param(p, ng),
+            Shape::Torus(t) => t.param(p),
+            Shape::Box(b) => {
+                let (min, max) = (b.min(), b.max());
+                box_param(
+                    p,
+                    ng,
+                    (min + max) * 0.5,
+                    (max - min) * 0.5,
+                    [Vec3::X, Vec3::Y, Vec3::Z],
+                )
+            }
+            Shape::OBox(b) => box_param(p, ng, b.center(), b.half_extents(), b.axes()),
+            Shape::Plane(_) | Shape::Quadric(_) | Shape::Polyhedron(_) | Shape::Csg(_) => {
+                Param::planar(p, ng)
+            }
+        }
+    }
+}
+
+impl Triangle {
+    /// The parameterisation of the point with barycentric weights `(1 − b1 − b2, b1,
+    /// b2)` given the vertices' texture coordinates `uv` (`None`: `(0,0)`, `(1,0)`,
+    /// `(0,1)`). The tangents solve `p_i − p_0 = Δu_i ∂p/∂u + Δv_i ∂p/∂v`; when the
+    /// texture coordinates are degenerate, the frame of the geometric normal is used.
+    pub fn param(&self, b1: f32, b2: f32, uv: Option<&[Vec2; 3]>) -> Param {
+        const UNIT: [Vec2; 3] = [Vec2::ZERO, Vec2::X, Vec2::Y];
+        let t = uv.unwrap_or(&UNIT);
+        let w = 1.0 - b1 - b2;
+        let uv_hit = t[0] * w + t[1] * b1 + t[2] * b2;
+        let [p0, p1, p2] = self.p;
+        let (d1, d2) = (t[1] - t[0], t[2] - t[0]);
+        let (e1, e2) = (p1 - p0, p2 - p0);
+        let det = d1.x * d2.y - d1.y * d2.x;
+        let ng = e1.cross(e2);
+        if det.abs() > 1e-20 * (d1.length_squared() * d2.length_squared()).sqrt() && det != 0.0 {
+            let inv = 1.0 / det;
+            let dpdu = (e1 * d2.y - e2 * d1.y) * inv;
+            let dpdv = (e2 * d1.x - e1 * d2.x) * inv;
+            if dpdu.is_finite() && dpdv.is_finite() && dpdu.cross(dpdv) != Vec3::ZERO {
+                return Param {
+                    uv: uv_hit,
+                    dpdu,
+                    dpdv,
+                };
+            }
+        }
+        let n = ng.normalize_or(Vec3::Z);
+        let f = Frame::from_z(n);
+        Param {
+            uv: uv_hit,
+            dpdu: f.x,
+            dpdv: f.y,
+        }
+    }
+}
+
+/// The inverse of the bilinear map of the quadrilateral `q` (corners at `(0,0)`,
+/// `(1,0)`, `(1,1)`, `(0,1)` in that order): the `(s, t)` with
+/// `p = (1−s)(1−t) q0 + s(1−t) q1 + s t q2 + (1−s) t q3`, for `p` in (or near) the
+/// quad's plane. `None` when no solution lies in the quad (within a small tolerance) or
+/// the quad is degenerate.
+///
+/// The quad is projected onto the coordinate plane most nearly its own; `t` is a root
+/// of `k2 t² + k1 t + k0 = 0` taken in the cancellation-free form
+/// (`q = −(k1 + sign(k1)√D)/2`, roots `q/k2` and `k0/q`), and `s` comes from whichever
+/// coordinate divides best.
+pub fn inverse_bilinear(p: Vec3, q: [Vec3; 4]) -> Option<Vec2> {
+    let n = (q[2] - q[0]).cross(q[3] - q[1]);
+    let k = n.abs().max_position();
+    let (i, j) = ((k + 1) % 3, (k + 2) % 3);
+    let flat = |v: Vec3| glam::DVec2::new(f64::from(v[i]), f64::from(v[j]));
+    let (a, b, c, d, x) = (flat(q[0]), flat(q[1]), flat(q[2]), flat(q[3]), flat(p));
+    let cross = |u: glam::DVec2, v: glam::DVec2| u.x * v.y - u.y * v.x;
+    let e = b - a;
+    let f = d - a;
+    let g = a - b + c - d;
+    let h = x - a;
+    let k2 = cross(g, f);
+    let k1 = cross(e, f) + cross(h, g);
+    let k0 = cross(h, e);
+    let scale = e.length_squared().max(f.length_squared());
+    if scale == 0.0 || !scale.is_finite() {
+        return None;
+    }
+    const TOL: f64 = 1e-6;
+    let inside = |t: f64| (-TOL..=1.0 + TOL).contains(&t);
+    let mut roots = [f64::NAN; 2];
+    if k2.abs() <= 1e-12 * scale {
+        // A parallelogram along t: linear.
+        if k1 != 0.0 {
+            roots[0] = -k0 / k1;
+        }
+    } else {
+        let disc = k1 * k1 - 4.0 * k0 * k2;
+        if disc < 0.0 {
+            return None;
+        }
+        let qq = -0.5 * (k1 + disc.sqrt().copysign(k1));
+        roots[0] = qq / k2;
+        if qq != 0.0 {
+            roots[1] = k0 / qq;
+        }
+    }
+    for t in roots {
+        if !t.is_finite() || !inside(t) {
+            continue;
+        }
+        let den = e + g * t;
+        let num = h - f * t;
+        let s = if den.x.abs() >= den.y.abs() {
+            num.x / den.x
+        } else {
+            num.y / den.y
+        };
+        if s.is_finite() && inside(s) {
+            return Some(Vec2::new(s as f32, t as f32));
+        }
+    }
+    None
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+
+    fn assert_frame_outward(param: &Param, n: Vec3) {
+        let c = param.dpdu.cross(param.dpdv);
+        assert!(c.is_finite() && c.dot(n) > 0.0, "{param:?} n={n}");
+    }
+
+    #[test]
+    fn sphere_uv_and_orientation() {
+        let s = Sphere::new(Vec3::new(1.0, 2.0, 3.0), 2.0);
+        let at = |d: Vec3| s.param(s.center + d * 2.0);
+        let z = at(Vec3::Z);
+        assert!((z.uv - Vec2::new(0.0, 0.5)).length() < 1e-6);
+        let x = at(Vec3::X);
+        assert!((x.uv - Vec2::new(0.25, 0.5)).length() < 1e-6);
+        assert!((at(Vec3::Y).uv.y - 1.0).abs() < 1e-6);
+        assert!(at(-Vec3::Y).uv.y.abs() < 1e-6);
+        for d in [
+            Vec3::X,
+            Vec3::Z,
+            -Vec3::X,
+            Vec3::new(0.3, 0.8, -0.5).normalize(),
+        ] {
+            assert_frame_outward(&at(d), d);
+        }
+        // The poles: finite, non-degenerate frames.
+        for d in [Vec3::Y, -Vec3::Y] {
+            assert_frame_outward(&at(d), d);
+        }
+        // ∂p/∂u is the derivative: a small step in u moves by it.
+        let d = Vec3::new(0.3, 0.4, 0.5).normalize();
+        let p = at(d);
+        let phi = d.x.atan2(d.z) + 1e-3 * TAU;
+        let th = d.y.acos();
+        let d2 = Vec3::new(th.sin() * phi.sin(), th.cos(), th.sin() * phi.cos());
+        let fd = (d2 - d) * 2.0 / 1e-3;
+        assert!((fd - p.dpdu).length() < 1e-2 * p.dpdu.length());
+    }
+
+    #[test]
+    fn torus_cylinder_and_box_frames_point_outwards() {
+        let t = Torus::new(Vec3::ZERO, Vec3::Y, 2.0, 0.5).unwrap();
+        let (ex, _, a) = t.frame();
+        let outer = ex * 2.5;
+        let p = t.param(outer);
+        assert!(p.uv.length() < 1e-6);
+        assert_frame_outward(&p, ex);
+        let top = ex * 2.0 + a * 0.5;
+        let p = t.param(top);
+        assert!((p.uv.y - 0.25).abs() < 1e-6);
+        assert_frame_outward(&p, a);
+
+        let c = Cone::new(Vec3::ZERO, 1.0, Vec3::new(0.0, 0.0, 4.0), 1.0);
+        let p = c.param(Vec3::new(1.0, 0.0, 2.0));
+        assert!((p.uv.y - 0.5).abs() < 1e-6);
+        assert_frame_outward(&p, Vec3::X);
+
+        let b = Shape::Box(crate::geometry::AaBox::new(Vec3::ZERO, Vec3::ONE).unwrap());
+        for n in [Vec3::X, -Vec3::X, Vec3::Y, -Vec3::Y, Vec3::Z, -Vec3::Z] {
+            let p = Vec3::splat(0.5) + n * 0.5 + Vec3::new(0.1, 0.2, 0.15) * (Vec3::ONE - n.abs());
+            let prm = b.param(p, n);
+            assert_frame_outward(&prm, n);
+            assert!(prm.uv.min_element() >= 0.0 && prm.uv.max_element() <= 1.0);
+        }
+    }
+
+    #[test]
+    fn triangle_tangents_reproduce_the_edges() {
+        let tri = Triangle {
+            p: [
+                Vec3::ZERO,
+                Vec3::new(2.0, 0.0, 0.0),
+                Vec3::new(0.0, 3.0, 0.0),
+            ],
+        };
+        let uv = [
+            Vec2::new(0.5, 0.5),
+            Vec2::new(1.0, 0.5),
+            Vec2::new(0.5, 1.0),
+        ];
+        let p = tri.param(0.25, 0.5, Some(&uv));
+        assert!((p.uv - Vec2::new(0.625, 0.75)).length() < 1e-6);
+        assert!((p.dpdu - Vec3::new(4.0, 0.0, 0.0)).length() < 1e-5);
+        assert!((p.dpdv - Vec3::new(0.0, 6.0, 0.0)).length() < 1e-5);
+        // Degenerate texture coordinates: a finite frame all the same.
+        let flat = [Vec2::ZERO; 3];
+        let p = tri.param(0.2, 0.2, Some(&flat));
+        assert_frame_outward(&p, Vec3::Z);
+    }
+
+    #[test]
+    fn inverse_bilinear_of_a_square_and_misses() {
+        let q = [Vec3::ZERO, Vec3::X, Vec3::new(1.0, 1.0, 0.0), Vec3::Y];
+        let st = inverse_bilinear(Vec3::new(0.25, 0.75, 0.0), q).unwrap();
+        assert!((st - Vec2::new(0.25, 0.75)).length() < 1e-6);
+        assert!(inverse_bilinear(Vec3::new(2.0, 0.5, 0.0), q).is_none());
+    }
+}
