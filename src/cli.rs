@@ -37,6 +37,78 @@ pub enum Command {
     /// Error against time: the f64 reference once, then a sweep of spp, adaptive AA,
     /// bailout, depth and backends, to DIR/study.csv and DIR/study.svg.
     Study(crate::quality_cmd::StudyArgs),
+    /// Solve a scene's diffuse interreflection by radiosity and render a view of it.
+    Radiosity(RadiosityArgs),
+}
+
+/// Radiosity solvers as named on the command line.
+#[derive(Clone, Copy, Debug, ValueEnum, PartialEq, Eq)]
+pub enum SolverArg {
+    /// Progressive refinement (shoot the most unshot energy first).
+    Progressive,
+    /// Gauss–Seidel on the full form-factor matrix (small meshes only).
+    GaussSeidel,
+}
+
+/// `emray radiosity`.
+#[derive(Args, Debug, Clone)]
+pub struct RadiosityArgs {
+    /// Scene file (surfaces whose material has an `emission` are the lights).
+    #[arg(value_name = "SCENE")]
+    pub scene: PathBuf,
+    /// Output image (.png or .exr).
+    #[arg(short, long, value_name = "OUT", default_value = "radiosity.png")]
+    pub output: PathBuf,
+    /// Also write the solved mesh with vertex colours as PLY.
+    #[arg(long, value_name = "FILE.ply")]
+    pub ply: Option<PathBuf>,
+    /// Longest element edge, in scene units [default: 1/12 of the scene's diagonal].
+    #[arg(long, value_name = "SIZE")]
+    pub patch_size: Option<f32>,
+    /// Form-factor sample points per shooting element: 1, 4, 16 or 64.
+    #[arg(long, default_value_t = 4, value_parser = parse_power_of_four)]
+    pub ff_samples: u32,
+    /// Visibility rays per pair of elements: 1, 4, 16 or 64.
+    #[arg(long, default_value_t = 1, value_parser = parse_power_of_four)]
+    pub vis_samples: u32,
+    /// Solver.
+    #[arg(long, value_enum, default_value_t = SolverArg::Progressive)]
+    pub solver: SolverArg,
+    /// Stop when the unshot power is below this fraction of the emitted power.
+    #[arg(long, default_value_t = 1e-3)]
+    pub epsilon: f64,
+    /// Most shots (progressive) or sweeps (Gauss–Seidel).
+    #[arg(long, default_value_t = 1_000_000)]
+    pub max_iterations: usize,
+    /// Ray-query backend for visibility and viewing.
+    #[arg(long, value_enum)]
+    pub backend: Option<BackendArg>,
+    /// Image size, overriding the scene's resolution.
+    #[arg(long, value_name = "WxH", value_parser = parse_res)]
+    pub res: Option<(u32, u32)>,
+    /// Samples per pixel of the view, rounded down to a square (1, 4, 9, ...).
+    #[arg(long, default_value_t = 4, value_parser = clap::value_parser!(u32).range(1..=4096))]
+    pub spp: u32,
+    /// Worker threads (default: all cores).
+    #[arg(short, long, value_name = "N", value_parser = clap::value_parser!(u32).range(1..=4096))]
+    pub threads: Option<u32>,
+    /// Print mesh size, iterations, residuals and timings.
+    #[arg(long)]
+    pub stats: bool,
+    /// Append the statistics (with the residual curve) as one JSON object to FILE.
+    #[arg(long, value_name = "FILE")]
+    pub stats_json: Option<PathBuf>,
+}
+
+/// The level `l` of a count `4^l` in 1..=64.
+fn parse_power_of_four(s: &str) -> Result<u32, String> {
+    match s.trim() {
+        "1" => Ok(0),
+        "4" => Ok(1),
+        "16" => Ok(2),
+        "64" => Ok(3),
+        _ => Err(format!("'{s}' is not one of 1, 4, 16, 64")),
+    }
 }
 
 /// `emray bench`.
@@ -325,6 +397,25 @@ pub struct RenderArgs {
     /// More log output (repeat for more).
     #[arg(short, long, action = clap::ArgAction::Count)]
     pub verbose: u8,
+    /// Global illumination: `radiosity` solves the diffuse interreflection first and
+    /// takes the diffuse term of polygons and meshes from it (two-pass).
+    #[arg(long, value_enum)]
+    pub gi: Option<GiArg>,
+    /// Radiosity patch size for `--gi radiosity` [default: 1/12 of the scene's
+    /// diagonal].
+    #[arg(long, value_name = "SIZE")]
+    pub patch_size: Option<f32>,
+    /// Shadow rays per emitting triangle (area light), a square number: 16 = 4×4
+    /// strata.
+    #[arg(long, default_value_t = 16, value_parser = clap::value_parser!(u32).range(1..=4096))]
+    pub area_samples: u32,
+}
+
+/// Global-illumination methods.
+#[derive(Clone, Copy, Debug, ValueEnum, PartialEq, Eq)]
+pub enum GiArg {
+    /// Two-pass: radiosity for the diffuse term, Whitted for the specular paths.
+    Radiosity,
 }
 
 impl RenderArgs {
@@ -355,6 +446,9 @@ impl RenderArgs {
             envmap: None,
             quiet: false,
             verbose: 0,
+            gi: None,
+            patch_size: None,
+            area_samples: 16,
         }
     }
 }

@@ -16,6 +16,7 @@ pub mod load;
 pub mod math;
 pub mod metrics;
 pub mod output;
+pub mod radiosity;
 pub mod render;
 pub mod run;
 pub mod scene;

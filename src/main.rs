@@ -29,6 +29,7 @@ fn main() -> ExitCode {
         Some(Command::Bench(b)) => return bench(&b),
         Some(Command::Compare(c)) => return quality_cmd::compare(&c),
         Some(Command::Stress(s)) => return quality_cmd::stress(&s),
+        Some(Command::Radiosity(r)) => return radiosity(&r),
         Some(Command::Study(s)) => return quality_cmd::study(&s),
         None => RenderArgs::default_scene(),
     };
@@ -270,6 +271,68 @@ fn bench(b: &cli::BenchArgs) -> ExitCode {
     }
 }
 
+/// `emray radiosity`: exit 1 on any input, solve or output error.
+fn radiosity(a: &cli::RadiosityArgs) -> ExitCode {
+    env_logger::Builder::from_env(env_logger::Env::default().default_filter_or("warn"))
+        .format_timestamp(None)
+        .init();
+    match radiosity_run(a) {
+        Ok(()) => ExitCode::SUCCESS,
+        Err(e) => {
+            eprintln!("emray: error: {e:#}");
+            ExitCode::from(1)
+        }
+    }
+}
+
+fn radiosity_run(a: &cli::RadiosityArgs) -> Result<()> {
+    use emray::radiosity::{RadiositySettings, SolverKind};
+    emray::output::Format::from_path(&a.output)?;
+    let mut builder = rayon::ThreadPoolBuilder::new();
+    if let Some(t) = a.threads {
+        builder = builder.num_threads(t as usize);
+    }
+    let pool = builder.build().context("cannot start the worker threads")?;
+    let scene = load::load_path(&a.scene)?;
+    let settings = RadiositySettings {
+        patch_size: a.patch_size,
+        shooter_level: a.ff_samples,
+        visibility_level: a.vis_samples,
+        epsilon: a.epsilon,
+        max_iterations: a.max_iterations,
+        solver: match a.solver {
+            cli::SolverArg::Progressive => SolverKind::Progressive,
+            cli::SolverArg::GaussSeidel => SolverKind::GaussSeidel,
+        },
+    };
+    let (w, h) = a.res.unwrap_or((scene.camera.width, scene.camera.height));
+    let spp = (a.spp as f32).sqrt().floor().max(1.0) as u32;
+    let backend: Backend = a
+        .backend
+        .map(Backend::from)
+        .unwrap_or_else(Backend::default_available);
+    let (sol, film, report) = pool
+        .install(|| emray::radiosity::run(&scene, backend, &settings, (w, h, spp)))
+        .with_context(|| a.scene.display().to_string())?;
+    emray::output::write_image(&a.output, &film, emray::output::Encoding::Srgb)?;
+    if let Some(p) = &a.ply {
+        emray::output::write_text(p, &sol.to_ply(1.0))?;
+    }
+    if a.stats {
+        println!("scene      {}\n{}", a.scene.display(), report.summary());
+    }
+    if let Some(path) = &a.stats_json {
+        let line = serde_json::to_string(&report).expect("report serialises");
+        let mut f = std::fs::OpenOptions::new()
+            .create(true)
+            .append(true)
+            .open(path)
+            .with_context(|| format!("{}: cannot open for writing", path.display()))?;
+        writeln!(f, "{line}").with_context(|| format!("{}: cannot write", path.display()))?;
+    }
+    Ok(())
+}
+
 /// Where scene `scene` goes.
 fn output_for(args: &RenderArgs, scene: &Path) -> PathBuf {
     let stem = emray::batch::scene_stem(scene);
@@ -320,6 +383,10 @@ fn plan(args: &RenderArgs) -> Result<Vec<Job>, String> {
     if args.tile.is_some() || args.crop.is_some() {
         if args.reference {
             return Err("--reference renders whole images: not with --tile or --crop".into());
+        }
+        if args.gi.is_some() {
+            // Each part would solve the radiosity on its own; the hash does not cover it.
+            return Err("--gi renders whole images: not with --tile or --crop".into());
         }
         if jobs.len() != 1 {
             return Err("--tile and --crop render one scene".into());
@@ -460,10 +527,25 @@ fn render_one(args: &RenderArgs, scene_path: Option<&Path>, out: &Path) -> Resul
             b.set_position(done as u64);
         }
     };
+    settings.area_samples = (args.area_samples as f32).sqrt().floor().max(1.0) as u32;
     let (film, report) = if args.reference {
         let strata = (args.spp.unwrap_or(256) as f64).sqrt().floor() as u32;
         emray::run::render_reference(&name, &scene, &settings, strata, load_ms)
             .map_err(|why| anyhow::anyhow!("{name}: {why}"))?
+    } else if let Some(cli::GiArg::Radiosity) = args.gi {
+        let rad = emray::radiosity::RadiositySettings {
+            patch_size: args.patch_size,
+            ..Default::default()
+        };
+        emray::run::render_two_pass(
+            &name,
+            &scene,
+            backend,
+            &settings,
+            &rad,
+            load_ms,
+            Some(&progress),
+        )?
     } else {
         emray::run::render_scene(&name, &scene, backend, &settings, load_ms, Some(&progress))?
     };

@@ -3,6 +3,7 @@
 
 use crate::accel::{Accel, AccelError, AccelStats, Backend};
 use crate::geometry::Kind;
+use crate::radiosity::{RadiosityError, RadiositySettings};
 use crate::render::{self, Film, Progress, RenderSettings, RenderStats};
 use crate::scene::Scene;
 use serde::Serialize;
@@ -277,6 +278,70 @@ pub fn render_scene(
             progress,
         },
     )
+}
+
+#[allow(clippy::too_many_arguments)]
+fn two_pass<A: Accel>(
+    name: &str,
+    scene: &Scene,
+    accel: &A,
+    settings: &RenderSettings,
+    rad: &RadiositySettings,
+    load_ms: f64,
+    build_ms: f64,
+    progress: Option<Progress<'_>>,
+) -> Result<(Film, Report), RadiosityError> {
+    let sol = crate::radiosity::solve(scene, accel, rad)?;
+    log::info!(
+        "radiosity: {} elements, {} shots, residual {:.2e}, form factors {:.0} ms, solve {:.0} ms",
+        sol.mesh.elements.len(),
+        sol.solve.iterations,
+        sol.solve.residuals.last().copied().unwrap_or(0.0),
+        sol.solve.form_factor_ms,
+        sol.solve.total_ms
+    );
+    let (film, stats) = render::render_with_gi(scene, accel, settings, Some(&sol), progress);
+    let t = Timings {
+        load: load_ms,
+        // The view-independent solve is preprocessing, like the build.
+        build: build_ms + sol.solve.total_ms,
+        render: stats.render_ms,
+    };
+    let report = Report::new(name, scene, settings, &accel.stats(), t, &stats);
+    Ok((film, report))
+}
+
+/// Two-pass rendering: build `backend` over `scene`, solve its radiosity with the
+/// backend's visibility, then render with the diffuse term of meshed surfaces from
+/// the solution and the specular paths from the Whitted recursion. The solve counts
+/// as build (preprocessing) time.
+pub fn render_two_pass(
+    name: &str,
+    scene: &Scene,
+    backend: Backend,
+    settings: &RenderSettings,
+    rad: &RadiositySettings,
+    load_ms: f64,
+    progress: Option<Progress<'_>>,
+) -> Result<(Film, Report), RadiosityError> {
+    let t0 = Instant::now();
+    let ms = |t: Instant| t.elapsed().as_secs_f64() * 1e3;
+    match backend {
+        Backend::Bvh => {
+            let accel = crate::accel::bvh::Bvh::build(scene);
+            let b = ms(t0);
+            two_pass(name, scene, &accel, settings, rad, load_ms, b, progress)
+        }
+        #[cfg(feature = "embree")]
+        Backend::Embree => {
+            let accel =
+                crate::accel::embree::EmbreeAccel::build(scene).map_err(AccelError::from)?;
+            let b = ms(t0);
+            two_pass(name, scene, &accel, settings, rad, load_ms, b, progress)
+        }
+        #[cfg(not(feature = "embree"))]
+        Backend::Embree => Err(AccelError::Unavailable("embree").into()),
+    }
 }
 
 /// Render `scene` with the f64 reference renderer ([`render::reference`]) using

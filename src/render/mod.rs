@@ -32,6 +32,8 @@ pub struct RenderSettings {
     pub spd: bool,
     /// Tile edge in pixels.
     pub tile: u32,
+    /// Shadow rays per emitting triangle (area light): `area_samples²`, stratified.
+    pub area_samples: u32,
     /// Embree build quality (the BVH backend ignores it).
     pub embree_quality: crate::accel::EmbreeQuality,
     /// Antialiasing: uniform `spp` samples per pixel, or adaptive subdivision.
@@ -137,6 +139,7 @@ impl RenderSettings {
             max_depth: 5,
             spd: false,
             tile: 16,
+            area_samples: 4,
             embree_quality: crate::accel::EmbreeQuality::Medium,
             aa: Aa::Uniform,
             bailout: 0.0,
@@ -175,9 +178,21 @@ pub fn render<A: Accel>(
     settings: &RenderSettings,
     progress: Option<Progress<'_>>,
 ) -> (Film, RenderStats) {
+    render_with_gi(scene, accel, settings, None, progress)
+}
+
+/// [`render`], two-pass when `gi` is given: the diffuse term of the meshed surfaces
+/// comes from the radiosity solution, the Whitted recursion adds the specular paths.
+pub fn render_with_gi<A: Accel>(
+    scene: &Scene,
+    accel: &A,
+    settings: &RenderSettings,
+    gi: Option<&crate::radiosity::Solution>,
+    progress: Option<Progress<'_>>,
+) -> (Film, RenderStats) {
     let start = std::time::Instant::now();
     let (w, h) = (settings.width, settings.height);
-    let tracer = whitted::Tracer::new(scene, accel, settings);
+    let tracer = whitted::Tracer::new(scene, accel, settings).with_gi(gi);
     // Only the samples of the region: every pixel and sample keeps its coordinates in
     // the whole image, so a part holds exactly the full render's pixels.
     let r = settings.region.unwrap_or(Region::full(w, h));

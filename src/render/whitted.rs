@@ -3,6 +3,7 @@
 use super::{RayGen, RenderSettings};
 use crate::accel::Accel;
 use crate::math::{next_float_down, offset_ray_origin, Ray, Vec3};
+use crate::radiosity::{area, Solution};
 use crate::scene::{Scene, Surface};
 
 /// Rays cast, by type.
@@ -56,6 +57,12 @@ pub(super) struct Tracer<'a, A: Accel> {
     accel: &'a A,
     max_depth: u32,
     spp: u32,
+    /// Emitting triangles, sampled as area lights.
+    area_lights: Vec<area::AreaLight>,
+    /// Shadow rays per area light: `area_samples²`.
+    area_samples: u32,
+    /// Two-pass mode: the diffuse term of meshed surfaces from this solution.
+    gi: Option<&'a Solution>,
     /// Hall & Greenberg's adaptive tree depth: no secondary ray whose weight (largest
     /// channel) is below this; 0 = off.
     bailout: f32,
@@ -110,6 +117,9 @@ impl<'a, A: Accel> Tracer<'a, A> {
             accel,
             max_depth: s.max_depth.max(1),
             spp: s.spp.max(1),
+            area_lights: area::collect(scene),
+            area_samples: s.area_samples,
+            gi: None,
             bailout: if s.bailout.is_finite() {
                 s.bailout.max(0.0)
             } else {
@@ -117,6 +127,12 @@ impl<'a, A: Accel> Tracer<'a, A> {
             },
             skip: s.skip,
         }
+    }
+
+    /// Take the diffuse term of meshed surfaces from a radiosity solution (two-pass).
+    pub(super) fn with_gi(mut self, gi: Option<&'a Solution>) -> Self {
+        self.gi = gi;
+        self
     }
 
     /// The value of sample-grid position `(i, j)`: its centre with one sample, else the
@@ -207,11 +223,15 @@ impl<'a, A: Accel> Tracer<'a, A> {
             if depth == 1 {
                 counts.eye_hit += 1;
             }
-            return self.shade(&surf, d, entering, depth, media, weight, counts);
+            let gi = self.gi.and_then(|g| g.radiosity_at(&hit, d));
+            return self.shade(&surf, d, entering, depth, media, weight, gi, counts);
         }
     }
 
-    /// Whitted shading of a true surface hit seen along unit direction `d`.
+    /// Whitted shading of a true surface hit seen along unit direction `d`; `gi` is the
+    /// radiosity there in two-pass mode, which replaces the ambient, emitted and
+    /// area-light terms (the radiosity pass knows only emitters: point lights still
+    /// add their direct diffuse and highlights, reflection and refraction stay).
     #[allow(clippy::too_many_arguments)]
     fn shade(
         &self,
@@ -221,6 +241,7 @@ impl<'a, A: Accel> Tracer<'a, A> {
         depth: u32,
         media: Media,
         weight: Vec3,
+        gi: Option<Vec3>,
         counts: &mut RayCounts,
     ) -> Vec3 {
         let scene = self.scene;
@@ -235,7 +256,10 @@ impl<'a, A: Accel> Tracer<'a, A> {
         let spawn =
             |dir: Vec3| -> Ray { Ray::new(offset_ray_origin(p, surf.point.err, ng, dir), dir) };
 
-        let mut color = scene.ambient * m.color * m.ka;
+        let mut color = match gi {
+            Some(b) => b,
+            None => self.local_diffuse(surf, m, ng, ns, entering, counts),
+        };
         let view = -d;
         for light in &scene.lights {
             let to_light = light.pos - p;
@@ -312,6 +336,38 @@ impl<'a, A: Accel> Tracer<'a, A> {
             counts.reflection += 1;
             let ray = spawn(reflect(d, ns));
             color += reflect_weight * self.trace(&ray, depth + 1, media, w, counts);
+        }
+        color
+    }
+}
+
+impl<A: Accel> Tracer<'_, A> {
+    /// Ambient, emission (front side) and the area lights' diffuse light.
+    fn local_diffuse(
+        &self,
+        surf: &Surface,
+        m: &crate::scene::Material,
+        ng: Vec3,
+        ns: Vec3,
+        entering: bool,
+        counts: &mut RayCounts,
+    ) -> Vec3 {
+        let mut color = self.scene.ambient * m.color * m.ka;
+        if entering && m.is_emitter() {
+            color += m.emission;
+        }
+        if !self.area_lights.is_empty() && m.kd > 0.0 {
+            let (e, rays) = area::direct(
+                self.accel,
+                &self.area_lights,
+                surf.point.p,
+                surf.point.err,
+                ng,
+                ns,
+                self.area_samples,
+            );
+            counts.shadow += rays;
+            color += m.color * m.kd * e;
         }
         color
     }

@@ -120,6 +120,10 @@ pub struct Material {
     /// overlap, the one with the highest priority is the medium, and the surfaces of
     /// the others inside it are skipped. Equal priorities: every surface counts.
     pub priority: u32,
+    /// Emitted radiosity (power per unit area, per channel) of an area light: surfaces
+    /// with a nonzero emission are the lights of the radiosity pass and area lights
+    /// of the Whitted renderer. Black for everything else.
+    pub emission: Vec3,
     /// Texture, bump and normal maps ([`Maps::NONE`] for a plain material).
     pub maps: Maps,
 }
@@ -137,8 +141,14 @@ impl Material {
         ior: 1.0,
         filter: Vec3::ONE,
         priority: 0,
+        emission: Vec3::ZERO,
         maps: Maps::NONE,
     };
+
+    /// Whether the material emits light.
+    pub fn is_emitter(&self) -> bool {
+        self.emission.max_element() > 0.0
+    }
 }
 
 impl Default for Material {

@@ -844,6 +844,10 @@ impl<'a, 's> Builder<'a, 's> {
                 None => Vec3::ONE,
             },
             priority: d.priority.as_ref().map_or(0, |p| *p.get_ref()),
+            emission: match &d.emission {
+                Some(e) => self.non_negative3(e, "`emission`")?,
+                None => Vec3::ZERO,
+            },
             ..Material::DEFAULT
         })
     }

@@ -201,6 +201,9 @@ pub struct MaterialDef {
     /// Nested-dielectric priority (default 0).
     #[serde(default, skip_serializing_if = "Option::is_none")]
     pub priority: Option<Spanned<u32>>,
+    /// Emitted radiosity of an area light (default black).
+    #[serde(default, skip_serializing_if = "Option::is_none")]
+    pub emission: Option<Spanned<V3>>,
     /// Texture multiplying `color`.
     #[serde(default, skip_serializing_if = "Option::is_none")]
     pub texture: Option<Spanned<TextureDef>>,

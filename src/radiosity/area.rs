@@ -1,0 +1,139 @@
+//! Area lights for the Whitted renderer: every triangle whose material has an
+//! `emission` is a Lambertian emitter (radiance `emission / π` from its front side),
+//! sampled with stratified shadow rays for soft shadows.
+//!
+//! The direct term at a point is `(emission/π) Σ_s V cosθ cosθ' A / (N r²)`: the
+//! irradiance from the light divided by π, so that a diffuse surface of reflectance
+//! `ρ` shows `ρ ×` it, the same units as the radiosity solution's `B`.
+
+use crate::accel::Accel;
+use crate::math::{gamma, next_float_down, offset_ray_origin, Ray, Vec3};
+use crate::scene::{Scene, INHERIT};
+use std::f32::consts::FRAC_1_PI;
+
+/// One emitting triangle in world space.
+#[derive(Clone, Copy, Debug, PartialEq)]
+pub struct AreaLight {
+    /// Corners (counterclockwise seen from the emitting front).
+    pub p: [Vec3; 3],
+    /// Unit normal of the front.
+    pub n: Vec3,
+    /// Area.
+    pub area: f32,
+    /// Emitted radiosity.
+    pub emission: Vec3,
+    /// Error bound of points on the triangle.
+    pub err: Vec3,
+}
+
+/// Every emitting triangle of `scene` (top level and instanced).
+pub fn collect(scene: &Scene) -> Vec<AreaLight> {
+    let mut out = Vec::new();
+    let mut push = |p: [Vec3; 3], err: Vec3, material: u32| {
+        let e = scene.materials[material as usize].emission;
+        if e.max_element() <= 0.0 {
+            return;
+        }
+        let c = (p[1] - p[0]).cross(p[2] - p[0]);
+        let len = c.length();
+        if !(len > 0.0 && len.is_finite()) {
+            return;
+        }
+        let m = p[0].abs().max(p[1].abs()).max(p[2].abs()).max_element();
+        out.push(AreaLight {
+            p,
+            n: c / len,
+            area: 0.5 * len,
+            emission: e,
+            err: err + Vec3::splat(m * gamma(12)),
+        });
+    };
+    for (k, t) in scene.triangles.items.iter().enumerate() {
+        push(t.p, Vec3::ZERO, scene.triangles.material[k]);
+    }
+    for inst in &scene.instances {
+        let object = &scene.objects[inst.object as usize];
+        for (k, t) in object.triangles.items.iter().enumerate() {
+            let mut material = object.triangles.material[k];
+            if material == INHERIT {
+                material = inst.material;
+            }
+            let mut err = Vec3::ZERO;
+            let p = t.p.map(|q| {
+                let (w, e) = inst.xform.point_to_world(q, Vec3::ZERO);
+                err = err.max(e);
+                w
+            });
+            push(p, err, material);
+        }
+    }
+    out
+}
+
+#[inline]
+fn hash(mut x: u32) -> u32 {
+    x ^= x >> 16;
+    x = x.wrapping_mul(0x7feb_352d);
+    x ^= x >> 15;
+    x = x.wrapping_mul(0x846c_a68b);
+    x ^= x >> 16;
+    x
+}
+
+#[inline]
+fn unit(x: u32) -> f32 {
+    (x >> 8) as f32 * (1.0 / (1u32 << 24) as f32)
+}
+
+/// `(irradiance / π)` from `lights` at point `p` (error bound `err`, unit geometric
+/// normal `ng` and shading normal `ns` both facing the viewer), with `n × n`
+/// stratified shadow rays per light, jittered per point (deterministic: the jitter is
+/// a hash of the point's coordinates). Returns the term and the shadow rays cast.
+pub fn direct<A: Accel>(
+    accel: &A,
+    lights: &[AreaLight],
+    p: Vec3,
+    err: Vec3,
+    ng: Vec3,
+    ns: Vec3,
+    n: u32,
+) -> (Vec3, u64) {
+    let n = n.max(1);
+    let seed = hash(p.x.to_bits() ^ hash(p.y.to_bits() ^ hash(p.z.to_bits())));
+    let mut sum = Vec3::ZERO;
+    let mut rays = 0;
+    for (li, l) in lights.iter().enumerate() {
+        // The light wholly behind the surface, or facing away from the point.
+        if l.p.iter().all(|&q| ns.dot(q - p) <= 0.0) || l.n.dot(p - l.p[0]) <= 0.0 {
+            continue;
+        }
+        let mut acc = 0.0;
+        for s in 0..n * n {
+            let h = hash(seed ^ hash(li as u32) ^ s.wrapping_mul(0x9e37_79b9));
+            let a = ((s % n) as f32 + unit(h)) / n as f32;
+            let b = ((s / n) as f32 + unit(hash(h))) / n as f32;
+            // Square to triangle, area-preserving (Shirley): √a, b.
+            let r = a.sqrt();
+            let (u, v) = (r * (1.0 - b), r * b);
+            let q = l.p[0] * (1.0 - u - v) + l.p[1] * u + l.p[2] * v;
+            let d = q - p;
+            let dist2 = d.length_squared();
+            let cos_s = ns.dot(d);
+            let cos_l = -l.n.dot(d);
+            if cos_s <= 0.0 || cos_l <= 0.0 || dist2 <= 0.0 {
+                continue;
+            }
+            rays += 1;
+            let org = offset_ray_origin(p, err, ng, d);
+            let target = offset_ray_origin(q, l.err, l.n, -d);
+            let mut ray = Ray::new(org, target - org);
+            ray.tmax = next_float_down(1.0);
+            if accel.occluded(&ray) {
+                continue;
+            }
+            acc += cos_s * cos_l / (dist2 * dist2);
+        }
+        sum += l.emission * (FRAC_1_PI * acc * l.area / (n * n) as f32);
+    }
+    (sum, rays)
+}

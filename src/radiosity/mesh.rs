@@ -1,0 +1,313 @@
+//! Meshing for the radiosity pass: every triangle of the scene (top level and
+//! instanced) is split by repeated midpoint subdivision (each triangle into four
+//! similar ones) until its longest edge is at most the patch size. The elements of one
+//! source triangle are stored in subdivision order, so a hit's barycentric coordinates
+//! on the source triangle find its element directly.
+
+use super::RadiosityError;
+use crate::accel::NO_INSTANCE;
+use crate::math::{gamma, Vec3};
+use crate::scene::{Geometry, Material, Scene, INHERIT};
+use std::collections::HashMap;
+
+/// Deepest subdivision of one source triangle (4^12 elements).
+pub const MAX_LEVEL: u32 = 12;
+/// Most elements a mesh may have.
+pub const MAX_ELEMENTS: usize = 1 << 22;
+
+/// One element (patch) of the radiosity mesh.
+#[derive(Clone, Copy, Debug, PartialEq)]
+pub struct Element {
+    /// Corners in world space, counterclockwise seen from the front.
+    pub p: [Vec3; 3],
+    /// Per-axis bound on the error of the corners and of points interpolated on them.
+    pub err: Vec3,
+    /// Unit normal of the front side (the side that emits and receives light).
+    pub n: Vec3,
+    /// Area.
+    pub area: f32,
+    /// Material index.
+    pub material: u32,
+    /// Indices into [`Mesh::vertices`] of the corners.
+    pub verts: [u32; 3],
+}
+
+impl Element {
+    /// The point with barycentric coordinates `(u, v)` (weights of corners 1 and 2).
+    #[inline]
+    pub fn point(&self, u: f32, v: f32) -> Vec3 {
+        self.p[0] * (1.0 - u - v) + self.p[1] * u + self.p[2] * v
+    }
+
+    /// The centroid.
+    pub fn centroid(&self) -> Vec3 {
+        (self.p[0] + self.p[1] + self.p[2]) / 3.0
+    }
+}
+
+/// Where the elements of one source triangle are.
+#[derive(Clone, Copy, Debug, PartialEq, Eq)]
+struct Source {
+    first: u32,
+    level: u32,
+}
+
+/// The radiosity mesh.
+#[derive(Clone, Debug, Default)]
+pub struct Mesh {
+    /// The elements.
+    pub elements: Vec<Element>,
+    /// Shared corners: elements meet at a vertex when their corners coincide, they lie
+    /// on the same plane and share the material (so a box's edge keeps its crease).
+    pub vertices: Vec<Vec3>,
+    /// Reflectance `color × kd` per material, each channel at most 0.999.
+    pub reflectance: Vec<Vec3>,
+    /// Emission per material.
+    pub emission: Vec<Vec3>,
+    /// Analytic primitives that are not meshed (they still occlude).
+    pub unmeshed: usize,
+    sources: HashMap<(u32, u32), Source>,
+}
+
+/// Corner order of the four children of a triangle `(a, b, c)` whose edge midpoints
+/// are `ab`, `bc`, `ca`: corner a, corner b, corner c, middle.
+fn children(t: [Vec3; 3]) -> [[Vec3; 3]; 4] {
+    let [a, b, c] = t;
+    let ab = (a + b) * 0.5;
+    let bc = (b + c) * 0.5;
+    let ca = (c + a) * 0.5;
+    [[a, ab, ca], [ab, b, bc], [ca, bc, c], [bc, ca, ab]]
+}
+
+/// The child `(u, v)` falls in and its coordinates there (the inverse of [`children`]).
+#[inline]
+pub(crate) fn descend(u: f32, v: f32) -> (usize, f32, f32) {
+    let w = 1.0 - u - v;
+    if w >= 0.5 {
+        (0, 2.0 * u, 2.0 * v)
+    } else if u >= 0.5 {
+        (1, 1.0 - 2.0 * w - 2.0 * v, 2.0 * v)
+    } else if v >= 0.5 {
+        (2, 2.0 * u, 1.0 - 2.0 * w - 2.0 * u)
+    } else {
+        (3, 1.0 - 2.0 * u, 1.0 - 2.0 * v)
+    }
+}
+
+/// Barycentric coordinates `(u, v)` of the centroids of the `4^level` sub-triangles
+/// of one triangle, in subdivision order: a stratified quadrature rule with equal
+/// weights.
+pub fn centroid_pattern(level: u32) -> Vec<(f32, f32)> {
+    let unit = [Vec3::ZERO, Vec3::X, Vec3::Y];
+    let mut tris = vec![unit];
+    for _ in 0..level {
+        tris = tris.iter().flat_map(|t| children(*t)).collect();
+    }
+    tris.iter()
+        .map(|t| {
+            let c = (t[0] + t[1] + t[2]) / 3.0;
+            (c.x, c.y)
+        })
+        .collect()
+}
+
+#[derive(Clone, Copy, PartialEq, Eq, Hash)]
+struct VertexKey {
+    pos: [u32; 3],
+    normal: [i32; 3],
+    material: u32,
+}
+
+impl Mesh {
+    /// Mesh the triangles of `scene` into elements of edge at most `patch_size`.
+    ///
+    /// # Errors
+    /// A patch size that is not a positive finite number, or a mesh that would exceed
+    /// [`MAX_ELEMENTS`].
+    pub fn build(scene: &Scene, patch_size: f32) -> Result<Mesh, RadiosityError> {
+        if !(patch_size.is_finite() && patch_size > 0.0) {
+            return Err(RadiosityError::Settings(format!(
+                "patch size {patch_size} is not a positive number"
+            )));
+        }
+        let mut mesh = Mesh {
+            reflectance: scene
+                .materials
+                .iter()
+                .map(|m| (m.color * m.kd).min(Vec3::splat(0.999)))
+                .collect(),
+            emission: scene
+                .materials
+                .iter()
+                .map(|m: &Material| m.emission)
+                .collect(),
+            ..Default::default()
+        };
+        let mut welder: HashMap<VertexKey, u32> = HashMap::new();
+        let top = |g: &Geometry| g.count_unmeshed();
+        mesh.unmeshed = top(&scene.geometry);
+        for (k, tri) in scene.triangles.items.iter().enumerate() {
+            let material = scene.triangles.material[k];
+            mesh.add_source(
+                (NO_INSTANCE, k as u32),
+                tri.p,
+                Vec3::ZERO,
+                material,
+                patch_size,
+                &mut welder,
+            )?;
+        }
+        for (ii, inst) in scene.instances.iter().enumerate() {
+            let object = &scene.objects[inst.object as usize];
+            mesh.unmeshed += top(object);
+            for (k, tri) in object.triangles.items.iter().enumerate() {
+                let mut material = object.triangles.material[k];
+                if material == INHERIT {
+                    material = inst.material;
+                }
+                let mut err = Vec3::ZERO;
+                let p = tri.p.map(|p| {
+                    let (q, e) = inst.xform.point_to_world(p, Vec3::ZERO);
+                    err = err.max(e);
+                    q
+                });
+                mesh.add_source(
+                    (ii as u32, k as u32),
+                    p,
+                    err,
+                    material,
+                    patch_size,
+                    &mut welder,
+                )?;
+            }
+        }
+        Ok(mesh)
+    }
+
+    fn add_source(
+        &mut self,
+        key: (u32, u32),
+        p: [Vec3; 3],
+        err: Vec3,
+        material: u32,
+        patch_size: f32,
+        welder: &mut HashMap<VertexKey, u32>,
+    ) -> Result<(), RadiosityError> {
+        let n = (p[1] - p[0]).cross(p[2] - p[0]);
+        let len = n.length();
+        if !(len > 0.0 && len.is_finite()) {
+            return Ok(());
+        }
+        let n = n / len;
+        let longest = (p[1] - p[0])
+            .length()
+            .max((p[2] - p[1]).length())
+            .max((p[0] - p[2]).length());
+        let mut level = 0;
+        while level < MAX_LEVEL && longest / (1u32 << level) as f32 > patch_size {
+            level += 1;
+        }
+        if self.elements.len() + (1usize << (2 * level)) > MAX_ELEMENTS {
+            return Err(RadiosityError::Settings(format!(
+                "patch size {patch_size} gives more than {MAX_ELEMENTS} elements; use a larger --patch-size"
+            )));
+        }
+        let magnitude = p[0].abs().max(p[1].abs()).max(p[2].abs()).max_element();
+        let err = err + Vec3::splat(magnitude * gamma(12));
+        self.sources.insert(
+            key,
+            Source {
+                first: self.elements.len() as u32,
+                level,
+            },
+        );
+        let mut tris = vec![p];
+        for _ in 0..level {
+            tris = tris.iter().flat_map(|t| children(*t)).collect();
+        }
+        let normal = (n * 1024.0).round().as_ivec3().to_array();
+        for t in tris {
+            let verts = t.map(|q| {
+                let k = VertexKey {
+                    pos: q.to_array().map(f32::to_bits),
+                    normal,
+                    material,
+                };
+                let next = self.vertices.len() as u32;
+                *welder.entry(k).or_insert_with(|| {
+                    self.vertices.push(q);
+                    next
+                })
+            });
+            self.elements.push(Element {
+                p: t,
+                err,
+                n,
+                area: 0.5 * (t[1] - t[0]).cross(t[2] - t[0]).length(),
+                material,
+                verts,
+            });
+        }
+        Ok(())
+    }
+
+    /// The element at barycentric `(u, v)` of triangle `prim` of instance `inst`
+    /// ([`NO_INSTANCE`] for the top level), with the point's coordinates in it.
+    pub fn locate(&self, inst: u32, prim: u32, u: f32, v: f32) -> Option<(usize, f32, f32)> {
+        let s = self.sources.get(&(inst, prim))?;
+        let (mut u, mut v) = (u.clamp(0.0, 1.0), v.clamp(0.0, 1.0));
+        let mut index = 0usize;
+        for _ in 0..s.level {
+            let (c, cu, cv) = descend(u, v);
+            index = index * 4 + c;
+            (u, v) = (cu, cv);
+        }
+        Some((s.first as usize + index, u, v))
+    }
+
+    /// Total area.
+    pub fn area(&self) -> f64 {
+        self.elements.iter().map(|e| e.area as f64).sum()
+    }
+}
+
+impl Geometry {
+    /// Analytic primitives, which the radiosity mesh leaves out.
+    fn count_unmeshed(&self) -> usize {
+        self.spheres.len() + self.cones.len() + self.shapes.len()
+    }
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+
+    #[test]
+    fn descend_inverts_children() {
+        let t = [Vec3::ZERO, Vec3::X, Vec3::Y];
+        for &(u, v) in &[
+            (0.1f32, 0.2f32),
+            (0.7, 0.1),
+            (0.1, 0.8),
+            (0.3, 0.3),
+            (0.45, 0.4),
+        ] {
+            let (c, cu, cv) = descend(u, v);
+            let child = children(t)[c];
+            let q = child[0] * (1.0 - cu - cv) + child[1] * cu + child[2] * cv;
+            assert!((q - Vec3::new(u, v, 0.0)).length() < 1e-6, "{u} {v} -> {c}");
+            assert!(cu >= -1e-6 && cv >= -1e-6 && cu + cv <= 1.0 + 1e-6);
+        }
+    }
+
+    #[test]
+    fn centroid_pattern_is_the_mean_centroid() {
+        for level in 0..3 {
+            let p = centroid_pattern(level);
+            assert_eq!(p.len(), 1 << (2 * level));
+            let (su, sv) = p.iter().fold((0.0, 0.0), |a, b| (a.0 + b.0, a.1 + b.1));
+            assert!((su / p.len() as f32 - 1.0 / 3.0).abs() < 1e-6);
+            assert!((sv / p.len() as f32 - 1.0 / 3.0).abs() < 1e-6);
+        }
+    }
+}

@@ -1,0 +1,408 @@
+//! Radiosity: diffuse interreflection between the scene's surfaces, view-independent.
+//!
+//! The phases: [`mesh`] splits every triangle into elements of at most the patch size;
+//! [`formfactor`] estimates form factors by ray casting (exact point-to-polygon form
+//! factors with visibility from `Accel::occluded`, either backend); [`solver`] solves
+//! the system by progressive refinement (or Gauss–Seidel on the full matrix); a
+//! [`Solution`] then holds per-vertex radiosities (area-weighted averages of the
+//! adjacent elements) that any camera can look at through ray casting, Gouraud
+//! interpolated, and that export as a PLY mesh with vertex colours.
+//!
+//! Units: an element's radiosity `B` (power per unit area) is what the image shows;
+//! the emitters are the surfaces whose material has an `emission`.
+//! Elements are one-sided: they emit and receive on the side their triangle's winding
+//! makes the front (counterclockwise seen from the front); the back side shows black.
+
+pub mod area;
+pub mod formfactor;
+pub mod mesh;
+pub mod solver;
+
+use crate::accel::{Accel, AccelError, Backend, Hit};
+use crate::geometry::Kind;
+use crate::math::Vec3;
+use crate::render::{Film, RayGen};
+use crate::scene::Scene;
+use formfactor::Sampling;
+use mesh::Mesh;
+use rayon::prelude::*;
+use serde::Serialize;
+use solver::Solve;
+use std::time::Instant;
+
+/// Errors of the radiosity pass.
+#[derive(Debug, thiserror::Error)]
+pub enum RadiosityError {
+    /// Bad settings (patch size, mesh too large, ...).
+    #[error("{0}")]
+    Settings(String),
+    /// Nothing emits light.
+    #[error("no surface emits light: give a material an `emission` (radiosity needs area lights)")]
+    NoEmitters,
+    /// The scene has no triangles to mesh.
+    #[error("the scene has no polygons or meshes to compute radiosity on")]
+    Empty,
+    /// The backend failed.
+    #[error(transparent)]
+    Accel(#[from] AccelError),
+}
+
+/// Which solver.
+#[derive(Clone, Copy, Debug, PartialEq, Eq, Serialize)]
+pub enum SolverKind {
+    /// Progressive refinement (shooting).
+    Progressive,
+    /// Gauss–Seidel on the full matrix (small meshes only).
+    GaussSeidel,
+}
+
+/// How to solve.
+#[derive(Clone, Debug, PartialEq)]
+pub struct RadiositySettings {
+    /// Longest element edge; `None`: 1/12 of the diagonal of the meshed triangles'
+    /// bounds.
+    pub patch_size: Option<f32>,
+    /// Shooter sample points per element: `4^shooter_level`.
+    pub shooter_level: u32,
+    /// Visibility rays per pair of elements: `4^visibility_level`.
+    pub visibility_level: u32,
+    /// Stop when the unshot power falls below this fraction of the emitted power
+    /// (progressive), or when no radiosity changes by more than this fraction of the
+    /// largest emission (Gauss–Seidel).
+    pub epsilon: f64,
+    /// Most shots (progressive) or sweeps (Gauss–Seidel).
+    pub max_iterations: usize,
+    /// Solver.
+    pub solver: SolverKind,
+}
+
+impl Default for RadiositySettings {
+    fn default() -> Self {
+        RadiositySettings {
+            patch_size: None,
+            shooter_level: 1,
+            visibility_level: 0,
+            epsilon: 1e-3,
+            max_iterations: 1_000_000,
+            solver: SolverKind::Progressive,
+        }
+    }
+}
+
+/// A solved scene: the mesh, element and vertex radiosities.
+#[derive(Clone, Debug)]
+pub struct Solution {
+    /// The mesh.
+    pub mesh: Mesh,
+    /// The solver's output.
+    pub solve: Solve,
+    /// Cohen's ambient term: the unshot energy spread uniformly, for display before
+    /// convergence (zero once everything is shot).
+    pub ambient: Vec3,
+    /// Displayed radiosity per element (`B + ρ·ambient`).
+    pub element_radiosity: Vec<Vec3>,
+    /// Displayed radiosity per vertex: area-weighted mean of the adjacent elements.
+    pub vertex_radiosity: Vec<Vec3>,
+}
+
+impl Solution {
+    /// Display values from a solve.
+    pub fn new(mesh: Mesh, solve: Solve) -> Self {
+        let total_area = mesh.area().max(f64::MIN_POSITIVE);
+        let mut rho_avg = Vec3::ZERO;
+        let mut unshot = Vec3::ZERO;
+        for (k, e) in mesh.elements.iter().enumerate() {
+            rho_avg += mesh.reflectance[e.material as usize] * e.area;
+            unshot += solve.unshot[k] * e.area;
+        }
+        let rho_avg = rho_avg / total_area as f32;
+        let ambient = unshot / total_area as f32 / (Vec3::ONE - rho_avg);
+        let element_radiosity: Vec<Vec3> = mesh
+            .elements
+            .iter()
+            .zip(&solve.radiosity)
+            .map(|(e, &b)| b + mesh.reflectance[e.material as usize] * ambient)
+            .collect();
+        let mut sum = vec![Vec3::ZERO; mesh.vertices.len()];
+        let mut weight = vec![0.0f32; mesh.vertices.len()];
+        for (e, &b) in mesh.elements.iter().zip(&element_radiosity) {
+            for &v in &e.verts {
+                sum[v as usize] += b * e.area;
+                weight[v as usize] += e.area;
+            }
+        }
+        let vertex_radiosity = sum
+            .iter()
+            .zip(&weight)
+            .map(|(&s, &w)| if w > 0.0 { s / w } else { Vec3::ZERO })
+            .collect();
+        Solution {
+            mesh,
+            solve,
+            ambient,
+            element_radiosity,
+            vertex_radiosity,
+        }
+    }
+
+    /// The Gouraud-interpolated radiosity at a hit on a meshed triangle seen along
+    /// `dir` (zero on its back side); `None` for primitives that are not meshed.
+    pub fn radiosity_at(&self, hit: &Hit, dir: Vec3) -> Option<Vec3> {
+        if hit.kind() != Kind::Triangle {
+            return None;
+        }
+        let (k, u, v) = self.mesh.locate(hit.inst_id, hit.prim_id, hit.u, hit.v)?;
+        let e = &self.mesh.elements[k];
+        if e.n.dot(dir) >= 0.0 {
+            return Some(Vec3::ZERO);
+        }
+        let c = e.verts.map(|i| self.vertex_radiosity[i as usize]);
+        Some(c[0] * (1.0 - u - v) + c[1] * u + c[2] * v)
+    }
+
+    /// The solved mesh as ASCII PLY with sRGB-encoded 8-bit vertex colours (values
+    /// scaled by `exposure`), one vertex per element corner so that creases stay sharp.
+    pub fn to_ply(&self, exposure: f32) -> String {
+        use std::fmt::Write;
+        let m = &self.mesh;
+        let mut s = String::new();
+        let _ = write!(
+            s,
+            "ply\nformat ascii 1.0\ncomment emray radiosity solution\nelement vertex {}\n\
+             property float x\nproperty float y\nproperty float z\n\
+             property uchar red\nproperty uchar green\nproperty uchar blue\n\
+             element face {}\nproperty list uchar int vertex_indices\nend_header\n",
+            m.vertices.len(),
+            m.elements.len()
+        );
+        let byte = |x: f32| (crate::output::srgb_encode(x * exposure) * 255.0).round() as u8;
+        for (p, c) in m.vertices.iter().zip(&self.vertex_radiosity) {
+            let _ = writeln!(
+                s,
+                "{} {} {} {} {} {}",
+                p.x,
+                p.y,
+                p.z,
+                byte(c.x),
+                byte(c.y),
+                byte(c.z)
+            );
+        }
+        for e in &m.elements {
+            let _ = writeln!(s, "3 {} {} {}", e.verts[0], e.verts[1], e.verts[2]);
+        }
+        s
+    }
+}
+
+/// Mesh `scene` and solve its radiosity with visibility from `accel`.
+pub fn solve<A: Accel>(
+    scene: &Scene,
+    accel: &A,
+    settings: &RadiositySettings,
+) -> Result<Solution, RadiosityError> {
+    let patch = match settings.patch_size {
+        Some(p) => p,
+        None => default_patch_size(scene),
+    };
+    let mesh = Mesh::build(scene, patch)?;
+    if mesh.elements.is_empty() {
+        return Err(RadiosityError::Empty);
+    }
+    let s = Sampling::new(settings.shooter_level, settings.visibility_level);
+    let solve = match settings.solver {
+        SolverKind::Progressive => {
+            solver::progressive(&mesh, accel, &s, settings.epsilon, settings.max_iterations)?
+        }
+        SolverKind::GaussSeidel => {
+            solver::gauss_seidel(&mesh, accel, &s, settings.epsilon, settings.max_iterations)?
+        }
+    };
+    Ok(Solution::new(mesh, solve))
+}
+
+/// 1/12 of the diagonal of the bounds of the scene's top-level and instanced
+/// triangles.
+pub fn default_patch_size(scene: &Scene) -> f32 {
+    let mut b = crate::math::Aabb::EMPTY;
+    for t in &scene.triangles.items {
+        b = b.union(&t.bounds());
+    }
+    for inst in &scene.instances {
+        for t in &scene.objects[inst.object as usize].triangles.items {
+            b = b.union(&inst.xform.bounds_to_world(&t.bounds()));
+        }
+    }
+    let d = b.extent().length();
+    if d.is_finite() && d > 0.0 {
+        d / 12.0
+    } else {
+        1.0
+    }
+}
+
+/// Look at a solution from the scene's camera (`width × height`, `spp²` stratified
+/// samples per pixel): Gouraud radiosity on meshed triangles, the material colour
+/// times the scene's ambient on other primitives, the background on misses.
+pub fn render_view<A: Accel>(
+    scene: &Scene,
+    accel: &A,
+    sol: &Solution,
+    width: u32,
+    height: u32,
+    spp: u32,
+) -> Film {
+    let gen = RayGen::new(&scene.camera, width, height);
+    let n = spp.max(1);
+    let rows: Vec<Vec<Vec3>> = (0..height)
+        .into_par_iter()
+        .map(|j| {
+            (0..width)
+                .map(|i| {
+                    let mut sum = Vec3::ZERO;
+                    for sy in 0..n {
+                        for sx in 0..n {
+                            let ray = gen.ray(
+                                i as f32 + (sx as f32 + 0.5) / n as f32,
+                                j as f32 + (sy as f32 + 0.5) / n as f32,
+                            );
+                            sum += match accel.intersect(&ray) {
+                                None => scene.background,
+                                Some(hit) => sol.radiosity_at(&hit, ray.dir).unwrap_or_else(|| {
+                                    let surf = scene.surface(&hit, &ray);
+                                    scene.materials[surf.material as usize].color * scene.ambient
+                                }),
+                            };
+                        }
+                    }
+                    sum / (n * n) as f32
+                })
+                .collect()
+        })
+        .collect();
+    let mut film = Film::new(width, height);
+    for (j, row) in rows.into_iter().enumerate() {
+        for (i, v) in row.into_iter().enumerate() {
+            film.set(i as u32, j as u32, v);
+        }
+    }
+    film
+}
+
+/// What a radiosity run reports (`--stats`, `--stats-json`).
+#[derive(Clone, Debug, PartialEq, Serialize)]
+pub struct RadiosityReport {
+    /// Backend name.
+    pub backend: &'static str,
+    /// Solver.
+    pub solver: SolverKind,
+    /// Patch size used.
+    pub patch_size: f32,
+    /// Elements.
+    pub elements: usize,
+    /// Shared vertices.
+    pub vertices: usize,
+    /// Analytic primitives left out of the mesh.
+    pub unmeshed: usize,
+    /// Shooter samples per element.
+    pub shooter_samples: usize,
+    /// Visibility rays per pair of elements.
+    pub visibility_samples: usize,
+    /// Shots or sweeps.
+    pub iterations: usize,
+    /// Residual curve.
+    pub residuals: Vec<f64>,
+    /// Milliseconds: building the backend, form factors, whole solve, one view.
+    pub build_ms: f64,
+    /// Form-factor time.
+    pub form_factor_ms: f64,
+    /// Solve time (form factors included).
+    pub solve_ms: f64,
+    /// Time to render one view of the solved scene.
+    pub view_ms: f64,
+}
+
+impl RadiosityReport {
+    /// Human-readable summary.
+    pub fn summary(&self) -> String {
+        let last = self.residuals.last().copied().unwrap_or(0.0);
+        format!(
+            "backend    {}\nmesh       {} elements, {} vertices (patch size {}), {} analytic primitives not meshed\n\
+             samples    {} per shooter, {} visibility rays per element pair\n\
+             solver     {:?}: {} iterations, final residual {:.3e}\n\
+             time       build {:.1} ms, form factors {:.1} ms, solve {:.1} ms, view {:.1} ms",
+            self.backend,
+            self.elements,
+            self.vertices,
+            self.patch_size,
+            self.unmeshed,
+            self.shooter_samples,
+            self.visibility_samples,
+            self.solver,
+            self.iterations,
+            last,
+            self.build_ms,
+            self.form_factor_ms,
+            self.solve_ms,
+            self.view_ms,
+        )
+    }
+}
+
+fn solve_and_view<A: Accel>(
+    scene: &Scene,
+    accel: &A,
+    settings: &RadiositySettings,
+    view: (u32, u32, u32),
+    build_ms: f64,
+) -> Result<(Solution, Film, RadiosityReport), RadiosityError> {
+    let sol = solve(scene, accel, settings)?;
+    let t = Instant::now();
+    let film = render_view(scene, accel, &sol, view.0, view.1, view.2);
+    let view_ms = t.elapsed().as_secs_f64() * 1e3;
+    let report = RadiosityReport {
+        backend: accel.stats().backend,
+        solver: settings.solver,
+        patch_size: settings
+            .patch_size
+            .unwrap_or_else(|| default_patch_size(scene)),
+        elements: sol.mesh.elements.len(),
+        vertices: sol.mesh.vertices.len(),
+        unmeshed: sol.mesh.unmeshed,
+        shooter_samples: 1 << (2 * settings.shooter_level),
+        visibility_samples: 1 << (2 * settings.visibility_level),
+        iterations: sol.solve.iterations,
+        residuals: sol.solve.residuals.clone(),
+        build_ms,
+        form_factor_ms: sol.solve.form_factor_ms,
+        solve_ms: sol.solve.total_ms,
+        view_ms,
+    };
+    Ok((sol, film, report))
+}
+
+/// Build `backend` over `scene`, solve, and render one `width × height` view with
+/// `spp²` samples per pixel.
+pub fn run(
+    scene: &Scene,
+    backend: Backend,
+    settings: &RadiositySettings,
+    view: (u32, u32, u32),
+) -> Result<(Solution, Film, RadiosityReport), RadiosityError> {
+    let t0 = Instant::now();
+    let ms = |t: Instant| t.elapsed().as_secs_f64() * 1e3;
+    match backend {
+        Backend::Bvh => {
+            let accel = crate::accel::bvh::Bvh::build(scene);
+            solve_and_view(scene, &accel, settings, view, ms(t0))
+        }
+        #[cfg(feature = "embree")]
+        Backend::Embree => {
+            let accel =
+                crate::accel::embree::EmbreeAccel::build(scene).map_err(AccelError::from)?;
+            solve_and_view(scene, &accel, settings, view, ms(t0))
+        }
+        #[cfg(not(feature = "embree"))]
+        Backend::Embree => Err(AccelError::Unavailable("embree").into()),
+    }
+}

@@ -1,0 +1,171 @@
+//! Solvers of the radiosity system `B_j = E_j + ρ_j Σ_i F_ji B_i`, in RGB.
+//!
+//! - Progressive refinement (Cohen, Chen, Wallace & Greenberg 1988): repeatedly shoot
+//!   the unshot energy of the element with the most unshot power; one row of form
+//!   factors at a time, so memory stays linear in the number of elements. The residual
+//!   is the unshot power over the emitted power.
+//! - Gauss–Seidel on the full matrix for small meshes, as a cross-check.
+
+use super::formfactor::{element_form_factor, Sampling};
+use super::mesh::Mesh;
+use super::RadiosityError;
+use crate::accel::Accel;
+use crate::math::Vec3;
+use rayon::prelude::*;
+use std::time::Instant;
+
+/// Largest mesh the full-matrix solver accepts (its matrix has n² entries).
+pub const MAX_FULL_MATRIX: usize = 4096;
+
+/// A solved (or partly solved) radiosity system.
+#[derive(Clone, Debug, Default)]
+pub struct Solve {
+    /// Radiosity per element.
+    pub radiosity: Vec<Vec3>,
+    /// Energy received but not yet shot, per element.
+    pub unshot: Vec<Vec3>,
+    /// Residual (unshot over emitted power) before each shot and after the last.
+    pub residuals: Vec<f64>,
+    /// Shots (progressive) or sweeps (Gauss–Seidel) done.
+    pub iterations: usize,
+    /// Milliseconds spent computing form factors.
+    pub form_factor_ms: f64,
+    /// Milliseconds for the whole solve.
+    pub total_ms: f64,
+}
+
+fn power(v: Vec3) -> f64 {
+    (v.x + v.y + v.z) as f64
+}
+
+/// One row of form factors `F_ij` for all `j`, in parallel.
+pub fn form_factor_row<A: Accel>(mesh: &Mesh, accel: &A, s: &Sampling, i: usize) -> Vec<f32> {
+    (0..mesh.elements.len())
+        .into_par_iter()
+        .map(|j| element_form_factor(mesh, accel, s, i, j))
+        .collect()
+}
+
+fn emitted(mesh: &Mesh) -> Result<Vec<Vec3>, RadiosityError> {
+    let e: Vec<Vec3> = mesh
+        .elements
+        .iter()
+        .map(|el| mesh.emission[el.material as usize])
+        .collect();
+    if e.iter().all(|v| v.max_element() <= 0.0) {
+        return Err(RadiosityError::NoEmitters);
+    }
+    Ok(e)
+}
+
+/// Progressive refinement until the residual is below `epsilon` or after
+/// `max_shots` shots.
+pub fn progressive<A: Accel>(
+    mesh: &Mesh,
+    accel: &A,
+    s: &Sampling,
+    epsilon: f64,
+    max_shots: usize,
+) -> Result<Solve, RadiosityError> {
+    let start = Instant::now();
+    let emission = emitted(mesh)?;
+    let n = mesh.elements.len();
+    let area: Vec<f32> = mesh.elements.iter().map(|e| e.area).collect();
+    let total_emitted: f64 = (0..n).map(|i| power(emission[i]) * area[i] as f64).sum();
+    let mut out = Solve {
+        radiosity: emission.clone(),
+        unshot: emission,
+        ..Default::default()
+    };
+    let mut ff_ms = 0.0;
+    loop {
+        let unshot_power: f64 = (0..n).map(|i| power(out.unshot[i]) * area[i] as f64).sum();
+        let residual = unshot_power / total_emitted;
+        out.residuals.push(residual);
+        if residual < epsilon || out.iterations >= max_shots {
+            break;
+        }
+        let i = (0..n)
+            .max_by(|&a, &b| {
+                let pa = power(out.unshot[a]) * area[a] as f64;
+                let pb = power(out.unshot[b]) * area[b] as f64;
+                pa.total_cmp(&pb)
+            })
+            .expect("non-empty mesh");
+        let t = Instant::now();
+        let row = form_factor_row(mesh, accel, s, i);
+        ff_ms += t.elapsed().as_secs_f64() * 1e3;
+        let shot = out.unshot[i];
+        out.unshot[i] = Vec3::ZERO;
+        for (j, &f) in row.iter().enumerate() {
+            if f > 0.0 {
+                let el = &mesh.elements[j];
+                let rho = mesh.reflectance[el.material as usize];
+                let db = rho * shot * (f * area[i] / area[j]);
+                out.radiosity[j] += db;
+                out.unshot[j] += db;
+            }
+        }
+        out.iterations += 1;
+    }
+    out.form_factor_ms = ff_ms;
+    out.total_ms = start.elapsed().as_secs_f64() * 1e3;
+    Ok(out)
+}
+
+/// Gauss–Seidel sweeps over the full system until no radiosity changes by more than
+/// `tolerance` (relative to the largest emission), or after `max_sweeps` sweeps.
+pub fn gauss_seidel<A: Accel>(
+    mesh: &Mesh,
+    accel: &A,
+    s: &Sampling,
+    tolerance: f64,
+    max_sweeps: usize,
+) -> Result<Solve, RadiosityError> {
+    let start = Instant::now();
+    let emission = emitted(mesh)?;
+    let n = mesh.elements.len();
+    if n > MAX_FULL_MATRIX {
+        return Err(RadiosityError::Settings(format!(
+            "{n} elements: the full-matrix solver takes at most {MAX_FULL_MATRIX}; use a larger --patch-size or the progressive solver"
+        )));
+    }
+    let t = Instant::now();
+    // f[i][j] = F_ij, from i to j.
+    let f: Vec<Vec<f32>> = (0..n).map(|i| form_factor_row(mesh, accel, s, i)).collect();
+    let ff_ms = t.elapsed().as_secs_f64() * 1e3;
+    let scale = emission
+        .iter()
+        .map(|e| e.max_element() as f64)
+        .fold(0.0, f64::max);
+    let mut b = emission.clone();
+    let mut out = Solve::default();
+    loop {
+        let mut change = 0.0f64;
+        for j in 0..n {
+            let ej = &mesh.elements[j];
+            let rho = mesh.reflectance[ej.material as usize];
+            let mut gathered = Vec3::ZERO;
+            for i in 0..n {
+                let fij = f[i][j];
+                if fij > 0.0 {
+                    // F_ji = F_ij A_i / A_j (reciprocity of the shooting estimate).
+                    gathered += b[i] * (fij * mesh.elements[i].area / ej.area);
+                }
+            }
+            let new = emission[j] + rho * gathered;
+            change = change.max((new - b[j]).abs().max_element() as f64);
+            b[j] = new;
+        }
+        out.iterations += 1;
+        out.residuals.push(change / scale);
+        if change / scale < tolerance || out.iterations >= max_sweeps {
+            break;
+        }
+    }
+    out.unshot = vec![Vec3::ZERO; n];
+    out.radiosity = b;
+    out.form_factor_ms = ff_ms;
+    out.total_ms = start.elapsed().as_secs_f64() * 1e3;
+    Ok(out)
+}

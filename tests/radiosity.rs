@@ -1,0 +1,536 @@
+//! Radiosity: form factors against analytic values, reciprocity and closure, energy
+//! conservation against the geometric series, solver convergence and agreement, both
+//! backends.
+
+use emray::accel::bvh::Bvh;
+use emray::geometry::Triangle;
+use emray::math::Vec3;
+use emray::radiosity::formfactor::{
+    element_form_factor, parallel_rectangles, perpendicular_rectangles, point_to_disk,
+    point_to_polygon, Sampling,
+};
+use emray::radiosity::mesh::Mesh;
+use emray::radiosity::{self, solver, RadiositySettings, SolverKind};
+use emray::scene::{Camera, Material, Scene};
+
+fn camera() -> Camera {
+    Camera {
+        from: Vec3::new(0.5, 0.5, 0.95),
+        at: Vec3::new(0.5, 0.5, 0.0),
+        up: Vec3::Y,
+        angle_deg: 60.0,
+        hither: 0.0,
+        width: 16,
+        height: 16,
+    }
+}
+
+/// A quad `a b c d` (counterclockwise seen from its front) as two triangles.
+fn quad(s: &mut Scene, q: [Vec3; 4], material: u32) {
+    s.add_triangle(
+        Triangle {
+            p: [q[0], q[1], q[2]],
+        },
+        material,
+    );
+    s.add_triangle(
+        Triangle {
+            p: [q[0], q[2], q[3]],
+        },
+        material,
+    );
+}
+
+/// The six inward-facing faces of the box `lo..hi`, all of `material` except the
+/// ceiling (`y = hi`), which gets `ceiling`.
+fn closed_box(s: &mut Scene, lo: Vec3, hi: Vec3, material: u32, ceiling: u32) {
+    let v = |x: usize, y: usize, z: usize| {
+        Vec3::new(
+            if x == 0 { lo.x } else { hi.x },
+            if y == 0 { lo.y } else { hi.y },
+            if z == 0 { lo.z } else { hi.z },
+        )
+    };
+    // Each face counterclockwise seen from inside.
+    quad(
+        s,
+        [v(0, 0, 0), v(0, 0, 1), v(1, 0, 1), v(1, 0, 0)],
+        material,
+    ); // floor
+    quad(s, [v(0, 1, 0), v(1, 1, 0), v(1, 1, 1), v(0, 1, 1)], ceiling); // ceiling
+    quad(
+        s,
+        [v(0, 0, 0), v(1, 0, 0), v(1, 1, 0), v(0, 1, 0)],
+        material,
+    ); // back z=lo
+    quad(
+        s,
+        [v(0, 0, 1), v(0, 1, 1), v(1, 1, 1), v(1, 0, 1)],
+        material,
+    ); // front z=hi
+    quad(
+        s,
+        [v(0, 0, 0), v(0, 1, 0), v(0, 1, 1), v(0, 0, 1)],
+        material,
+    ); // left x=lo
+    quad(
+        s,
+        [v(1, 0, 0), v(1, 0, 1), v(1, 1, 1), v(1, 1, 0)],
+        material,
+    ); // right x=hi
+}
+
+/// An outward-facing box (an occluder) `lo..hi`.
+fn solid_box(s: &mut Scene, lo: Vec3, hi: Vec3, material: u32) {
+    let mut inner = Scene::new(camera());
+    closed_box(&mut inner, lo, hi, material, material);
+    for t in &inner.triangles.items {
+        s.add_triangle(
+            Triangle {
+                p: [t.p[0], t.p[2], t.p[1]],
+            },
+            material,
+        );
+    }
+}
+
+/// A unit box: reflectance `rho` everywhere, the ceiling also emitting 1.
+fn white_box(rho: f32) -> Scene {
+    let mut s = Scene::new(camera());
+    s.materials.push(Material {
+        color: Vec3::splat(rho),
+        ..Material::DEFAULT
+    });
+    s.materials.push(Material {
+        color: Vec3::splat(rho),
+        emission: Vec3::ONE,
+        ..Material::DEFAULT
+    });
+    closed_box(&mut s, Vec3::ZERO, Vec3::ONE, 0, 1);
+    s
+}
+
+/// A box with a small emitter patch under the ceiling, coloured walls and an occluding
+/// block: shadows, colour bleeding.
+fn cornellish() -> Scene {
+    let mut s = Scene::new(camera());
+    s.ambient = Vec3::ZERO;
+    let white = Vec3::splat(0.7);
+    for color in [white, Vec3::new(0.7, 0.1, 0.1), Vec3::new(0.1, 0.6, 0.1)] {
+        s.materials.push(Material {
+            color,
+            ..Material::DEFAULT
+        });
+    }
+    s.materials.push(Material {
+        color: white,
+        emission: Vec3::splat(5.0),
+        ..Material::DEFAULT
+    });
+    closed_box(&mut s, Vec3::ZERO, Vec3::ONE, 0, 0);
+    // Recolour the side walls (triangles 8..12 are left and right).
+    for k in 8..10 {
+        s.triangles.material[k] = 1;
+    }
+    for k in 10..12 {
+        s.triangles.material[k] = 2;
+    }
+    // The light, facing down, just under the ceiling.
+    let y = 0.999;
+    quad(
+        &mut s,
+        [
+            Vec3::new(0.35, y, 0.35),
+            Vec3::new(0.65, y, 0.35),
+            Vec3::new(0.65, y, 0.65),
+            Vec3::new(0.35, y, 0.65),
+        ],
+        3,
+    );
+    // Corners off the element grid's rational points: a visibility ray exactly through
+    // an edge may be caught by the watertight BVH and missed by Embree's default
+    // triangle test (such a ray joined two centroids for a block at x = 0.31).
+    solid_box(
+        &mut s,
+        Vec3::new(0.3123, 0.1071, 0.3317),
+        Vec3::new(0.6189, 0.4277, 0.5843),
+        0,
+    );
+    s
+}
+
+#[test]
+fn closed_box_rows_sum_to_one_and_energy_follows_the_series() {
+    let rho = 0.5f32;
+    let scene = white_box(rho);
+    let accel = Bvh::build(&scene);
+    let mesh = Mesh::build(&scene, 0.5).unwrap();
+    // Diagonals of 1.41 halved twice: 16 elements per triangle.
+    assert_eq!(mesh.elements.len(), 12 * 16);
+    let s = Sampling::new(1, 0);
+    for i in 0..mesh.elements.len() {
+        let sum: f32 = solver::form_factor_row(&mesh, &accel, &s, i).iter().sum();
+        assert!((sum - 1.0).abs() < 0.01, "row {i} sums to {sum}");
+    }
+    let settings = RadiositySettings {
+        patch_size: Some(0.5),
+        epsilon: 1e-5,
+        ..Default::default()
+    };
+    let sol = radiosity::solve(&scene, &accel, &settings).unwrap();
+    // Power leaving all surfaces: emitted × (1 + ρ + ρ² + …) = Φ/(1 − ρ).
+    let total: f64 = sol
+        .mesh
+        .elements
+        .iter()
+        .zip(&sol.solve.radiosity)
+        .map(|(e, b)| (b.x * e.area) as f64)
+        .sum();
+    let expect = 1.0 / (1.0 - rho as f64);
+    assert!(
+        ((total - expect) / expect).abs() < 0.01,
+        "total power {total}, series {expect}"
+    );
+}
+
+#[test]
+fn form_factors_are_reciprocal_on_random_pairs() {
+    let scene = cornellish();
+    let accel = Bvh::build(&scene);
+    let mesh = Mesh::build(&scene, 0.45).unwrap();
+    let n = mesh.elements.len();
+    let s = Sampling::new(3, 1);
+    let mut state = 0x1234_5678u32;
+    let mut next = || {
+        state ^= state << 13;
+        state ^= state >> 17;
+        state ^= state << 5;
+        state as usize % n
+    };
+    let mut checked = 0;
+    while checked < 40 {
+        let (i, j) = (next(), next());
+        let fij = element_form_factor(&mesh, &accel, &s, i, j);
+        let fji = element_form_factor(&mesh, &accel, &s, j, i);
+        if fij == 0.0 && fji == 0.0 {
+            continue;
+        }
+        let (ai, aj) = (mesh.elements[i].area, mesh.elements[j].area);
+        let (x, y) = (ai * fij, aj * fji);
+        // Pairs that share an edge or a corner have a singular integrand: they get 3%.
+        let touching = mesh.elements[i]
+            .p
+            .iter()
+            .any(|p| mesh.elements[j].p.iter().any(|q| (*p - *q).length() < 1e-6));
+        let tol = if touching { 0.03 } else { 0.01 };
+        assert!(
+            (x - y).abs() <= tol * x.max(y),
+            "pair ({i}, {j}): A_i F_ij = {x}, A_j F_ji = {y}"
+        );
+        checked += 1;
+    }
+}
+
+/// Form factor from the meshed rectangle made of triangles `from` to the one made of
+/// `to`: the area-weighted mean over the source elements of their row sums.
+fn rect_to_rect(scene: &Scene, patch: f32, level: u32) -> f64 {
+    let accel = Bvh::build(scene);
+    let mesh = Mesh::build(scene, patch).unwrap();
+    let s = Sampling::new(level, 0);
+    let (mut num, mut den) = (0.0f64, 0.0f64);
+    for (i, e) in mesh.elements.iter().enumerate() {
+        if e.material != 0 {
+            continue;
+        }
+        let row = solver::form_factor_row(&mesh, &accel, &s, i);
+        let to: f64 = row
+            .iter()
+            .zip(&mesh.elements)
+            .filter(|(_, e)| e.material == 1)
+            .map(|(f, _)| *f as f64)
+            .sum();
+        num += to * e.area as f64;
+        den += e.area as f64;
+    }
+    num / den
+}
+
+#[test]
+fn parallel_and_perpendicular_rectangles_match_the_analytic_values() {
+    // Parallel: a 1 × 2 rectangle facing another one 0.5 above it.
+    let mut s = Scene::new(camera());
+    s.materials = vec![Material::DEFAULT, Material::DEFAULT];
+    let (a, b, c) = (1.0f32, 2.0f32, 0.5f32);
+    quad(
+        &mut s,
+        [
+            Vec3::ZERO,
+            Vec3::new(a, 0.0, 0.0),
+            Vec3::new(a, b, 0.0),
+            Vec3::new(0.0, b, 0.0),
+        ],
+        0,
+    );
+    quad(
+        &mut s,
+        [
+            Vec3::new(0.0, 0.0, c),
+            Vec3::new(0.0, b, c),
+            Vec3::new(a, b, c),
+            Vec3::new(a, 0.0, c),
+        ],
+        1,
+    );
+    let f = rect_to_rect(&s, 0.26, 1);
+    let expect = parallel_rectangles(a as f64, b as f64, c as f64);
+    assert!(((f - expect) / expect).abs() < 0.01, "{f} vs {expect}");
+
+    // Perpendicular: the l × w floor (z = 0, y in 0..w) to the l × h wall (y = 0).
+    let mut s = Scene::new(camera());
+    s.materials = vec![Material::DEFAULT, Material::DEFAULT];
+    let (l, w, h) = (1.0f32, 1.0f32, 0.6f32);
+    quad(
+        &mut s,
+        [
+            Vec3::ZERO,
+            Vec3::new(l, 0.0, 0.0),
+            Vec3::new(l, w, 0.0),
+            Vec3::new(0.0, w, 0.0),
+        ],
+        0,
+    );
+    quad(
+        &mut s,
+        [
+            Vec3::ZERO,
+            Vec3::new(0.0, 0.0, h),
+            Vec3::new(l, 0.0, h),
+            Vec3::new(l, 0.0, 0.0),
+        ],
+        1,
+    );
+    let f = rect_to_rect(&s, 0.26, 2);
+    let expect = perpendicular_rectangles(l as f64, w as f64, h as f64);
+    assert!(((f - expect) / expect).abs() < 0.02, "{f} vs {expect}");
+}
+
+#[test]
+fn point_to_disk_matches_the_analytic_value() {
+    // A 256-gon inscribed in the disk has 0.01% less area: 0.1% tolerance.
+    for (r, h) in [(1.0f32, 1.0f32), (0.5, 2.0), (3.0, 0.5)] {
+        let poly: Vec<Vec3> = (0..256)
+            .map(|k| {
+                let a = k as f32 / 256.0 * std::f32::consts::TAU;
+                Vec3::new(r * a.cos(), r * a.sin(), h)
+            })
+            .collect();
+        let f = point_to_polygon(Vec3::ZERO, Vec3::Z, &poly) as f64;
+        let expect = point_to_disk(r as f64, h as f64);
+        assert!(
+            ((f - expect) / expect).abs() < 1e-3,
+            "r {r} h {h}: {f} vs {expect}"
+        );
+    }
+}
+
+#[test]
+fn progressive_residual_decreases_and_agrees_with_gauss_seidel() {
+    let scene = cornellish();
+    let accel = Bvh::build(&scene);
+    let base = RadiositySettings {
+        patch_size: Some(0.45),
+        epsilon: 1e-4,
+        ..Default::default()
+    };
+    let p = radiosity::solve(&scene, &accel, &base).unwrap();
+    let r = &p.solve.residuals;
+    assert!(r.len() > 10);
+    for w in r.windows(2) {
+        assert!(w[1] <= w[0], "residual went up: {} -> {}", w[0], w[1]);
+    }
+    assert!(*r.last().unwrap() < 1e-4);
+    let g = radiosity::solve(
+        &scene,
+        &accel,
+        &RadiositySettings {
+            solver: SolverKind::GaussSeidel,
+            epsilon: 1e-6,
+            ..base
+        },
+    )
+    .unwrap();
+    let scale = g
+        .solve
+        .radiosity
+        .iter()
+        .map(|b| b.max_element())
+        .fold(0.0f32, f32::max);
+    for (k, (a, b)) in p.solve.radiosity.iter().zip(&g.solve.radiosity).enumerate() {
+        assert!(
+            (*a - *b).abs().max_element() < 2e-3 * scale,
+            "element {k}: progressive {a} vs Gauss-Seidel {b}"
+        );
+    }
+    // Colour bleeding: the floor next to the red wall is redder than next to the green.
+    let floor_near = |x: f32| {
+        p.mesh
+            .elements
+            .iter()
+            .zip(&p.solve.radiosity)
+            .filter(|(e, _)| {
+                e.n.y > 0.9 && e.centroid().y < 0.01 && (e.centroid().x - x).abs() < 0.1
+            })
+            .map(|(_, b)| *b)
+            .fold(Vec3::ZERO, |a, b| a + b)
+    };
+    let (l, r) = (floor_near(0.05), floor_near(0.95));
+    assert!(l.x / l.y > r.x / r.y, "red side {l}, green side {r}");
+}
+
+#[cfg(feature = "embree")]
+#[test]
+fn both_backends_give_the_same_solution() {
+    let scene = cornellish();
+    let settings = RadiositySettings {
+        patch_size: Some(0.45),
+        epsilon: 1e-4,
+        ..Default::default()
+    };
+    let bvh = Bvh::build(&scene);
+    let embree = emray::accel::embree::EmbreeAccel::build(&scene).unwrap();
+    let a = radiosity::solve(&scene, &bvh, &settings).unwrap();
+    let b = radiosity::solve(&scene, &embree, &settings).unwrap();
+    assert_eq!(a.solve.iterations, b.solve.iterations);
+    for (k, (x, y)) in a.solve.radiosity.iter().zip(&b.solve.radiosity).enumerate() {
+        let rel = (*x - *y).abs().max_element() / x.max_element().max(1e-6);
+        assert!(rel < 1e-3, "element {k}: bvh {x} vs embree {y}");
+    }
+}
+
+#[test]
+fn the_view_shows_the_interpolated_solution() {
+    let scene = cornellish();
+    let accel = Bvh::build(&scene);
+    let sol = radiosity::solve(
+        &scene,
+        &accel,
+        &RadiositySettings {
+            patch_size: Some(0.45),
+            ..Default::default()
+        },
+    )
+    .unwrap();
+    let film = radiosity::render_view(&scene, &accel, &sol, 16, 16, 1);
+    // Looking at the back wall from inside: every pixel lit, none black.
+    let lo = film
+        .pixels
+        .iter()
+        .map(|p| p.min_element())
+        .fold(f32::MAX, f32::min);
+    assert!(lo > 0.0, "a black pixel inside the lit box");
+    // No pixel brighter than the brightest vertex.
+    let hi = sol
+        .vertex_radiosity
+        .iter()
+        .map(|v| v.max_element())
+        .fold(0.0f32, f32::max);
+    assert!(film.pixels.iter().all(|p| p.max_element() <= hi * 1.0001));
+    // The PLY lists every vertex and element.
+    let ply = sol.to_ply(1.0);
+    assert!(ply.contains(&format!("element vertex {}", sol.mesh.vertices.len())));
+    assert_eq!(
+        ply.lines().count(),
+        13 + sol.mesh.vertices.len() + sol.mesh.elements.len()
+    );
+}
+
+#[test]
+fn area_light_sampling_matches_the_form_factor_and_softens_shadows() {
+    use emray::radiosity::area;
+    // A 1 × 1 emitter facing down, 1 above the origin of a floor facing up.
+    let mut s = Scene::new(camera());
+    s.materials.push(Material::DEFAULT);
+    s.materials.push(Material {
+        emission: Vec3::splat(2.0),
+        ..Material::DEFAULT
+    });
+    let light = [
+        Vec3::new(-0.5, 1.0, -0.5),
+        Vec3::new(0.5, 1.0, -0.5),
+        Vec3::new(0.5, 1.0, 0.5),
+        Vec3::new(-0.5, 1.0, 0.5),
+    ];
+    quad(&mut s, light, 1);
+    let lights = area::collect(&s);
+    assert_eq!(lights.len(), 2);
+    assert!(
+        lights.iter().all(|l| l.n.y < -0.99),
+        "the emitter faces down"
+    );
+    let accel = Bvh::build(&s);
+    let p = Vec3::new(0.1, 0.0, -0.2);
+    let (e, rays) = area::direct(&accel, &lights, p, Vec3::ZERO, Vec3::Y, Vec3::Y, 8);
+    assert_eq!(rays, 2 * 64);
+    // Irradiance/π = E × F(point → light).
+    let f = point_to_polygon(p, Vec3::Y, &light);
+    assert!(
+        (e.x / (2.0 * f) - 1.0).abs() < 0.02,
+        "{} vs {}",
+        e.x,
+        2.0 * f
+    );
+    // A blocker over half of the light: a penumbra, between none and all.
+    let mut blocked = s.clone();
+    quad(
+        &mut blocked,
+        [
+            Vec3::new(-2.0, 0.5, -2.0),
+            Vec3::new(0.1, 0.5, -2.0),
+            Vec3::new(0.1, 0.5, 2.0),
+            Vec3::new(-2.0, 0.5, 2.0),
+        ],
+        0,
+    );
+    let accel = Bvh::build(&blocked);
+    let (h, _) = area::direct(&accel, &lights, p, Vec3::ZERO, Vec3::Y, Vec3::Y, 8);
+    assert!(
+        h.x > 0.2 * e.x && h.x < 0.8 * e.x,
+        "penumbra {} of {}",
+        h.x,
+        e.x
+    );
+}
+
+#[test]
+fn two_pass_without_specular_paths_shows_the_radiosity_solution() {
+    let scene = cornellish();
+    let accel = Bvh::build(&scene);
+    let sol = radiosity::solve(
+        &scene,
+        &accel,
+        &RadiositySettings {
+            patch_size: Some(0.45),
+            ..Default::default()
+        },
+    )
+    .unwrap();
+    let view = radiosity::render_view(&scene, &accel, &sol, 16, 16, 1);
+    let mut settings = emray::RenderSettings::for_scene(&scene);
+    settings.width = 16;
+    settings.height = 16;
+    let (film, stats) = emray::render::render_with_gi(&scene, &accel, &settings, Some(&sol), None);
+    // Everything is diffuse and there are no point lights: one diffuse term, counted
+    // once, from the solution; no shadow rays.
+    assert_eq!(stats.rays.shadow, 0);
+    for (a, b) in film.pixels.iter().zip(&view.pixels) {
+        assert!((*a - *b).abs().max_element() <= 1e-6 * b.max_element().max(1.0));
+    }
+    // Without the solution the emitter still lights the room, through area-light
+    // sampling, with soft shadows: direct light only, so darker on average.
+    let (direct, stats) = emray::render::render(&scene, &accel, &settings, None);
+    assert!(stats.rays.shadow > 0);
+    let mean = |f: &emray::render::Film| {
+        f.pixels.iter().map(|p| p.x + p.y + p.z).sum::<f32>() / f.pixels.len() as f32
+    };
+    assert!(mean(&direct) > 0.0 && mean(&direct) < mean(&film));
+}
