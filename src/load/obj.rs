@@ -135,7 +135,7 @@
 
 use super::LoadError;
 use crate::geometry::polygon::Triangulator;
-use crate::geometry::Triangle;
+use crate::geometry::{QuadUv, Triangle};
 use crate::math::{Aabb, DVec3, Vec3};
 use crate::scene::texture::{Image, Wrap};
 use crate::scene::{Camera, Environment, Geometry, Light, LoadStats, Material, Scene, Texture};
@@ -1629,6 +1629,7 @@ impl<'a> Builder<'a> {
                     continue;
                 }
                 let m = self.material_index(slot);
+                let first = self.geometry.triangles.len();
                 for t in 0..self.tris.len() {
                     let [a, b, c] = self.tris[t];
                     let tri = Triangle {
@@ -1640,6 +1641,16 @@ impl<'a> Builder<'a> {
                         let i = self.geometry.triangles.len() - 1;
                         self.geometry
                             .set_triangle_uvs(i, [self.uvs[a], self.uvs[b], self.uvs[c]]);
+                    }
+                }
+                // A textured quad takes its (u, v) from the bilinear patch.
+                if arity == 4 && self.uvs.len() == 4 && self.geometry.triangles.len() == first + 2 {
+                    let p = [self.pts[0], self.pts[1], self.pts[2], self.pts[3]];
+                    let uv = [self.uvs[0], self.uvs[1], self.uvs[2], self.uvs[3]];
+                    if let Some(q) = QuadUv::new(p, uv) {
+                        let k = self.geometry.add_quad(q);
+                        self.geometry.set_triangle_quad(first, k);
+                        self.geometry.set_triangle_quad(first + 1, k);
                     }
                 }
             }
