@@ -338,6 +338,129 @@ fn mirror_sphere_centre_pixel_shows_the_texel_behind_the_camera() {
     }
 }
 
+/// Face colours of the six-file cube map (+x, −x, +y, −y, +z, −z), sRGB bytes.
+const FACE_COLOURS: [[u8; 3]; 6] = [
+    [250, 30, 30],
+    [30, 250, 30],
+    [30, 30, 250],
+    [250, 250, 30],
+    [30, 250, 250],
+    [250, 30, 250],
+];
+/// The −z face's outer quadrants: top-left, top-right, bottom-left, bottom-right.
+const NZ_QUADRANTS: [[u8; 3]; 4] = [[120, 0, 0], [0, 120, 0], [0, 0, 120], [120, 120, 0]];
+
+fn linear(c: [u8; 3]) -> Vec3 {
+    Vec3::from(c.map(|v| srgb_to_linear(f32::from(v) / 255.0)))
+}
+
+/// A six-file cube map, each face 16 × 16 in its colour; on the −z face only the
+/// central 4 × 4 texels, the rest being one colour per quadrant (to check the face's
+/// orientation). `ext` per face.
+fn write_cube(dir: &Path, ext: [&str; 6]) {
+    for (k, name) in emray::scene::texture::CUBE_FACES.iter().enumerate() {
+        write_png(&dir.join(format!("{name}.{}", ext[k])), 16, 16, |x, y| {
+            let centre = (6..10).contains(&x) && (6..10).contains(&y);
+            if k == 5 && !centre {
+                NZ_QUADRANTS[usize::from(y >= 8) * 2 + usize::from(x >= 8)]
+            } else {
+                FACE_COLOURS[k]
+            }
+        });
+    }
+}
+
+/// A mirror sphere in a six-file cube map, seen from each axis: its centre pixel shows
+/// the face straight behind the camera; the background seen along −z shows the −z
+/// face upright (+y up, +x right). The same cube map from a directory (`--envmap DIR`,
+/// `[render] environment`), from MTL `refl -type cube_*`, on both backends.
+#[test]
+fn six_file_cube_map_faces_are_seen_in_their_directions() {
+    let dir = TempDir::new().unwrap();
+    let sky = dir.path().join("sky");
+    std::fs::create_dir(&sky).unwrap();
+    write_cube(&sky, ["png"; 6]);
+    let env = Environment::load(&sky).unwrap();
+    let axes = [Vec3::X, -Vec3::X, Vec3::Y, -Vec3::Y, Vec3::Z, -Vec3::Z];
+    for (k, a) in axes.into_iter().enumerate() {
+        let mut s = mirror_scene(a * 6.0, env.clone());
+        s.camera.angle_deg = 60.0;
+        if a.y != 0.0 {
+            s.camera.up = Vec3::Z;
+        }
+        for b in backends() {
+            let film = render_scene("t", &s, b, &RenderSettings::for_scene(&s), 0.0, None)
+                .unwrap()
+                .0;
+            let want = linear(FACE_COLOURS[k]);
+            let got = film.get(2, 2);
+            assert!(close(got, want, 1e-4), "{b:?} from {a}: {got} vs {want}");
+            if k == 4 {
+                // Looking along −z past the sphere: the −z face's quadrants.
+                for (q, (i, j)) in [(0, 0), (4, 0), (0, 4), (4, 4)].into_iter().enumerate() {
+                    let want = linear(NZ_QUADRANTS[q]);
+                    let got = film.get(i, j);
+                    assert!(close(got, want, 1e-4), "{b:?} pixel ({i}, {j}): {got}");
+                }
+            }
+        }
+    }
+
+    // MTL: the six faces as `refl -type cube_*` give the same map.
+    let faces = [
+        ("cube_right", "px"),
+        ("cube_left", "nx"),
+        ("cube_top", "py"),
+        ("cube_bottom", "ny"),
+        ("cube_back", "pz"),
+        ("cube_front", "nz"),
+    ];
+    let mut mtl = String::from("newmtl m\nKd 1 1 1\n");
+    for (t, f) in faces {
+        mtl += &format!("refl -type {t} sky/{f}.png\n");
+    }
+    std::fs::write(dir.path().join("m.mtl"), &mtl).unwrap();
+    let obj = "mtllib m.mtl\nv 0 0 0\nv 1 0 0\nv 0 1 0\nusemtl m\nf 1 2 3\n";
+    std::fs::write(dir.path().join("c.obj"), obj).unwrap();
+    let data = load_geometry(&dir.path().join("c.obj")).unwrap();
+    assert!(data.warnings.is_empty(), "{:?}", data.warnings);
+    assert!(
+        data.environment.as_ref() == Some(&env),
+        "MTL cube map differs"
+    );
+    // One face missing: a warning naming it, no environment.
+    std::fs::write(
+        dir.path().join("m.mtl"),
+        mtl.replace("refl -type cube_top sky/py.png\n", ""),
+    )
+    .unwrap();
+    let data = load_geometry(&dir.path().join("c.obj")).unwrap();
+    assert!(data.environment.is_none());
+    assert!(
+        data.warnings.iter().any(|w| w.contains("missing cube_top")),
+        "{:?}",
+        data.warnings
+    );
+
+    // The scene format: a directory as `[render] environment`.
+    let toml = "[camera]\nfrom = [0, 0, 5]\nat = [0, 0, 0]\nfov = 40\nresolution = [4, 4]\n\n\
+                [render]\nenvironment = \"sky\"\n";
+    std::fs::write(dir.path().join("s.toml"), toml).unwrap();
+    let scene = emray::load::load_path(&dir.path().join("s.toml")).unwrap();
+    assert!(
+        scene.environment.as_ref() == Some(&env),
+        "TOML cube map differs"
+    );
+
+    // A face of another size, and a missing face, are errors naming the file.
+    write_png(&sky.join("py.png"), 8, 8, |_, _| [0, 0, 0]);
+    let e = Environment::load(&sky).unwrap_err();
+    assert!(e.contains("py is 8 × 8"), "{e}");
+    std::fs::remove_file(sky.join("py.png")).unwrap();
+    let e = Environment::load(&sky).unwrap_err();
+    assert!(e.contains("py.png"), "{e}");
+}
+
 fn write_png(path: &Path, w: u32, h: u32, f: impl Fn(u32, u32) -> [u8; 3]) {
     let mut img = image::RgbImage::new(w, h);
     for (x, y, p) in img.enumerate_pixels_mut() {
