@@ -545,6 +545,8 @@ struct ForwardRef {
 /// Scan the OBJ text line by line as tobj splits it, check what tobj would reject (or
 /// panic on) except malformed numbers, and record per-face facts. No number is parsed
 /// but face indices.
+// Kept out of line (called once) so that profiles show the scan as its own phase.
+#[inline(never)]
 fn scan(text: &str) -> Result<Scan, Located> {
     let mut s = Scan::default();
     let mut counts = [0usize; 3];
@@ -640,9 +642,17 @@ fn scan(text: &str) -> Result<Scan, Located> {
                 let mut all_texcoords = true;
                 for tok in words {
                     n += 1;
+                    // One pass over the token's parts: what they say about normals and
+                    // texture coordinates is collected on the way.
                     let mut parts = 0;
+                    let mut last_empty = false;
+                    let mut has_vt = false;
                     for (k, part) in tok.split('/').enumerate() {
                         parts += 1;
+                        last_empty = part.is_empty();
+                        if k == 1 {
+                            has_vt = !part.is_empty();
+                        }
                         if k >= 3 {
                             return Err(err(
                                 Some(tok),
@@ -702,10 +712,10 @@ fn scan(text: &str) -> Result<Scan, Located> {
                             }
                         }
                     }
-                    if parts < 3 || tok.rsplit('/').next().is_some_and(str::is_empty) {
+                    if parts < 3 || last_empty {
                         all_normals = false;
                     }
-                    if tok.split('/').nth(1).map_or(true, str::is_empty) {
+                    if !has_vt {
                         all_texcoords = false;
                     }
                 }
@@ -1613,6 +1623,8 @@ impl<'a> Builder<'a> {
         })
     }
 
+    // Kept out of line (called once) so that profiles show the conversion.
+    #[inline(never)]
     fn build(
         &mut self,
         models: &[tobj::Model],
