@@ -322,15 +322,20 @@ fn radiosity_run(a: &cli::RadiosityArgs) -> Result<()> {
         println!("scene      {}\n{}", a.scene.display(), report.summary());
     }
     if let Some(path) = &a.stats_json {
-        let line = serde_json::to_string(&report).expect("report serialises");
-        let mut f = std::fs::OpenOptions::new()
-            .create(true)
-            .append(true)
-            .open(path)
-            .with_context(|| format!("{}: cannot open for writing", path.display()))?;
-        writeln!(f, "{line}").with_context(|| format!("{}: cannot write", path.display()))?;
+        append_json_line(path, &report)?;
     }
     Ok(())
+}
+
+/// Appends `value` as one JSON line to `path` (the `--stats-json` log: one record per run).
+fn append_json_line(path: &Path, value: &impl serde::Serialize) -> Result<()> {
+    let line = serde_json::to_string(value).expect("report serialises");
+    let mut f = std::fs::OpenOptions::new()
+        .create(true)
+        .append(true)
+        .open(path)
+        .with_context(|| format!("{}: cannot open for writing", path.display()))?;
+    writeln!(f, "{line}").with_context(|| format!("{}: cannot write", path.display()))
 }
 
 /// Where scene `scene` goes.
@@ -570,13 +575,7 @@ fn render_one(args: &RenderArgs, scene_path: Option<&Path>, out: &Path) -> Resul
         log::info!("wrote {}", out.display());
     }
     if let Some(path) = &args.stats_json {
-        let line = serde_json::to_string(&report).expect("report serialises");
-        let mut f = std::fs::OpenOptions::new()
-            .create(true)
-            .append(true)
-            .open(path)
-            .with_context(|| format!("{}: cannot open for writing", path.display()))?;
-        writeln!(f, "{line}").with_context(|| format!("{}: cannot write", path.display()))?;
+        append_json_line(path, &report)?;
     }
     Ok(())
 }
