@@ -286,7 +286,7 @@ fn radiosity(a: &cli::RadiosityArgs) -> ExitCode {
 }
 
 fn radiosity_run(a: &cli::RadiosityArgs) -> Result<()> {
-    use emray::radiosity::{RadiositySettings, SolverKind};
+    use emray::radiosity::{FormFactorMethod, RadiositySettings, SolverKind};
     emray::output::Format::from_path(&a.output)?;
     let mut builder = rayon::ThreadPoolBuilder::new();
     if let Some(t) = a.threads {
@@ -303,6 +303,10 @@ fn radiosity_run(a: &cli::RadiosityArgs) -> Result<()> {
         solver: match a.solver {
             cli::SolverArg::Progressive => SolverKind::Progressive,
             cli::SolverArg::GaussSeidel => SolverKind::GaussSeidel,
+        },
+        form_factors: match a.form_factors {
+            cli::FormFactorArg::Raycast => FormFactorMethod::RayCast,
+            cli::FormFactorArg::Hemicube => FormFactorMethod::Hemicube(a.hemicube_res),
         },
     };
     let (w, h) = a.res.unwrap_or((scene.camera.width, scene.camera.height));

@@ -15,6 +15,7 @@
 
 pub mod area;
 pub mod formfactor;
+pub mod hemicube;
 pub mod mesh;
 pub mod solver;
 
@@ -56,6 +57,17 @@ pub enum SolverKind {
     GaussSeidel,
 }
 
+/// How form factors are computed.
+#[derive(Clone, Copy, Debug, PartialEq, Eq, Serialize)]
+pub enum FormFactorMethod {
+    /// Exact point-to-polygon form factors at sample points on the shooter, times the
+    /// visibility from `Accel::occluded` rays (either backend).
+    RayCast,
+    /// A hemicube of this many pixels across its top face on each shooter's centroid,
+    /// visibility from its depth buffer (meshed triangles only).
+    Hemicube(u32),
+}
+
 /// How to solve.
 #[derive(Clone, Debug, PartialEq)]
 pub struct RadiositySettings {
@@ -74,6 +86,8 @@ pub struct RadiositySettings {
     pub max_iterations: usize,
     /// Solver.
     pub solver: SolverKind,
+    /// Form-factor method.
+    pub form_factors: FormFactorMethod,
 }
 
 impl Default for RadiositySettings {
@@ -85,6 +99,7 @@ impl Default for RadiositySettings {
             epsilon: 1e-3,
             max_iterations: 1_000_000,
             solver: SolverKind::Progressive,
+            form_factors: FormFactorMethod::RayCast,
         }
     }
 }
@@ -209,16 +224,35 @@ pub fn solve<A: Accel>(
     if mesh.elements.is_empty() {
         return Err(RadiosityError::Empty);
     }
-    let s = Sampling::new(settings.shooter_level, settings.visibility_level);
-    let solve = match settings.solver {
-        SolverKind::Progressive => {
-            solver::progressive(&mesh, accel, &s, settings.epsilon, settings.max_iterations)?
-        }
-        SolverKind::GaussSeidel => {
-            solver::gauss_seidel(&mesh, accel, &s, settings.epsilon, settings.max_iterations)?
-        }
-    };
+    let solve = solve_mesh(&mesh, accel, settings)?;
     Ok(Solution::new(mesh, solve))
+}
+
+/// Solve the radiosity system of `mesh` with the settings' form factors and solver.
+fn solve_mesh<A: Accel>(
+    mesh: &Mesh,
+    accel: &A,
+    settings: &RadiositySettings,
+) -> Result<Solve, RadiosityError> {
+    let (eps, max) = (settings.epsilon, settings.max_iterations);
+    match settings.form_factors {
+        FormFactorMethod::RayCast => {
+            let s = Sampling::new(settings.shooter_level, settings.visibility_level);
+            let row = |i| solver::form_factor_row(mesh, accel, &s, i);
+            match settings.solver {
+                SolverKind::Progressive => solver::progressive_rows(mesh, row, eps, max),
+                SolverKind::GaussSeidel => solver::gauss_seidel_rows(mesh, row, eps, max),
+            }
+        }
+        FormFactorMethod::Hemicube(res) => {
+            let h = hemicube::Hemicube::new(res)?;
+            let row = |i| h.row(mesh, i);
+            match settings.solver {
+                SolverKind::Progressive => solver::progressive_rows(mesh, row, eps, max),
+                SolverKind::GaussSeidel => solver::gauss_seidel_rows(mesh, row, eps, max),
+            }
+        }
+    }
 }
 
 /// 1/12 of the diagonal of the bounds of the scene's top-level and instanced
@@ -296,6 +330,8 @@ pub struct RadiosityReport {
     pub backend: &'static str,
     /// Solver.
     pub solver: SolverKind,
+    /// Form-factor method.
+    pub form_factors: FormFactorMethod,
     /// Patch size used.
     pub patch_size: f32,
     /// Elements.
@@ -326,9 +362,18 @@ impl RadiosityReport {
     /// Human-readable summary.
     pub fn summary(&self) -> String {
         let last = self.residuals.last().copied().unwrap_or(0.0);
+        let method = match self.form_factors {
+            FormFactorMethod::RayCast => format!(
+                "ray cast, {} points per shooter, {} visibility rays per element pair",
+                self.shooter_samples, self.visibility_samples
+            ),
+            FormFactorMethod::Hemicube(res) => {
+                format!("hemicube, {res}x{res} top face, on each shooter's centroid")
+            }
+        };
         format!(
             "backend    {}\nmesh       {} elements, {} vertices (patch size {}), {} analytic primitives not meshed\n\
-             samples    {} per shooter, {} visibility rays per element pair\n\
+             ff         {}\n\
              solver     {:?}: {} iterations, final residual {:.3e}\n\
              time       build {:.1} ms, form factors {:.1} ms, solve {:.1} ms, view {:.1} ms",
             self.backend,
@@ -336,8 +381,7 @@ impl RadiosityReport {
             self.vertices,
             self.patch_size,
             self.unmeshed,
-            self.shooter_samples,
-            self.visibility_samples,
+            method,
             self.solver,
             self.iterations,
             last,
@@ -363,6 +407,7 @@ fn solve_and_view<A: Accel>(
     let report = RadiosityReport {
         backend: accel.stats().backend,
         solver: settings.solver,
+        form_factors: settings.form_factors,
         patch_size: settings
             .patch_size
             .unwrap_or_else(|| default_patch_size(scene)),
