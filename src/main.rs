@@ -308,6 +308,9 @@ fn radiosity_run(a: &cli::RadiosityArgs) -> Result<()> {
             cli::FormFactorArg::Raycast => FormFactorMethod::RayCast,
             cli::FormFactorArg::Hemicube => FormFactorMethod::Hemicube(a.hemicube_res),
         },
+        subdiv_threshold: a.subdiv_threshold,
+        min_patch_size: a.min_patch_size,
+        subdiv_passes: a.subdiv_passes,
     };
     let (w, h) = a.res.unwrap_or((scene.camera.width, scene.camera.height));
     let spp = (a.spp as f32).sqrt().floor().max(1.0) as u32;

@@ -10,7 +10,7 @@ use emray::radiosity::formfactor::{
     point_to_polygon, Sampling,
 };
 use emray::radiosity::hemicube::Hemicube;
-use emray::radiosity::mesh::Mesh;
+use emray::radiosity::mesh::{longest_edge, Mesh};
 use emray::radiosity::{self, solver, FormFactorMethod, RadiositySettings, SolverKind};
 use emray::scene::{Camera, Material, Scene};
 
@@ -701,4 +701,132 @@ fn hemicube_and_ray_cast_solutions_agree_on_a_cornell_box() {
         mean < 0.03,
         "elements differ by {mean} of the largest on average"
     );
+}
+
+/// A floor under a small light, half of it shadowed by a horizontal blocker whose edge
+/// is over `x = 0.5`: the penumbra on the floor spans about `x` in 0.45..0.55.
+fn shadow_scene() -> Scene {
+    let mut s = Scene::new(camera());
+    s.ambient = Vec3::ZERO;
+    s.materials.push(Material {
+        color: Vec3::splat(0.6),
+        ..Material::DEFAULT
+    });
+    s.materials.push(Material {
+        color: Vec3::splat(0.6),
+        emission: Vec3::splat(20.0),
+        ..Material::DEFAULT
+    });
+    let up = |y: f32, x0: f32, x1: f32, z0: f32, z1: f32| {
+        [
+            Vec3::new(x0, y, z0),
+            Vec3::new(x0, y, z1),
+            Vec3::new(x1, y, z1),
+            Vec3::new(x1, y, z0),
+        ]
+    };
+    quad(&mut s, up(0.0, 0.0, 1.0, 0.0, 1.0), 0); // floor
+    quad(&mut s, up(0.5, 0.0, 0.5, 0.0, 1.0), 0); // blocker (its top faces up)
+    let mut light = up(0.99, 0.45, 0.55, 0.45, 0.55);
+    light.reverse(); // facing down
+    quad(&mut s, light, 1);
+    s
+}
+
+#[test]
+fn adaptive_subdivision_refines_the_shadow_boundary_without_cracks() {
+    let scene = shadow_scene();
+    let accel = Bvh::build(&scene);
+    let base = RadiositySettings {
+        patch_size: Some(0.26),
+        epsilon: 1e-2,
+        ..Default::default()
+    };
+    let uniform = radiosity::solve(&scene, &accel, &base).unwrap();
+    let sol = radiosity::solve(
+        &scene,
+        &accel,
+        &RadiositySettings {
+            subdiv_threshold: Some(0.2),
+            min_patch_size: Some(0.03),
+            subdiv_passes: 2,
+            ..base
+        },
+    )
+    .unwrap();
+    let m = &sol.mesh;
+    assert_eq!(
+        sol.solve.refinements.len(),
+        2,
+        "{:?}",
+        sol.solve.refinements
+    );
+    assert!(m.elements.len() > uniform.mesh.elements.len());
+    // Floor elements: finer at the shadow boundary than far from it.
+    let size = |near: bool| {
+        let sizes: Vec<f32> = m
+            .elements
+            .iter()
+            .filter(|e| e.centroid().y < 0.01)
+            .filter(|e| ((e.centroid().x - 0.5).abs() < 0.1) == near)
+            .filter(|e| near || (e.centroid().x - 0.5).abs() > 0.3)
+            .map(|e| longest_edge(&e.p))
+            .collect();
+        sizes.iter().sum::<f32>() / sizes.len() as f32
+    };
+    let (near, far) = (size(true), size(false));
+    assert!(
+        near < 0.5 * far,
+        "mean edge {near} at the boundary, {far} away"
+    );
+    // Power stays put (same light, same surfaces): within 3% of the uniform mesh's.
+    let power = |s: &radiosity::Solution| -> f64 {
+        s.mesh
+            .elements
+            .iter()
+            .zip(&s.solve.radiosity)
+            .map(|(e, b)| (b.x * e.area) as f64)
+            .sum()
+    };
+    let (a, b) = (power(&uniform), power(&sol));
+    assert!(
+        ((a - b) / a).abs() < 0.03,
+        "power {a} uniform, {b} adaptive"
+    );
+    // No cracks: wherever an element's corner lies inside another element's edge (a
+    // T-junction, found here by brute force), the corner's radiosity equals the
+    // coarser element's interpolation along that edge.
+    let corners: Vec<(Vec3, u32, Vec3)> = m
+        .elements
+        .iter()
+        .flat_map(|e| (0..3).map(move |c| (e.p[c], e.verts[c], e.n)))
+        .collect();
+    let v = &sol.vertex_radiosity;
+    let mut junctions = 0;
+    for e in &m.elements {
+        for k in 0..3 {
+            let (pa, pb) = (e.p[k], e.p[(k + 1) % 3]);
+            let (ba, bb) = (v[e.verts[k] as usize], v[e.verts[(k + 1) % 3] as usize]);
+            let d = pb - pa;
+            for &(q, vert, n) in &corners {
+                if n.dot(e.n) < 0.999 {
+                    continue;
+                }
+                let t = (q - pa).dot(d) / d.length_squared();
+                if !(0.01..0.99).contains(&t) || (pa + d * t - q).length() > 1e-6 {
+                    continue;
+                }
+                junctions += 1;
+                let along = ba * (1.0 - t) + bb * t;
+                let here = v[vert as usize];
+                assert!(
+                    (here - along).abs().max_element() <= 1e-5 * along.max_element().max(1.0),
+                    "T-junction at {q}: vertex {here}, edge {along}"
+                );
+            }
+        }
+    }
+    assert!(junctions > 0, "no T-junction to check");
+    // The same through the mesh's own list.
+    assert!(!m.hanging_vertices().is_empty());
 }

@@ -88,6 +88,14 @@ pub struct RadiositySettings {
     pub solver: SolverKind,
     /// Form-factor method.
     pub form_factors: FormFactorMethod,
+    /// Adaptive subdivision: after a solve, split the elements whose radiosity differs
+    /// from a neighbour's by more than this fraction of the largest reflected radiosity,
+    /// and solve again; `None`: uniform mesh.
+    pub subdiv_threshold: Option<f32>,
+    /// Smallest element edge adaptive subdivision makes; `None`: 1/8 of the patch size.
+    pub min_patch_size: Option<f32>,
+    /// Most rounds of adaptive subdivision.
+    pub subdiv_passes: u32,
 }
 
 impl Default for RadiositySettings {
@@ -100,6 +108,9 @@ impl Default for RadiositySettings {
             max_iterations: 1_000_000,
             solver: SolverKind::Progressive,
             form_factors: FormFactorMethod::RayCast,
+            subdiv_threshold: None,
+            min_patch_size: None,
+            subdiv_passes: 3,
         }
     }
 }
@@ -146,11 +157,17 @@ impl Solution {
                 weight[v as usize] += e.area;
             }
         }
-        let vertex_radiosity = sum
+        let mut vertex_radiosity: Vec<Vec3> = sum
             .iter()
             .zip(&weight)
             .map(|(&s, &w)| if w > 0.0 { s / w } else { Vec3::ZERO })
             .collect();
+        // T-junctions: a vertex inside a coarser element's edge takes the value the
+        // coarser element interpolates there, so the shading has no crack.
+        for (m, a, b) in mesh.hanging_vertices() {
+            let v = &mut vertex_radiosity;
+            v[m as usize] = (v[a as usize] + v[b as usize]) * 0.5;
+        }
         Solution {
             mesh,
             solve,
@@ -220,12 +237,78 @@ pub fn solve<A: Accel>(
         Some(p) => p,
         None => default_patch_size(scene),
     };
-    let mesh = Mesh::build(scene, patch)?;
+    let mut mesh = Mesh::build(scene, patch)?;
     if mesh.elements.is_empty() {
         return Err(RadiosityError::Empty);
     }
-    let solve = solve_mesh(&mesh, accel, settings)?;
+    let mut solve = solve_mesh(&mesh, accel, settings)?;
+    let (mut form_factor_ms, mut total_ms, mut refinements) =
+        (solve.form_factor_ms, solve.total_ms, Vec::new());
+    if let Some(threshold) = settings.subdiv_threshold {
+        let min = settings.min_patch_size.unwrap_or(patch / 8.0);
+        if !(threshold.is_finite() && threshold > 0.0 && min.is_finite() && min > 0.0) {
+            return Err(RadiosityError::Settings(format!(
+                "subdivision threshold {threshold} and minimum patch size {min} must be positive"
+            )));
+        }
+        for _ in 0..settings.subdiv_passes {
+            let marked = marked_for_split(&mesh, &solve.radiosity, threshold, min);
+            if marked.is_empty() {
+                break;
+            }
+            mesh.split(&marked)?;
+            refinements.push(marked.len());
+            // A fresh solve on the refined mesh: every element starts with its emission
+            // unshot, so the energy bookkeeping is that of a first solve.
+            solve = solve_mesh(&mesh, accel, settings)?;
+            form_factor_ms += solve.form_factor_ms;
+            total_ms += solve.total_ms;
+        }
+    }
+    solve.form_factor_ms = form_factor_ms;
+    solve.total_ms = total_ms;
+    solve.refinements = refinements;
     Ok(Solution::new(mesh, solve))
+}
+
+/// The elements to split: those whose radiosity differs from a neighbour's (an element
+/// sharing a corner, on any plane) by more than `threshold` times the largest radiosity
+/// of a non-emitting element, in some channel, and whose halves would still have edges
+/// of at least `min`. Emitters are not split.
+pub fn marked_for_split(mesh: &Mesh, radiosity: &[Vec3], threshold: f32, min: f32) -> Vec<usize> {
+    let emits = |k: usize| mesh.emission[mesh.elements[k].material as usize].max_element() > 0.0;
+    let scale = (0..mesh.elements.len())
+        .filter(|&k| !emits(k))
+        .map(|k| radiosity[k].max_element())
+        .fold(0.0f32, f32::max);
+    if scale <= 0.0 {
+        return Vec::new();
+    }
+    let mut at: std::collections::HashMap<[u32; 3], Vec<usize>> = Default::default();
+    for (k, e) in mesh.elements.iter().enumerate() {
+        if !emits(k) {
+            for p in e.p {
+                at.entry(p.to_array().map(f32::to_bits))
+                    .or_default()
+                    .push(k);
+            }
+        }
+    }
+    let mut mark = vec![false; mesh.elements.len()];
+    for around in at.values() {
+        for (x, &i) in around.iter().enumerate() {
+            for &j in &around[x + 1..] {
+                let d = (radiosity[i] - radiosity[j]).abs().max_element();
+                if d > threshold * scale {
+                    mark[i] = true;
+                    mark[j] = true;
+                }
+            }
+        }
+    }
+    (0..mesh.elements.len())
+        .filter(|&k| mark[k] && mesh::longest_edge(&mesh.elements[k].p) * 0.5 >= min)
+        .collect()
 }
 
 /// Solve the radiosity system of `mesh` with the settings' form factors and solver.
@@ -334,8 +417,10 @@ pub struct RadiosityReport {
     pub form_factors: FormFactorMethod,
     /// Patch size used.
     pub patch_size: f32,
-    /// Elements.
+    /// Elements (after adaptive subdivision).
     pub elements: usize,
+    /// Elements split in each round of adaptive subdivision.
+    pub refinements: Vec<usize>,
     /// Shared vertices.
     pub vertices: usize,
     /// Analytic primitives left out of the mesh.
@@ -373,6 +458,7 @@ impl RadiosityReport {
         };
         format!(
             "backend    {}\nmesh       {} elements, {} vertices (patch size {}), {} analytic primitives not meshed\n\
+             subdivide  {:?} elements split per round\n\
              ff         {}\n\
              solver     {:?}: {} iterations, final residual {:.3e}\n\
              time       build {:.1} ms, form factors {:.1} ms, solve {:.1} ms, view {:.1} ms",
@@ -381,6 +467,7 @@ impl RadiosityReport {
             self.vertices,
             self.patch_size,
             self.unmeshed,
+            self.refinements,
             method,
             self.solver,
             self.iterations,
@@ -412,6 +499,7 @@ fn solve_and_view<A: Accel>(
             .patch_size
             .unwrap_or_else(|| default_patch_size(scene)),
         elements: sol.mesh.elements.len(),
+        refinements: sol.solve.refinements.clone(),
         vertices: sol.mesh.vertices.len(),
         unmeshed: sol.mesh.unmeshed,
         shooter_samples: 1 << (2 * settings.shooter_level),

@@ -32,6 +32,9 @@ pub struct Solve {
     pub form_factor_ms: f64,
     /// Milliseconds for the whole solve.
     pub total_ms: f64,
+    /// Elements split in each round of adaptive subdivision (each round is followed by
+    /// a fresh solve; the other fields describe the last one, the times cover all).
+    pub refinements: Vec<usize>,
 }
 
 fn power(v: Vec3) -> f64 {
