@@ -30,6 +30,11 @@ pub const DEFAULT_RES: u32 = 128;
 /// Largest resolution accepted.
 pub const MAX_RES: u32 = 4096;
 
+/// How far outside a triangle (in barycentric weight) a pixel centre may be and still
+/// count: a pixel centre on an edge shared by two triangles must not slip between
+/// them through rounding; if both take it, the depth test keeps one.
+const SLACK: f32 = 1e-5;
+
 /// No element seen through a pixel.
 const NONE: u32 = u32::MAX;
 
@@ -174,28 +179,28 @@ impl Hemicube {
                 (l, el.n.dot(x - el.p[0]) > 0.0)
             })
             .collect();
-        let per_face: Vec<Vec<(u32, f32)>> = FACES
+        let per_face: Vec<Vec<f32>> = FACES
             .par_iter()
             .map(|face| self.face(face, &local, near.max(f32::MIN_POSITIVE), skip))
             .collect();
         let mut row = vec![0.0f32; mesh.elements.len()];
-        for hits in per_face {
-            for (j, f) in hits {
-                row[j as usize] += f;
+        for sums in per_face {
+            for (r, f) in row.iter_mut().zip(sums) {
+                *r += f;
             }
         }
         row
     }
 
     /// Rasterise every element onto one face; the delta form factors summed per
-    /// visible element, as `(element, form factor)` pairs.
+    /// visible element.
     fn face(
         &self,
         face: &Face,
         local: &[([Vec3; 3], bool)],
         near: f32,
         skip: Option<usize>,
-    ) -> Vec<(u32, f32)> {
+    ) -> Vec<f32> {
         let width = self.res;
         let height = if face.top { self.res } else { self.res / 2 };
         let mut depth = vec![0.0f32; width * height];
@@ -207,6 +212,9 @@ impl Hemicube {
                 continue;
             }
             // (depth, u, v) per corner, clipped to depth ≥ near.
+            if l.iter().all(|p| p.z <= 0.0) {
+                continue;
+            }
             let cuv = l.map(|p| {
                 let a = p.to_array();
                 Vec3::new(face.sign * a[face.depth], a[face.u], a[face.v])
@@ -246,13 +254,13 @@ impl Hemicube {
             }
         }
         let table = if face.top { &self.top } else { &self.side };
-        let mut sums: std::collections::HashMap<u32, f32> = std::collections::HashMap::new();
-        for (p, &j) in item.iter().enumerate() {
+        let mut sums = vec![0.0f32; local.len()];
+        for (&j, &d) in item.iter().zip(table) {
             if j != NONE {
-                *sums.entry(j).or_insert(0.0) += table[p];
+                sums[j as usize] += d;
             }
         }
-        sums.into_iter().collect()
+        sums
     }
 }
 
@@ -272,19 +280,26 @@ fn raster(t: [Vec3; 3], width: usize, height: usize, id: u32, depth: &mut [f32],
     if x0 > x1 || y0 > y1 {
         return;
     }
+    // Barycentric weights as edge functions a (x - o.x) + b (y - o.y) from a corner o
+    // of each edge (well conditioned even for huge clipped triangles), normalised by
+    // the signed area so that all three are ≥ 0 inside whatever the winding.
     let inv = 1.0 / area;
-    let edge = |a: Vec3, b: Vec3, x: f32, y: f32| (b.x - a.x) * (y - a.y) - (x - a.x) * (b.y - a.y);
+    let edge = |p: Vec3, q: Vec3| ((p.y - q.y) * inv, (q.x - p.x) * inv, p);
+    let e = [edge(t[1], t[2]), edge(t[2], t[0]), edge(t[0], t[1])];
     for py in y0 as usize..=y1 as usize {
         let y = py as f32 + 0.5;
+        let row = e.map(|(_, b, o)| b * (y - o.y));
         for px in x0 as usize..=x1 as usize {
             let x = px as f32 + 0.5;
-            let w0 = edge(t[1], t[2], x, y) * inv;
-            let w1 = edge(t[2], t[0], x, y) * inv;
-            let w2 = edge(t[0], t[1], x, y) * inv;
-            if w0 < 0.0 || w1 < 0.0 || w2 < 0.0 {
+            let w = [
+                e[0].0 * (x - e[0].2.x) + row[0],
+                e[1].0 * (x - e[1].2.x) + row[1],
+                e[2].0 * (x - e[2].2.x) + row[2],
+            ];
+            if w[0] < -SLACK || w[1] < -SLACK || w[2] < -SLACK {
                 continue;
             }
-            let z = w0 * t[0].z + w1 * t[1].z + w2 * t[2].z;
+            let z = w[0] * t[0].z + w[1] * t[1].z + w[2] * t[2].z;
             let p = py * width + px;
             if z > depth[p] {
                 depth[p] = z;
