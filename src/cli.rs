@@ -413,8 +413,9 @@ pub struct RenderArgs {
     #[arg(long, value_name = "SIZE", value_parser = emray::batch::limits::parse_size)]
     pub max_memory: Option<u64>,
     /// Environment map for rays that leave the scene (PNG/JPEG: 2:1 latitude-longitude
-    /// or a 4:3 cube cross), replacing the scene's own.
-    #[arg(long, value_name = "FILE")]
+    /// or a 4:3 cube cross, or a directory of six cube faces px, nx, py, ny, pz, nz),
+    /// replacing the scene's own.
+    #[arg(long, value_name = "FILE|DIR")]
     pub envmap: Option<PathBuf>,
     /// No progress bar and no messages but errors.
     #[arg(short, long)]

@@ -3,13 +3,13 @@
 //! bump normal against the analytic tilt, a mirror sphere against the environment
 //! texel behind the camera, OBJ `vt`/MTL maps as documented, and backend agreement.
 
-use emray::accel::Backend;
+use emray::accel::{Accel, Backend};
 use emray::geometry::{inverse_bilinear, Kind, Sphere, Triangle};
 use emray::load::obj::{load_geometry, MISSING_TEXTURE};
 use emray::math::{Ray, Vec3};
 use emray::render::RenderSettings;
-use emray::run::render_scene;
-use emray::scene::texture::{bump_normal, Image, Wrap};
+use emray::run::{render_scene, with_accel, WithAccel};
+use emray::scene::texture::{bump_normal, srgb_to_linear, Image, Wrap, NO_TEXTURE};
 use emray::scene::{Camera, Environment, Light, Maps, Material, Scene, Texture};
 use emray::Hit;
 use glam::Vec2;
@@ -338,12 +338,307 @@ fn mirror_sphere_centre_pixel_shows_the_texel_behind_the_camera() {
     }
 }
 
+/// Face colours of the six-file cube map (+x, −x, +y, −y, +z, −z), sRGB bytes.
+const FACE_COLOURS: [[u8; 3]; 6] = [
+    [250, 30, 30],
+    [30, 250, 30],
+    [30, 30, 250],
+    [250, 250, 30],
+    [30, 250, 250],
+    [250, 30, 250],
+];
+/// The −z face's outer quadrants: top-left, top-right, bottom-left, bottom-right.
+const NZ_QUADRANTS: [[u8; 3]; 4] = [[120, 0, 0], [0, 120, 0], [0, 0, 120], [120, 120, 0]];
+
+fn linear(c: [u8; 3]) -> Vec3 {
+    Vec3::from(c.map(|v| srgb_to_linear(f32::from(v) / 255.0)))
+}
+
+/// A six-file cube map, each face 16 × 16 in its colour; on the −z face only the
+/// central 4 × 4 texels, the rest being one colour per quadrant (to check the face's
+/// orientation). `ext` per face.
+fn write_cube(dir: &Path, ext: [&str; 6]) {
+    for (k, name) in emray::scene::texture::CUBE_FACES.iter().enumerate() {
+        write_png(&dir.join(format!("{name}.{}", ext[k])), 16, 16, |x, y| {
+            let centre = (6..10).contains(&x) && (6..10).contains(&y);
+            if k == 5 && !centre {
+                NZ_QUADRANTS[usize::from(y >= 8) * 2 + usize::from(x >= 8)]
+            } else {
+                FACE_COLOURS[k]
+            }
+        });
+    }
+}
+
+/// A mirror sphere in a six-file cube map, seen from each axis: its centre pixel shows
+/// the face straight behind the camera; the background seen along −z shows the −z
+/// face upright (+y up, +x right). The same cube map from a directory (`--envmap DIR`,
+/// `[render] environment`), from MTL `refl -type cube_*`, on both backends.
+#[test]
+fn six_file_cube_map_faces_are_seen_in_their_directions() {
+    let dir = TempDir::new().unwrap();
+    let sky = dir.path().join("sky");
+    std::fs::create_dir(&sky).unwrap();
+    write_cube(&sky, ["png"; 6]);
+    let env = Environment::load(&sky).unwrap();
+    let axes = [Vec3::X, -Vec3::X, Vec3::Y, -Vec3::Y, Vec3::Z, -Vec3::Z];
+    for (k, a) in axes.into_iter().enumerate() {
+        let mut s = mirror_scene(a * 6.0, env.clone());
+        s.camera.angle_deg = 60.0;
+        if a.y != 0.0 {
+            s.camera.up = Vec3::Z;
+        }
+        for b in backends() {
+            let film = render_scene("t", &s, b, &RenderSettings::for_scene(&s), 0.0, None)
+                .unwrap()
+                .0;
+            let want = linear(FACE_COLOURS[k]);
+            let got = film.get(2, 2);
+            assert!(close(got, want, 1e-4), "{b:?} from {a}: {got} vs {want}");
+            if k == 4 {
+                // Looking along −z past the sphere: the −z face's quadrants.
+                for (q, (i, j)) in [(0, 0), (4, 0), (0, 4), (4, 4)].into_iter().enumerate() {
+                    let want = linear(NZ_QUADRANTS[q]);
+                    let got = film.get(i, j);
+                    assert!(close(got, want, 1e-4), "{b:?} pixel ({i}, {j}): {got}");
+                }
+            }
+        }
+    }
+
+    // MTL: the six faces as `refl -type cube_*` give the same map.
+    let faces = [
+        ("cube_right", "px"),
+        ("cube_left", "nx"),
+        ("cube_top", "py"),
+        ("cube_bottom", "ny"),
+        ("cube_back", "pz"),
+        ("cube_front", "nz"),
+    ];
+    let mut mtl = String::from("newmtl m\nKd 1 1 1\n");
+    for (t, f) in faces {
+        mtl += &format!("refl -type {t} sky/{f}.png\n");
+    }
+    std::fs::write(dir.path().join("m.mtl"), &mtl).unwrap();
+    let obj = "mtllib m.mtl\nv 0 0 0\nv 1 0 0\nv 0 1 0\nusemtl m\nf 1 2 3\n";
+    std::fs::write(dir.path().join("c.obj"), obj).unwrap();
+    let data = load_geometry(&dir.path().join("c.obj")).unwrap();
+    assert!(data.warnings.is_empty(), "{:?}", data.warnings);
+    assert!(
+        data.environment.as_ref() == Some(&env),
+        "MTL cube map differs"
+    );
+    // One face missing: a warning naming it, no environment.
+    std::fs::write(
+        dir.path().join("m.mtl"),
+        mtl.replace("refl -type cube_top sky/py.png\n", ""),
+    )
+    .unwrap();
+    let data = load_geometry(&dir.path().join("c.obj")).unwrap();
+    assert!(data.environment.is_none());
+    assert!(
+        data.warnings.iter().any(|w| w.contains("missing cube_top")),
+        "{:?}",
+        data.warnings
+    );
+
+    // The scene format: a directory as `[render] environment`.
+    let toml = "[camera]\nfrom = [0, 0, 5]\nat = [0, 0, 0]\nfov = 40\nresolution = [4, 4]\n\n\
+                [render]\nenvironment = \"sky\"\n";
+    std::fs::write(dir.path().join("s.toml"), toml).unwrap();
+    let scene = emray::load::load_path(&dir.path().join("s.toml")).unwrap();
+    assert!(
+        scene.environment.as_ref() == Some(&env),
+        "TOML cube map differs"
+    );
+
+    // A face of another size, and a missing face, are errors naming the file.
+    write_png(&sky.join("py.png"), 8, 8, |_, _| [0, 0, 0]);
+    let e = Environment::load(&sky).unwrap_err();
+    assert!(e.contains("py is 8 × 8"), "{e}");
+    std::fs::remove_file(sky.join("py.png")).unwrap();
+    let e = Environment::load(&sky).unwrap_err();
+    assert!(e.contains("py.png"), "{e}");
+}
+
 fn write_png(path: &Path, w: u32, h: u32, f: impl Fn(u32, u32) -> [u8; 3]) {
     let mut img = image::RgbImage::new(w, h);
     for (x, y, p) in img.enumerate_pixels_mut() {
         *p = image::Rgb(f(x, y));
     }
     img.save(path).unwrap();
+}
+
+/// A JPEG texture decodes (sRGB to linear for colour maps, as-is for data maps): four
+/// flat 16 × 16 blocks (one chroma block each, so subsampling does not mix them) come
+/// back within JPEG's loss, read both through `Image::load` and an MTL `map_Kd`.
+#[test]
+fn jpeg_textures_decode_within_the_codec_loss() {
+    use image::codecs::jpeg::JpegEncoder;
+    let dir = TempDir::new().unwrap();
+    let colours: [[u8; 3]; 4] = [[200, 40, 30], [20, 180, 60], [40, 60, 220], [230, 230, 40]];
+    let block = |x: u32, y: u32| colours[(2 * (y / 16) + x / 16) as usize];
+    let mut img = image::RgbImage::new(32, 32);
+    for (x, y, p) in img.enumerate_pixels_mut() {
+        *p = image::Rgb(block(x, y));
+    }
+    // A `.tex` name: the format is recognised from the content, not the extension.
+    let path = dir.path().join("blocks.tex");
+    let mut bytes = Vec::new();
+    JpegEncoder::new_with_quality(&mut bytes, 95)
+        .encode_image(&img)
+        .unwrap();
+    assert_eq!(&bytes[..2], &[0xFF, 0xD8], "a JPEG stream");
+    std::fs::write(&path, &bytes).unwrap();
+    let tol = 4.0 / 255.0;
+    let colour = Image::load(&path, true).unwrap();
+    let data = Image::load(&path, false).unwrap();
+    assert_eq!((colour.width(), colour.height()), (32, 32));
+    for j in (2..32).step_by(4) {
+        for i in (2..32).step_by(4) {
+            let want = Vec3::from(block(i, j).map(|c| f32::from(c) / 255.0));
+            let got = data.texel(i64::from(i), i64::from(j));
+            assert!(
+                close(got, want, tol),
+                "data texel ({i}, {j}): {got} vs {want}"
+            );
+            let lin = want.to_array().map(srgb_to_linear);
+            let got = colour.texel(i64::from(i), i64::from(j));
+            assert!(
+                close(got, Vec3::from(lin), tol),
+                "colour texel ({i}, {j}): {got} vs {lin:?}"
+            );
+        }
+    }
+    // Through an OBJ material: the quad's lower-left corner (vt 0 0) is the bottom-left
+    // block, texel (4, 28).
+    std::fs::write(
+        dir.path().join("m.mtl"),
+        "newmtl tex\nKd 1 1 1\nmap_Kd blocks.tex\n",
+    )
+    .unwrap();
+    std::fs::write(
+        dir.path().join("q.obj"),
+        "mtllib m.mtl\nv 0 0 0\nv 1 0 0\nv 1 1 0\nv 0 1 0\nvt 0 0\nvt 1 0\nvt 1 1\n\
+         vt 0 1\nusemtl tex\nf 1/1 2/2 3/3 4/4\n",
+    )
+    .unwrap();
+    let loaded = load_geometry(&dir.path().join("q.obj")).unwrap();
+    assert!(loaded.warnings.is_empty(), "{:?}", loaded.warnings);
+    let m = loaded.materials.iter().find(|m| m.maps.color != NO_TEXTURE);
+    let index = m.expect("the JPEG map_Kd is loaded").maps.color as usize;
+    match &loaded.textures[index] {
+        Texture::Image(img) => assert_eq!(img.texel(4, 28), colour.texel(4, 28)),
+        t => panic!("not an image texture: {t:?}"),
+    }
+}
+
+/// A convex quad that is not a parallelogram, textured (a checker image) with the unit
+/// square's `vt`.
+const KITE_OBJ: &str = "\
+mtllib m.mtl
+v 0 0 0
+v 4 0 0
+v 2 4 0
+v 0 2 0
+vt 0 0
+vt 1 0
+vt 1 1
+vt 0 1
+usemtl checker
+f 1/1 2/2 3/3 4/4
+";
+const KITE: [Vec3; 4] = [
+    Vec3::new(0.0, 0.0, 0.0),
+    Vec3::new(4.0, 0.0, 0.0),
+    Vec3::new(2.0, 4.0, 0.0),
+    Vec3::new(0.0, 2.0, 0.0),
+];
+
+fn bilinear_point(q: [Vec3; 4], s: f32, t: f32) -> Vec3 {
+    (q[0] * (1.0 - s) + q[1] * s) * (1.0 - t) + (q[3] * (1.0 - s) + q[2] * s) * t
+}
+
+/// For each ray, the texture coordinates the scene gives its hit, and the ones the hit
+/// triangle's own barycentric `vt` interpolation would give.
+struct UvAtHits<'a> {
+    scene: &'a Scene,
+    rays: &'a [Ray],
+}
+
+impl WithAccel for UvAtHits<'_> {
+    type Output = Vec<(Vec2, Vec2)>;
+    fn run<A: Accel>(self, accel: &A, _: f64) -> Self::Output {
+        let g = &self.scene.geometry;
+        self.rays
+            .iter()
+            .map(|ray| {
+                let hit = accel.intersect(ray).expect("the ray hits the quad");
+                let surf = self.scene.surface(&hit, ray);
+                let uv = surf.param.expect("a textured material").uv;
+                let i = hit.prim_id as usize;
+                let vt = &g.vertex_uvs[g.triangle_uvs[i] as usize];
+                let bary = g.triangles.items[i].param(hit.u, hit.v, Some(vt)).uv;
+                (uv, bary)
+            })
+            .collect()
+    }
+}
+
+/// The `(u, v)` of an OBJ quad face come from its bilinear patch: a texture line (here
+/// `u = s` for fixed `s`) is the straight segment of the patch, where barycentric `vt`
+/// interpolation on the two triangles bends it at the diagonal. Directly and through a
+/// transformed TOML include, on both backends.
+#[test]
+fn quad_faces_take_the_inverse_bilinear_uv() {
+    let dir = TempDir::new().unwrap();
+    write_png(&dir.path().join("c.png"), 8, 8, |x, y| {
+        if (x + y) % 2 == 0 {
+            [255, 255, 255]
+        } else {
+            [0, 0, 0]
+        }
+    });
+    std::fs::write(
+        dir.path().join("m.mtl"),
+        "newmtl checker\nKd 1 1 1\nmap_Kd c.png\n",
+    )
+    .unwrap();
+    std::fs::write(dir.path().join("q.obj"), KITE_OBJ).unwrap();
+    std::fs::write(
+        dir.path().join("s.toml"),
+        "[camera]\nfrom = [0, 0, 10]\nat = [0, 0, 0]\nfov = 40\nresolution = [8, 8]\n\n\
+         [[objects]]\ntype = \"include\"\nfile = \"q.obj\"\n\
+         transform = [{ scale = 2 }, { translate = [1, 0, 0] }]\n",
+    )
+    .unwrap();
+    let obj = emray::load::load_path(&dir.path().join("q.obj")).unwrap();
+    assert_eq!(obj.geometry.quads.len(), 1, "one quad record");
+    let toml = emray::load::load_path(&dir.path().join("s.toml")).unwrap();
+    let placed = KITE.map(|p| p * 2.0 + Vec3::X);
+    let samples: Vec<(f32, f32)> = [0.25f32, 0.5, 0.8]
+        .iter()
+        .flat_map(|&s| (1..10).map(move |k| (s, k as f32 / 10.0)))
+        .collect();
+    for (scene, quad) in [(&obj, KITE), (&toml, placed)] {
+        let rays: Vec<Ray> = samples
+            .iter()
+            .map(|&(s, t)| Ray::new(bilinear_point(quad, s, t) + Vec3::Z * 5.0, -Vec3::Z))
+            .collect();
+        for backend in backends() {
+            let settings = RenderSettings::for_scene(scene);
+            let work = UvAtHits { scene, rays: &rays };
+            let got = with_accel(scene, backend, &settings, work).unwrap();
+            let mut bend = 0.0f32;
+            for (&(s, t), (uv, bary)) in samples.iter().zip(&got) {
+                let err = (*uv - Vec2::new(s, t)).abs().max_element();
+                assert!(err < 1e-4, "{backend:?}: ({s}, {t}) got {uv}");
+                bend = bend.max((bary.x - s).abs());
+            }
+            // The barycentric version is off the straight line by far more.
+            assert!(bend > 0.05, "{backend:?}: barycentric bend only {bend}");
+        }
+    }
 }
 
 const QUAD_OBJ: &str = "\

@@ -329,6 +329,71 @@ pub fn inverse_bilinear(p: Vec3, q: [Vec3; 4]) -> Option<Vec2> {
     None
 }
 
+/// A planar, convex quadrilateral face with texture coordinates at its corners, in
+/// order: its points take the `(u, v)` of the bilinear patch through the corners (the
+/// inverse bilinear map, then bilinear interpolation of the corners' `uv`), not the
+/// per-triangle barycentric interpolation, which bends texture lines along the diagonal
+/// of any quad that is not a parallelogram.
+#[derive(Clone, Copy, Debug, PartialEq)]
+pub struct QuadUv {
+    /// Corners, in the face's order.
+    pub p: [Vec3; 4],
+    /// Texture coordinates of the corners.
+    pub uv: [Vec2; 4],
+}
+
+impl QuadUv {
+    /// The record of the quad `p` with texture coordinates `uv`, or `None` unless it is
+    /// convex (every corner turns the same way about its normal) and planar within
+    /// 10⁻⁴ of its size (the distance of the diagonals from each other).
+    pub fn new(p: [Vec3; 4], uv: [Vec2; 4]) -> Option<QuadUv> {
+        let d = |v: Vec3| v.as_dvec3();
+        let q = p.map(d);
+        let n = (q[2] - q[0]).cross(q[3] - q[1]);
+        let len = n.length();
+        if !(len > 0.0 && len.is_finite()) {
+            return None;
+        }
+        let n = n / len;
+        for k in 0..4 {
+            let (a, b, c) = (q[k], q[(k + 1) % 4], q[(k + 2) % 4]);
+            if (b - a).cross(c - b).dot(n) <= 0.0 {
+                return None;
+            }
+        }
+        // The diagonals lie in parallel planes (normal n); their distance is the twist.
+        let size = (q[2] - q[0]).length().max((q[3] - q[1]).length());
+        if (q[1] - q[0]).dot(n).abs() > 1e-4 * size {
+            return None;
+        }
+        uv.iter().all(|t| t.is_finite()).then_some(QuadUv { p, uv })
+    }
+
+    /// The parameterisation at `x`, a point on the quad: `None` when `x` maps outside
+    /// it or the corners' texture coordinates are degenerate there (the caller falls
+    /// back to the triangle's own).
+    pub fn param(&self, x: Vec3) -> Option<Param> {
+        let st = inverse_bilinear(x, self.p)?;
+        let (s, t) = (st.x, st.y);
+        let [p0, p1, p2, p3] = self.p;
+        let [t0, t1, t2, t3] = self.uv;
+        let uv = (t0 * (1.0 - s) + t1 * s) * (1.0 - t) + (t3 * (1.0 - s) + t2 * s) * t;
+        let dp_ds = (p1 - p0) * (1.0 - t) + (p2 - p3) * t;
+        let dp_dt = (p3 - p0) * (1.0 - s) + (p2 - p1) * s;
+        let duv_ds = (t1 - t0) * (1.0 - t) + (t2 - t3) * t;
+        let duv_dt = (t3 - t0) * (1.0 - s) + (t2 - t1) * s;
+        // [∂p/∂u ∂p/∂v] = [∂p/∂s ∂p/∂t] J⁻¹ with J the Jacobian of (u, v) in (s, t).
+        let det = duv_ds.x * duv_dt.y - duv_dt.x * duv_ds.y;
+        if det == 0.0 || !det.is_finite() {
+            return None;
+        }
+        let dpdu = (dp_ds * duv_dt.y - dp_dt * duv_ds.y) / det;
+        let dpdv = (dp_dt * duv_ds.x - dp_ds * duv_dt.x) / det;
+        let ok = dpdu.is_finite() && dpdv.is_finite() && dpdu.cross(dpdv) != Vec3::ZERO;
+        ok.then_some(Param { uv, dpdu, dpdv })
+    }
+}
+
 #[cfg(test)]
 mod tests {
     use super::*;
@@ -419,6 +484,24 @@ mod tests {
         let flat = [Vec2::ZERO; 3];
         let p = tri.param(0.2, 0.2, Some(&flat));
         assert_frame_outward(&p, Vec3::Z);
+    }
+
+    #[test]
+    fn quad_record_needs_a_planar_convex_quad() {
+        let sq = [Vec3::ZERO, Vec3::X, Vec3::new(1.0, 1.0, 0.0), Vec3::Y];
+        let uv = [Vec2::ZERO, Vec2::X, Vec2::ONE, Vec2::Y];
+        let q = QuadUv::new(sq, uv).expect("a square");
+        let prm = q.param(Vec3::new(0.25, 0.5, 0.0)).unwrap();
+        assert!((prm.uv - Vec2::new(0.25, 0.5)).length() < 1e-6);
+        assert!((prm.dpdu - Vec3::X).length() < 1e-6 && (prm.dpdv - Vec3::Y).length() < 1e-6);
+        // Concave (corner 2 pushed inside), twisted, degenerate: no record.
+        let concave = [sq[0], sq[1], Vec3::new(0.3, 0.3, 0.0), sq[3]];
+        assert!(QuadUv::new(concave, uv).is_none());
+        let twisted = [sq[0], sq[1], Vec3::new(1.0, 1.0, 0.1), sq[3]];
+        assert!(QuadUv::new(twisted, uv).is_none());
+        assert!(QuadUv::new([Vec3::ZERO; 4], uv).is_none());
+        // Clockwise order is as good as counter-clockwise.
+        assert!(QuadUv::new([sq[0], sq[3], sq[2], sq[1]], uv).is_some());
     }
 
     #[test]

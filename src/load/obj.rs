@@ -67,7 +67,10 @@
 //!   multiplied by it; the material keeps the last one given) are used; the others
 //!   (`-o`, `-t`, `-mm`, `-blendu`, ...) are skipped with a warning.
 //! - `refl` with a 2:1 latitude-longitude or 4:3 cube-cross image becomes the scene's
-//!   environment map (the first one that loads; a command-line `--envmap` wins).
+//!   environment map (the first one that loads; a command-line `--envmap` wins). Six
+//!   `refl -type cube_right|cube_left|cube_top|cube_bottom|cube_back|cube_front FILE`
+//!   statements (the faces +x, −x, +y, −y, +z, −z: the front is −z) make a cube map
+//!   instead, used when no single-image `refl` loads; a missing face is a warning.
 //! - Other maps (`map_Ka`, `map_d`, `map_Ns`, `disp`, `decal`) are skipped with one
 //!   warning per library.
 //! - A map whose file cannot be read is a warning naming the file and the library's
@@ -135,7 +138,7 @@
 
 use super::LoadError;
 use crate::geometry::polygon::Triangulator;
-use crate::geometry::Triangle;
+use crate::geometry::{QuadUv, Triangle};
 use crate::math::{Aabb, DVec3, Vec3};
 use crate::scene::texture::{Image, Wrap};
 use crate::scene::{Camera, Environment, Geometry, Light, LoadStats, Material, Scene, Texture};
@@ -1031,6 +1034,17 @@ enum MapKind {
     Reflection,
 }
 
+/// `refl -type` of the cube faces +x, −x, +y, −y, +z, −z: the front is −z (where a
+/// camera with the default orientation looks), the right +x, the top +y.
+const CUBE_TYPES: [&str; 6] = [
+    "cube_right",
+    "cube_left",
+    "cube_top",
+    "cube_bottom",
+    "cube_back",
+    "cube_front",
+];
+
 /// A texture statement of a material.
 #[derive(Clone, Debug)]
 struct TexStmt {
@@ -1046,6 +1060,8 @@ struct TexStmt {
     clamp: bool,
     /// `-s u v`.
     scale: [f32; 2],
+    /// For `refl -type cube_*`: the face, +x −x +y −y +z −z as 0..6.
+    cube: Option<usize>,
     /// Where: `library:line`.
     at: String,
 }
@@ -1057,6 +1073,7 @@ fn parse_map(words: &[&str]) -> Result<MapOptions, String> {
     let mut scale = [1.0f32, 1.0];
     let mut clamp = false;
     let mut ignored = Vec::new();
+    let mut map_type = None;
     let mut i = 0;
     let number = |t: &str| t.parse::<f32>().ok().filter(|v| v.is_finite());
     while i < words.len() && words[i].starts_with('-') && number(words[i]).is_none() {
@@ -1074,7 +1091,11 @@ fn parse_map(words: &[&str]) -> Result<MapOptions, String> {
                 clamp = arg(i) == Some("on");
                 i += 1;
             }
-            "-blendu" | "-blendv" | "-boost" | "-cc" | "-imfchan" | "-texres" | "-type" => {
+            "-type" => {
+                map_type = arg(i).map(str::to_string);
+                i += 1;
+            }
+            "-blendu" | "-blendv" | "-boost" | "-cc" | "-imfchan" | "-texres" => {
                 ignored.push(opt.to_string());
                 i += 1;
             }
@@ -1110,6 +1131,7 @@ fn parse_map(words: &[&str]) -> Result<MapOptions, String> {
         bump_scale: bm,
         clamp,
         scale,
+        map_type,
         ignored,
     })
 }
@@ -1120,6 +1142,8 @@ struct MapOptions {
     bump_scale: f32,
     clamp: bool,
     scale: [f32; 2],
+    /// `-type` (used by `refl`: `sphere` or `cube_top`, ...).
+    map_type: Option<String>,
     ignored: Vec<String>,
 }
 
@@ -1230,8 +1254,30 @@ fn sanitize_mtl(
                         bump_scale,
                         clamp,
                         scale,
-                        ignored,
+                        map_type,
+                        mut ignored,
                     }) => {
+                        let mut cube = None;
+                        match map_type.as_deref() {
+                            None => {}
+                            Some("sphere") if kind == MapKind::Reflection => {}
+                            Some(t) if kind == MapKind::Reflection => {
+                                cube = CUBE_TYPES.iter().position(|&c| c == t);
+                                if cube.is_none() {
+                                    warn(
+                                        rest.get(1).copied(),
+                                        format!(
+                                            "unknown reflection map type {}: expected sphere, \
+                                             cube_top, cube_bottom, cube_front, cube_back, \
+                                             cube_left or cube_right",
+                                            show(t)
+                                        ),
+                                    );
+                                    continue;
+                                }
+                            }
+                            Some(_) => ignored.push("-type".into()),
+                        }
                         if !ignored.is_empty() {
                             option_notes.push(format!(
                                 "{}:{ln}: texture option(s) {} not supported; ignored",
@@ -1247,6 +1293,7 @@ fn sanitize_mtl(
                             bump_scale,
                             clamp,
                             scale,
+                            cube,
                             at: format!("{}:{ln}", path.display()),
                         });
                     }
@@ -1416,10 +1463,15 @@ impl<'a> Builder<'a> {
     fn load_maps(&mut self, maps: &[TexStmt]) {
         let mut cache: HashMap<(std::path::PathBuf, bool, bool), u32> = HashMap::new();
         let mut missing: Option<u32> = None;
+        let mut cube: [Option<&TexStmt>; 6] = [None; 6];
         for m in maps {
             let Some(&i) = self.by_name.get(m.material.as_str()) else {
                 continue;
             };
+            if let Some(face) = m.cube {
+                cube[face].get_or_insert(m);
+                continue;
+            }
             if m.kind == MapKind::Reflection {
                 if self.environment.is_none() {
                     match Environment::load(&m.file) {
@@ -1483,6 +1535,38 @@ impl<'a> Builder<'a> {
                 MapKind::Normal => maps.normal = t,
                 MapKind::Reflection => {}
             }
+        }
+        self.load_cube(&cube);
+    }
+
+    /// The environment from the six `refl -type cube_*` faces, unless a single-image
+    /// reflection map already gave one; a missing or unreadable face is a warning.
+    fn load_cube(&mut self, cube: &[Option<&TexStmt>; 6]) {
+        let Some(first) = cube.iter().flatten().next() else {
+            return;
+        };
+        if self.environment.is_some() {
+            return;
+        }
+        let missing: Vec<&str> = (0..6)
+            .filter(|&k| cube[k].is_none())
+            .map(|k| CUBE_TYPES[k])
+            .collect();
+        if !missing.is_empty() {
+            self.warnings.push(format!(
+                "{}: cube reflection map incomplete, missing {}; the background stays",
+                first.at,
+                missing.join(", ")
+            ));
+            return;
+        }
+        let files = cube.map(|m| m.map(|m| m.file.clone()).unwrap_or_default());
+        match Environment::load_faces(&files) {
+            Ok(env) => self.environment = Some(env),
+            Err(e) => self.warnings.push(format!(
+                "{}: cube reflection map not used: {e}; the background stays",
+                first.at
+            )),
         }
     }
 
@@ -1629,6 +1713,7 @@ impl<'a> Builder<'a> {
                     continue;
                 }
                 let m = self.material_index(slot);
+                let first = self.geometry.triangles.len();
                 for t in 0..self.tris.len() {
                     let [a, b, c] = self.tris[t];
                     let tri = Triangle {
@@ -1640,6 +1725,16 @@ impl<'a> Builder<'a> {
                         let i = self.geometry.triangles.len() - 1;
                         self.geometry
                             .set_triangle_uvs(i, [self.uvs[a], self.uvs[b], self.uvs[c]]);
+                    }
+                }
+                // A textured quad takes its (u, v) from the bilinear patch.
+                if arity == 4 && self.uvs.len() == 4 && self.geometry.triangles.len() == first + 2 {
+                    let p = [self.pts[0], self.pts[1], self.pts[2], self.pts[3]];
+                    let uv = [self.uvs[0], self.uvs[1], self.uvs[2], self.uvs[3]];
+                    if let Some(q) = QuadUv::new(p, uv) {
+                        let k = self.geometry.add_quad(q);
+                        self.geometry.set_triangle_quad(first, k);
+                        self.geometry.set_triangle_quad(first + 1, k);
                     }
                 }
             }

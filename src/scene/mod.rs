@@ -3,7 +3,7 @@
 
 use crate::accel::NO_INSTANCE;
 use crate::geometry::{
-    Cone, Csg, Intersect, Kind, Param, Shape, ShapeHit, Sphere, SurfacePoint, Triangle,
+    Cone, Csg, Intersect, Kind, Param, QuadUv, Shape, ShapeHit, Sphere, SurfacePoint, Triangle,
 };
 use crate::math::{Aabb, Ray, Vec3, Xform};
 use crate::Hit;
@@ -216,6 +216,12 @@ pub struct Geometry {
     pub triangle_uvs: Vec<u32>,
     /// Per-vertex texture coordinates of triangles that have them (OBJ `vt`).
     pub vertex_uvs: Vec<[Vec2; 3]>,
+    /// Per triangle: index into `quads` when the triangle is half of a textured quad
+    /// face (its `(u, v)` then come from the quad's bilinear patch), or `u32::MAX`; may
+    /// be shorter than `triangles`.
+    pub triangle_quads: Vec<u32>,
+    /// Textured quad faces (OBJ faces of four vertices with `vt`, planar and convex).
+    pub quads: Vec<QuadUv>,
     /// Spheres.
     pub spheres: Prims<Sphere>,
     /// Open cones and cylinders.
@@ -397,6 +403,21 @@ impl Geometry {
         self.vertex_uvs.push(uv);
     }
 
+    /// Add a textured quad face; returns its index for [`Geometry::set_triangle_quad`].
+    pub fn add_quad(&mut self, quad: QuadUv) -> u32 {
+        self.quads.push(quad);
+        self.quads.len() as u32 - 1
+    }
+
+    /// Make triangle `tri` (an index into `triangles`) half of quad `quad`: its texture
+    /// coordinates come from the quad's bilinear patch.
+    pub fn set_triangle_quad(&mut self, tri: usize, quad: u32) {
+        if self.triangle_quads.len() <= tri {
+            self.triangle_quads.resize(tri + 1, u32::MAX);
+        }
+        self.triangle_quads[tri] = quad;
+    }
+
     /// The texture coordinates and tangents at `surf`, a hit on these primitives (in
     /// their space).
     pub fn param(&self, hit: &Hit, surf: &Surface) -> Param {
@@ -404,6 +425,13 @@ impl Geometry {
         let i = hit.prim_id as usize;
         match kind {
             Kind::Triangle => {
+                let quad = match self.triangle_quads.get(i) {
+                    Some(&k) if k != u32::MAX => self.quads[k as usize].param(surf.point.p),
+                    _ => None,
+                };
+                if let Some(param) = quad {
+                    return param;
+                }
                 let uv = match self.triangle_uvs.get(i) {
                     Some(&k) if k != u32::MAX => Some(&self.vertex_uvs[k as usize]),
                     _ => None,

@@ -42,6 +42,13 @@
 //! −z is −y (−z at its top edge): the cross folds into the cube seen from inside.
 //! An image whose width is twice its height is a latitude-longitude map, one with
 //! width:height = 4:3 a cube cross; any other shape is an error.
+//!
+//! A cube map may also come as six square images of one size, the same faces as in
+//! the cross: each is the view from the cube's centre along its axis, the four side
+//! faces (±x, ±z) upright with +y up, the +y face with −z at its bottom edge and +x to
+//! the right, the −y face with −z at its top edge and +x to the right. A directory
+//! holding `px`, `nx`, `py`, `ny`, `pz` and `nz` (each `.png`, `.jpg` or `.jpeg`) for
+//! +x, −x, +y, −y, +z and −z is read as such a cube map ([`Environment::load`]).
 
 use crate::math::Vec3;
 use glam::Vec2;
@@ -460,11 +467,67 @@ impl Environment {
         ))
     }
 
-    /// Read an environment map (colour, sRGB-decoded).
+    /// A cube map from six square faces of one size, in the order +x, −x, +y, −y, +z,
+    /// −z (see the module documentation for their orientation).
     ///
     /// # Errors
-    /// A message naming the file.
+    /// When a face is not square or the sizes differ.
+    pub fn from_faces(faces: [Image; 6]) -> Result<Environment, String> {
+        let (w, h) = (faces[0].width, faces[0].height);
+        for (f, name) in faces.iter().zip(CUBE_FACES) {
+            if f.width != f.height || (f.width, f.height) != (w, h) {
+                return Err(format!(
+                    "the cube map's faces must be square and of one size: {name} is {} × \
+                     {}, {} is {w} × {h}",
+                    f.width, f.height, CUBE_FACES[0]
+                ));
+            }
+        }
+        Ok(Environment::Cube(Box::new(faces.map(|mut f| {
+            f.wrap = Wrap::Clamp;
+            f
+        }))))
+    }
+
+    /// Read a cube map from six image files (colour, sRGB-decoded), in the order +x,
+    /// −x, +y, −y, +z, −z.
+    ///
+    /// # Errors
+    /// A message naming the file that cannot be read, or the faces' mismatch.
+    pub fn load_faces(files: &[std::path::PathBuf; 6]) -> Result<Environment, String> {
+        let mut faces = Vec::with_capacity(6);
+        for f in files {
+            faces.push(Image::load(f, true)?);
+        }
+        let faces: [Image; 6] = faces.try_into().expect("six faces");
+        Environment::from_faces(faces).map_err(|e| format!("{}: {e}", files[0].display()))
+    }
+
+    /// Read an environment map (colour, sRGB-decoded): an image file (2:1 latitude-
+    /// longitude or 4:3 cube cross), or a directory holding the six faces of a cube
+    /// map, `px`, `nx`, `py`, `ny`, `pz`, `nz` with the extension `.png`, `.jpg` or
+    /// `.jpeg`.
+    ///
+    /// # Errors
+    /// A message naming the file (or the missing face).
     pub fn load(path: &Path) -> Result<Environment, String> {
+        if path.is_dir() {
+            let mut files: [std::path::PathBuf; 6] = Default::default();
+            for (file, name) in files.iter_mut().zip(CUBE_FACES) {
+                *file = ["png", "jpg", "jpeg"]
+                    .iter()
+                    .map(|ext| path.join(format!("{name}.{ext}")))
+                    .find(|f| f.is_file())
+                    .ok_or_else(|| {
+                        format!(
+                            "{}: a cube map directory needs {name}.png (or .jpg, .jpeg), \
+                             one of the faces px, nx, py, ny, pz, nz",
+                            path.display()
+                        )
+                    })?;
+            }
+            return Environment::load_faces(&files);
+        }
         let img = Image::load(path, true)?;
         Environment::from_image(img).map_err(|e| format!("{}: {e}", path.display()))
     }
@@ -481,6 +544,9 @@ impl Environment {
         }
     }
 }
+
+/// The names of the cube faces +x, −x, +y, −y, +z, −z (files in a cube map directory).
+pub const CUBE_FACES: [&str; 6] = ["px", "nx", "py", "ny", "pz", "nz"];
 
 /// The latitude-longitude texture coordinates of unit direction `d`.
 pub fn latlong_uv(d: Vec3) -> Vec2 {

@@ -23,8 +23,8 @@ use super::{suggest, SceneSettings, Source, MAX_SIDE};
 use crate::geometry::bezier::{teapot_patches, tessellate, BezierPatch};
 use crate::geometry::polygon::Triangulator;
 use crate::geometry::{
-    AaBox, CappedCone, Cone, Csg, CsgOp, CsgTree, OBox, Plane, Polyhedron, Quadric, Shape, Sphere,
-    Torus, Triangle,
+    AaBox, CappedCone, Cone, Csg, CsgOp, CsgTree, OBox, Plane, Polyhedron, QuadUv, Quadric, Shape,
+    Sphere, Torus, Triangle,
 };
 use crate::load::{nff, obj, LoadError};
 use crate::math::{Aabb, Vec3, Xform};
@@ -2115,11 +2115,14 @@ impl<'a, 's> Builder<'a, 's> {
         let identity = x == DAffine3::IDENTITY;
         {
             let g = Self::geometry(&mut self.geometry, sink);
+            let to_world = |v: Vec3| f32v(x.transform_point3(v.as_dvec3()));
+            // The included quads, placed once each when a triangle first needs them.
+            let mut quads = vec![u32::MAX; s.quads.len()];
             for (i, tri) in s.triangles.items.iter().enumerate() {
                 let m = mat(s.triangles.material[i]);
                 let mut p = tri.p;
                 if !identity {
-                    p = p.map(|v| f32v(x.transform_point3(v.as_dvec3())));
+                    p = p.map(to_world);
                 }
                 let normals = match s.triangle_normals[i] {
                     u32::MAX => None,
@@ -2139,6 +2142,22 @@ impl<'a, 's> Builder<'a, 's> {
                 match normals {
                     Some(n) => g.add_smooth_triangle(Triangle { p }, n, m),
                     None => g.add_triangle(Triangle { p }, m),
+                }
+                let placed = g.triangles.len() - 1;
+                if let Some(&k) = s.triangle_uvs.get(i).filter(|&&k| k != u32::MAX) {
+                    let t = s.vertex_uvs[k as usize];
+                    let t = if mirror { [t[0], t[2], t[1]] } else { t };
+                    g.set_triangle_uvs(placed, t);
+                }
+                if let Some(&k) = s.triangle_quads.get(i).filter(|&&k| k != u32::MAX) {
+                    if quads[k as usize] == u32::MAX {
+                        let q = s.quads[k as usize];
+                        quads[k as usize] = g.add_quad(QuadUv {
+                            p: if identity { q.p } else { q.p.map(to_world) },
+                            ..q
+                        });
+                    }
+                    g.set_triangle_quad(placed, quads[k as usize]);
                 }
             }
         }
