@@ -268,7 +268,7 @@ impl Hemicube {
 /// pixel-centre sampling, keeping the nearest (largest inverse depth) per pixel.
 fn raster(t: [Vec3; 3], width: usize, height: usize, id: u32, depth: &mut [f32], item: &mut [u32]) {
     let area = (t[1].x - t[0].x) * (t[2].y - t[0].y) - (t[2].x - t[0].x) * (t[1].y - t[0].y);
-    if !(area.abs() > 0.0) || !area.is_finite() {
+    if area == 0.0 || !area.is_finite() {
         return;
     }
     let lo = t[0].min(t[1]).min(t[2]);
