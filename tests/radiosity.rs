@@ -830,3 +830,45 @@ fn adaptive_subdivision_refines_the_shadow_boundary_without_cracks() {
     // The same through the mesh's own list.
     assert!(!m.hanging_vertices().is_empty());
 }
+
+#[test]
+fn classroom_ceiling_and_desk_undersides_are_lit_only_indirectly_but_lit() {
+    let path = std::path::Path::new(env!("CARGO_MANIFEST_DIR")).join("scenes/classroom.toml");
+    let scene = emray::load::load_path(&path).unwrap();
+    let accel = Bvh::build(&scene);
+    let sol = radiosity::solve(
+        &scene,
+        &accel,
+        &RadiositySettings {
+            patch_size: Some(4.0),
+            epsilon: 0.05,
+            ..Default::default()
+        },
+    )
+    .unwrap();
+    let m = &sol.mesh;
+    let mean = |pick: &dyn Fn(&radiosity::mesh::Element) -> bool| {
+        let (mut b, mut a) = (0.0f64, 0.0f64);
+        for (e, r) in m.elements.iter().zip(&sol.solve.radiosity) {
+            if pick(e) {
+                b += (r.max_element() * e.area) as f64;
+                a += e.area as f64;
+            }
+        }
+        assert!(a > 0.0);
+        b / a
+    };
+    let ceiling = mean(&|e| e.n.y < -0.9 && e.centroid().y > 2.995);
+    let undersides = mean(&|e| e.n.y < -0.9 && (e.centroid().y - 0.7).abs() < 1e-3);
+    let floor = mean(&|e| e.n.y > 0.9 && e.centroid().y < 1e-3);
+    // The panels face down from just under the ceiling and the desk tops hide them
+    // from their undersides: these receive only interreflected light, and get some.
+    assert!(
+        ceiling > 0.02 * floor && ceiling < floor,
+        "ceiling {ceiling}, floor {floor}"
+    );
+    assert!(
+        undersides > 0.02 * floor && undersides < floor,
+        "undersides {undersides}, floor {floor}"
+    );
+}
