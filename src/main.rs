@@ -329,15 +329,20 @@ fn radiosity_run(a: &cli::RadiosityArgs) -> Result<()> {
         println!("scene      {}\n{}", a.scene.display(), report.summary());
     }
     if let Some(path) = &a.stats_json {
-        let line = serde_json::to_string(&report).expect("report serialises");
-        let mut f = std::fs::OpenOptions::new()
-            .create(true)
-            .append(true)
-            .open(path)
-            .with_context(|| format!("{}: cannot open for writing", path.display()))?;
-        writeln!(f, "{line}").with_context(|| format!("{}: cannot write", path.display()))?;
+        append_json_line(path, &report)?;
     }
     Ok(())
+}
+
+/// Appends `value` as one JSON line to `path` (the `--stats-json` log: one record per run).
+fn append_json_line(path: &Path, value: &impl serde::Serialize) -> Result<()> {
+    let line = serde_json::to_string(value).expect("report serialises");
+    let mut f = std::fs::OpenOptions::new()
+        .create(true)
+        .append(true)
+        .open(path)
+        .with_context(|| format!("{}: cannot open for writing", path.display()))?;
+    writeln!(f, "{line}").with_context(|| format!("{}: cannot write", path.display()))
 }
 
 /// Where scene `scene` goes.
@@ -481,6 +486,7 @@ fn render_one(args: &RenderArgs, scene_path: Option<&Path>, out: &Path) -> Resul
         settings.max_depth = 5;
     }
     settings.embree_quality = args.embree_quality.into();
+    settings.embree_robust = args.embree_robust;
     settings.bailout = args.bailout.unwrap_or(if args.spd {
         0.0
     } else {
@@ -576,13 +582,7 @@ fn render_one(args: &RenderArgs, scene_path: Option<&Path>, out: &Path) -> Resul
         log::info!("wrote {}", out.display());
     }
     if let Some(path) = &args.stats_json {
-        let line = serde_json::to_string(&report).expect("report serialises");
-        let mut f = std::fs::OpenOptions::new()
-            .create(true)
-            .append(true)
-            .open(path)
-            .with_context(|| format!("{}: cannot open for writing", path.display()))?;
-        writeln!(f, "{line}").with_context(|| format!("{}: cannot write", path.display()))?;
+        append_json_line(path, &report)?;
     }
     Ok(())
 }

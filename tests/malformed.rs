@@ -33,6 +33,20 @@ fn nested_csg(depth: usize) -> String {
     )
 }
 
+/// A chain of `depth` defines, each an instance of the next, the last a sphere.
+fn nested_defines(depth: usize) -> String {
+    let mut s = nested_csg(0);
+    for i in 0..depth {
+        let child = if i + 1 == depth {
+            "{ type = \"sphere\", center = [0, 0, 0], radius = 1 }".to_string()
+        } else {
+            format!("{{ type = \"instance\", of = \"d{}\" }}", i + 1)
+        };
+        s += &format!("[define.d{i}]\ntype = \"group\"\nchildren = [{child}]\n");
+    }
+    s + "[[objects]]\ntype = \"instance\"\nof = \"d0\"\n"
+}
+
 /// The corpus: (file name, contents); `None` makes a directory (unreadable as a file).
 fn corpus() -> Vec<(&'static str, Option<Vec<u8>>)> {
     let t = |s: String| Some(s.into_bytes());
@@ -79,6 +93,7 @@ fn corpus() -> Vec<(&'static str, Option<Vec<u8>>)> {
             t(nested_csg(0).replace("[8, 8]", "[100000, 100000]")),
         ),
         ("deep-csg.toml", t(nested_csg(300))),
+        ("deep-defines.toml", t(nested_defines(3000))),
         (
             "deep-arrays.toml",
             t(format!("a = {}{}\n", "[".repeat(20000), "]".repeat(20000))),
