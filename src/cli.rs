@@ -343,6 +343,10 @@ pub struct RenderArgs {
     /// Embree build quality (RTC_BUILD_QUALITY_*).
     #[arg(long, value_enum, default_value_t = QualityArg::Medium)]
     pub embree_quality: QualityArg,
+    /// Embree robust traversal (RTC_SCENE_FLAG_ROBUST) on every scene: no ray slips
+    /// between triangles sharing an edge, at some cost in speed.
+    #[arg(long)]
+    pub embree_robust: bool,
     /// Antialiasing: `uniform` (`--spp` stratified samples) or `adaptive` (corner rays
     /// shared by neighbouring pixels, subdivided where the corners differ).
     #[arg(long, value_enum, default_value_t = AaArg::Uniform)]
@@ -432,6 +436,7 @@ impl RenderArgs {
             threads: None,
             spd: false,
             embree_quality: QualityArg::Medium,
+            embree_robust: false,
             aa: AaArg::Uniform,
             aa_threshold: emray::render::DEFAULT_AA_THRESHOLD,
             aa_depth: emray::render::DEFAULT_AA_DEPTH,

@@ -479,6 +479,7 @@ fn render_one(args: &RenderArgs, scene_path: Option<&Path>, out: &Path) -> Resul
         settings.max_depth = 5;
     }
     settings.embree_quality = args.embree_quality.into();
+    settings.embree_robust = args.embree_robust;
     settings.bailout = args.bailout.unwrap_or(if args.spd {
         0.0
     } else {

@@ -170,27 +170,45 @@ pub fn stress(a: &StressArgs) -> ExitCode {
             ),
         );
     }
-    for level in [2, 4] {
-        let (scene, targets) = tessellated_sphere(level);
-        let origins = origins(64, 3.0);
-        let (rays, misses) = watertight(&Bvh::build(&scene), &targets, &origins);
+    for (name, case) in quadric_root_cases() {
+        let st = case(a.rays);
         check(
-            misses == 0,
+            st.nan == 0 && st.disagree == 0 && st.worst_dist < ROOT_DIST_BOUND,
             format!(
-                "watertight (bvh, {} triangles): {misses} misses of {rays}",
-                scene.triangles.len()
+                "{name}: {} rays ({} hit in f64): {} NaN, {} hit/miss disagreements \
+                 outside the band ({} rays in it), worst |dt|/max(t,1) {:.3e}, \
+                 worst f32 hit point distance from the surface {:.3e}",
+                st.rays, st.hits, st.nan, st.disagree, st.in_band, st.worst_t, st.worst_dist
             ),
         );
+    }
+    for (name, case, n) in watertight_cases() {
+        let touching = |st: &WatertightStats| {
+            format!(
+                "{} misses of {} rays (and {} of {} rays that may only touch an apex or ridge)",
+                st.misses, st.rays, st.touching_misses, st.touching
+            )
+        };
+        let st = case.run(&Bvh::build(&case.scene), n, 3.0);
+        check(
+            st.misses == 0,
+            format!("watertight ({name}, bvh): {}", touching(&st)),
+        );
         #[cfg(feature = "embree")]
-        match emray::accel::embree::EmbreeAccel::build(&scene) {
-            Ok(e) => {
-                let (rays, misses) = watertight(&e, &targets, &origins);
-                println!(
-                    "info watertight (embree, {} triangles): {misses} misses of {rays}",
-                    scene.triangles.len()
-                );
+        for robust in [false, true] {
+            let flag = if robust { "robust" } else { "default flags" };
+            match emray::accel::embree::EmbreeAccel::build_with(
+                &case.scene,
+                "",
+                Default::default(),
+                robust,
+            ) {
+                Ok(e) => {
+                    let st = case.run(&e, n, 3.0);
+                    println!("info watertight ({name}, embree {flag}): {}", touching(&st));
+                }
+                Err(e) => println!("info embree unavailable: {e}"),
             }
-            Err(e) => println!("info embree unavailable: {e}"),
         }
     }
     if ok {

@@ -60,6 +60,9 @@ pub struct Report {
     pub mrays_per_s: f64,
     /// Backend details.
     pub accel: String,
+    /// The primitive kinds the backend holds and dispatches to
+    /// ([`AccelStats::kinds`]), e.g. `spheres×8, triangles×1`.
+    pub kinds: String,
 }
 
 impl Report {
@@ -115,6 +118,7 @@ impl Report {
             } else {
                 format!("{}: {}", accel.backend, accel.detail)
             },
+            kinds: crate::accel::kinds_summary(&accel.kinds),
         }
     }
 
@@ -133,6 +137,7 @@ impl Report {
              backend    {} ({} threads)\n\
              image      {}x{}, {} spp, depth {}{}\n\
              prims      {} ({} lights{})\n\
+             kinds      {} (only these are dispatched to)\n\
              time       load {:.1} ms, build {:.1} ms, render {:.1} ms\n\
              rays       eye {} (hit {}), reflection {}, refraction {}, shadow {}, total {}\n\
              tir        {}\n\
@@ -157,6 +162,7 @@ impl Report {
             } else {
                 String::new()
             },
+            self.kinds,
             t.load,
             t.build,
             t.render,
@@ -215,6 +221,7 @@ pub fn with_accel<W: WithAccel>(
                 scene,
                 &config,
                 settings.embree_quality,
+                settings.embree_robust,
             )?;
             let build = ms(t0);
             Ok(work.run(&accel, build))
@@ -374,6 +381,11 @@ pub fn render_reference(
         nodes: 0,
         bytes: 0,
         detail: format!("f64, brute force, {strata}x{strata} stratified samples"),
+        kinds: Kind::ALL
+            .into_iter()
+            .map(|k| (k, scene.count(k)))
+            .filter(|&(_, n)| n > 0)
+            .collect(),
     };
     let mut st = settings.clone();
     st.spp = strata * strata;

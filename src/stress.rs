@@ -106,10 +106,46 @@ pub fn differing_share(a: &Film, b: &Film) -> f64 {
     crate::output::differing_pixels(a, b) as f64 / a.pixels.len().max(1) as f64
 }
 
+/// A closed mesh and the points of it that rays are aimed at exactly: vertices and
+/// points on edges shared by two triangles, each with an outward direction and the
+/// least cosine to it of a ray that must enter the mesh there (rays more oblique
+/// could only graze the mesh or touch a sharp apex or ridge at that one point).
+pub struct Watertight {
+    /// The mesh (NFF polygons, shared vertices bit-identical).
+    pub scene: Scene,
+    /// `(point, outward unit direction, least cosine)`.
+    pub targets: Vec<(Vec3, Vec3, f32)>,
+    /// The centre the mesh surrounds.
+    pub center: Vec3,
+}
+
+/// NFF source of the triangles `tris` (counter-clockwise seen from outside), each
+/// vertex rounded to f32 once so that shared vertices are bit-identical.
+fn mesh_source(tris: &[[Vec3; 3]], center: Vec3) -> String {
+    let mut src = format!(
+        "v\nfrom {} {} {}\nat {} {} {}\nup 0 1 0\nangle 30\nhither 0\nresolution 8 8\n\
+         f 1 1 1 1 0 0 0 1\n",
+        center.x,
+        center.y,
+        center.z + 5.0,
+        center.x,
+        center.y,
+        center.z
+    );
+    for t in tris {
+        src.push_str("p 3");
+        for v in t {
+            src.push_str(&format!(" {} {} {}", v.x, v.y, v.z));
+        }
+        src.push('\n');
+    }
+    src
+}
+
 /// A closed triangle mesh: the octahedron subdivided `n` times and pushed onto the
-/// unit sphere, as NFF polygons (every edge shared by two triangles, every vertex by
-/// four or six).
-pub fn tessellated_sphere(n: u32) -> (Scene, Vec<Vec3>) {
+/// unit sphere (every edge shared by two triangles, every vertex by four or six),
+/// moved to `center`. Targets: every vertex and edge midpoint.
+pub fn tessellated_sphere(n: u32, center: Vec3) -> Watertight {
     let mut tris: Vec<[DVec3; 3]> = Vec::new();
     let (x, y, z) = (DVec3::X, DVec3::Y, DVec3::Z);
     for sx in [1.0, -1.0] {
@@ -137,52 +173,147 @@ pub fn tessellated_sphere(n: u32) -> (Scene, Vec<Vec3>) {
         }
         tris = next;
     }
-    // Round the vertices to f32 once, so that shared vertices are bit-identical.
-    let f = |v: DVec3| v.as_vec3();
-    let mut src = String::from(
-        "v\nfrom 0 0 5\nat 0 0 0\nup 0 1 0\nangle 30\nhither 0\nresolution 8 8\n\
-         f 1 1 1 1 0 0 0 1\n",
-    );
+    let c64 = center.as_dvec3();
+    let tris: Vec<[Vec3; 3]> = tris
+        .iter()
+        .map(|t| t.map(|v| (v + c64).as_vec3()))
+        .collect();
     let mut targets = Vec::new();
-    for t in &tris {
-        src.push_str("p 3");
-        for v in t {
-            let v = f(*v);
-            src.push_str(&format!(" {} {} {}", v.x, v.y, v.z));
-        }
-        src.push('\n');
-        let [a, b, c] = t.map(f);
-        // Vertices and edge midpoints (computed in f32: exactly on the shared edge
-        // up to rounding, which is what a watertight test must survive).
-        targets.extend([a, (a + b) * 0.5, (b + c) * 0.5, (c + a) * 0.5]);
-    }
-    let scene = parse_str(&src, Path::new("<stress>")).expect("generated mesh parses");
-    (scene, targets)
-}
-
-/// Rays from several outside origins aimed exactly at `targets` (vertices and edge
-/// midpoints of the closed convex mesh around the origin) that it faces: `(rays,
-/// misses)`. Targets seen at grazing incidence (within 30° of the sphere's tangent
-/// plane, more than the facets deviate from it: the ray could only touch the mesh
-/// at that point) are left out.
-pub fn watertight<A: Accel>(accel: &A, targets: &[Vec3], origins: &[Vec3]) -> (u64, u64) {
-    let (mut rays, mut misses) = (0, 0);
-    for &o in origins {
-        for &t in targets {
-            if t.normalize().dot((o - t).normalize()) < 0.5 {
-                continue;
-            }
-            let ray = Ray::new(o, t - o);
-            rays += 1;
-            if accel.intersect(&ray).is_none() {
-                misses += 1;
-            }
+    for &[a, b, c] in &tris {
+        // Vertices and edge midpoints (computed in f32: exactly on the shared edge up
+        // to rounding, which is what a watertight test must survive).
+        for p in [a, (a + b) * 0.5, (b + c) * 0.5, (c + a) * 0.5] {
+            // 60° from the normal: more than the facets deviate from the sphere.
+            targets.push((p, (p - center).normalize(), 0.5));
         }
     }
-    (rays, misses)
+    let scene = parse_str(&mesh_source(&tris, center), Path::new("<stress>"))
+        .expect("generated mesh parses");
+    Watertight {
+        scene,
+        targets,
+        center,
+    }
 }
 
-/// Origins around a closed mesh at distance `r`, `n` of them (a spiral over the sphere).
+/// A closed bipyramid of `2 n` thin triangles (aspect about `n / 6`): two fans of
+/// `n` triangles sharing one apex each (at ±`center.z + 1`) and a rim of `n`
+/// vertices on the unit circle, moved to `center`. Targets: both apexes (shared by
+/// `n` triangles), every rim vertex, and points at 1/8 … 7/8 along every spoke.
+pub fn bipyramid(n: u32, center: Vec3) -> Watertight {
+    let c64 = center.as_dvec3();
+    let at = |v: DVec3| (v + c64).as_vec3();
+    let top = at(DVec3::Z);
+    let bottom = at(-DVec3::Z);
+    let rim: Vec<Vec3> = (0..n)
+        .map(|k| {
+            let a = std::f64::consts::TAU * k as f64 / n as f64;
+            at(DVec3::new(a.cos(), a.sin(), 0.0))
+        })
+        .collect();
+    let mut tris = Vec::with_capacity(2 * n as usize);
+    // The apexes (half-angle 45°) and the rim (a 90° ridge) are entered only by rays
+    // within 45° of their axis: 0.8 leaves a margin.
+    let mut targets = vec![(top, Vec3::Z, 0.8), (bottom, -Vec3::Z, 0.8)];
+    for k in 0..n as usize {
+        let (a, b) = (rim[k], rim[(k + 1) % n as usize]);
+        tris.push([top, a, b]);
+        tris.push([bottom, b, a]);
+        let radial = (a - center) * Vec3::new(1.0, 1.0, 0.0);
+        // The cone's outward normal along the spoke (rim radius 1, height 1).
+        let up = (radial.normalize() + Vec3::Z).normalize();
+        let down = (radial.normalize() - Vec3::Z).normalize();
+        targets.push((a, radial.normalize(), 0.8));
+        for i in 1..8 {
+            let f = i as f32 / 8.0;
+            targets.push((top + (a - top) * f, up, 0.5));
+            targets.push((bottom + (a - bottom) * f, down, 0.5));
+        }
+    }
+    let scene = parse_str(&mesh_source(&tris, center), Path::new("<stress>"))
+        .expect("generated mesh parses");
+    Watertight {
+        scene,
+        targets,
+        center,
+    }
+}
+
+impl Watertight {
+    /// Rays from `n` origins around the mesh at distance `r` (a spiral over the
+    /// sphere) aimed exactly at every target that they must enter the mesh at (see
+    /// [`Watertight::targets`]).
+    pub fn run<A: Accel>(&self, accel: &A, n: u32, r: f32) -> WatertightStats {
+        let mut st = WatertightStats::default();
+        for o in origins(n, r) {
+            let o = o + self.center;
+            for &(t, normal, cos_min) in &self.targets {
+                let cos = normal.dot((o - t).normalize());
+                if cos < cos_min.min(0.5) {
+                    continue;
+                }
+                let miss = accel.intersect(&Ray::new(o, t - o)).is_none();
+                if cos >= cos_min {
+                    st.rays += 1;
+                    st.misses += u64::from(miss);
+                } else {
+                    st.touching += 1;
+                    st.touching_misses += u64::from(miss);
+                }
+            }
+        }
+        st
+    }
+}
+
+/// What [`Watertight::run`] counted.
+#[derive(Clone, Copy, Debug, Default, PartialEq, Eq)]
+pub struct WatertightStats {
+    /// Rays that must enter the mesh at their target.
+    pub rays: u64,
+    /// Of those, the ones that hit nothing.
+    pub misses: u64,
+    /// Rays through a sharp apex or ridge from outside its cone of entry, within 60° of
+    /// its outward direction: they may touch the mesh at that one point only, so a miss
+    /// is no error (reported, not asserted).
+    pub touching: u64,
+    /// Of those, the ones that hit nothing.
+    pub touching_misses: u64,
+}
+
+/// The watertightness cases `emray stress` runs: `(name, mesh, ray origins)`.
+pub fn watertight_cases() -> Vec<(String, Watertight, u32)> {
+    let far = Vec3::new(1e3, -2e3, 5e2);
+    vec![
+        (
+            "sphere, 2048 triangles".into(),
+            tessellated_sphere(4, Vec3::ZERO),
+            64,
+        ),
+        (
+            "sphere, 2048 triangles at (1e3, -2e3, 5e2)".into(),
+            tessellated_sphere(4, far),
+            64,
+        ),
+        (
+            "bipyramid, 1000 thin triangles".into(),
+            bipyramid(500, Vec3::ZERO),
+            64,
+        ),
+        (
+            "bipyramid, 1000 thin triangles at (1e3, -2e3, 5e2)".into(),
+            bipyramid(500, far),
+            64,
+        ),
+        (
+            "bipyramid, 10000 thinner triangles at (1e3, -2e3, 5e2)".into(),
+            bipyramid(5000, far),
+            16,
+        ),
+    ]
+}
+
+/// Origins at distance `r` from the origin, `n` of them (a spiral over the sphere).
 pub fn origins(n: u32, r: f32) -> Vec<Vec3> {
     (0..n)
         .map(|k| {
@@ -203,13 +334,8 @@ pub fn far_sphere(dist: f32, radius: f32, n: u32, seed: u32) -> (f64, u64, u64) 
     let sphere = crate::geometry::Sphere::new(c, radius);
     let mut worst = 0.0f64;
     let (mut miss, mut extra) = (0, 0);
-    let mut state = seed.wrapping_mul(0x9e37_79b9) | 1;
-    let mut rnd = || {
-        state ^= state << 13;
-        state ^= state >> 17;
-        state ^= state << 5;
-        (state >> 8) as f32 / (1u32 << 24) as f32
-    };
+    let mut rng = Rng::new(seed);
+    let mut rnd = || rng.unit() as f32;
     for _ in 0..n {
         // Points up to 1.1 radii from the centre, on the plane through it.
         let (a, b) = (rnd() * std::f32::consts::TAU, rnd().sqrt() * 1.1 * radius);
@@ -225,4 +351,260 @@ pub fn far_sphere(dist: f32, radius: f32, n: u32, seed: u32) -> (f64, u64, u64) 
         }
     }
     (worst, miss, extra)
+}
+
+/// A small deterministic generator (xorshift32) for the random stress rays.
+struct Rng(u32);
+
+impl Rng {
+    fn new(seed: u32) -> Rng {
+        Rng(seed.wrapping_mul(0x9e37_79b9) | 1)
+    }
+
+    /// Uniform in `[0, 1)`.
+    fn unit(&mut self) -> f64 {
+        self.0 ^= self.0 << 13;
+        self.0 ^= self.0 >> 17;
+        self.0 ^= self.0 << 5;
+        (self.0 >> 8) as f64 / (1u32 << 24) as f64
+    }
+
+    /// Uniform in `[lo, hi)`.
+    fn range(&mut self, lo: f64, hi: f64) -> f64 {
+        lo + (hi - lo) * self.unit()
+    }
+
+    /// A unit vector perpendicular to unit `w`, at a random angle around it.
+    fn perpendicular(&mut self, w: DVec3) -> DVec3 {
+        let a = self.range(0.0, std::f64::consts::TAU);
+        let (u, v) = w.any_orthonormal_pair();
+        u * a.cos() + v * a.sin()
+    }
+
+    /// `±10^-k` with `k` uniform in `[lo, hi]`, sometimes exactly 0.
+    fn tiny(&mut self, lo: f64, hi: f64) -> f64 {
+        if self.unit() < 0.02 {
+            return 0.0;
+        }
+        let s = if self.unit() < 0.5 { -1.0 } else { 1.0 };
+        s * 10f64.powf(-self.range(lo, hi))
+    }
+}
+
+/// What a near-degenerate quadric case measured, f32 intersector against the f64
+/// reference on the same (f32) rays.
+#[derive(Clone, Copy, Debug, Default, PartialEq)]
+pub struct RootStats {
+    /// Rays cast.
+    pub rays: u64,
+    /// Rays the f64 reference hits.
+    pub hits: u64,
+    /// f32 hits with a NaN or infinite `t` or normal.
+    pub nan: u64,
+    /// Hit/miss disagreements outside the band around tangency.
+    pub disagree: u64,
+    /// Rays within the band (hit/miss may differ there; not counted above).
+    pub in_band: u64,
+    /// Worst `|t₃₂ − t₆₄| / max(t₆₄, 1)` where both hit.
+    pub worst_t: f64,
+    /// Worst distance of the f32 hit point (evaluated in f64) from the exact surface.
+    pub worst_dist: f64,
+}
+
+/// Bound on [`RootStats::worst_dist`] (unit-sized surfaces).
+pub const ROOT_DIST_BOUND: f64 = 1e-4;
+
+/// One near-degenerate quadric case: its name, and a function casting `n` rays.
+pub type RootCase = (&'static str, fn(u32) -> RootStats);
+
+/// Compare `shape` (f32) against the reference `exact` (nearest `t > 0` in f64) and the
+/// surface distance `dist` on `n` rays from `gen`, which also says whether a ray lies
+/// within the tangent band.
+fn roots<S: crate::geometry::Intersect>(
+    n: u32,
+    shape: &S,
+    mut gen: impl FnMut(&mut Rng) -> (Ray, bool),
+    exact: impl Fn(&DRay) -> Option<f64>,
+    dist: impl Fn(DVec3) -> f64,
+) -> RootStats {
+    let mut rng = Rng::new(n ^ 0x5eed);
+    let mut st = RootStats::default();
+    for _ in 0..n {
+        let (ray, band) = gen(&mut rng);
+        let dray = DRay::from(&ray);
+        st.rays += 1;
+        let want = exact(&dray);
+        let got = shape.intersect(&ray);
+        st.hits += u64::from(want.is_some());
+        st.in_band += u64::from(band);
+        if let Some(h) = got {
+            if !h.t.is_finite() || !h.ng.is_finite() {
+                st.nan += 1;
+                continue;
+            }
+        }
+        match (got, want) {
+            (Some(h), Some(e)) => {
+                let t = h.t as f64;
+                st.worst_t = st.worst_t.max((t - e).abs() / e.max(1.0));
+                st.worst_dist = st.worst_dist.max(dist(dray.org + dray.dir * t));
+            }
+            (Some(_), None) | (None, Some(_)) if !band => st.disagree += 1,
+            _ => {}
+        }
+    }
+    st
+}
+
+/// An f32 ray from f64 origin and direction.
+fn ray32(o: DVec3, d: DVec3) -> Ray {
+    Ray::new(o.as_vec3(), d.as_vec3())
+}
+
+/// `|F(p)| / |∇F(p)|`: the distance from `p` to the quadric `c` to first order.
+fn quadric_dist(c: &[f64; 10], p: DVec3) -> f64 {
+    r64::quadric::quadric_value(c, p).abs() / r64::quadric::quadric_gradient(c, p).length()
+}
+
+/// The quadric-root stress cases: rays that make the quadratic degenerate (`a → 0`:
+/// almost parallel to a paraboloid's axis or a cone's generator) or nearly tangent
+/// (discriminant ≈ 0: impact parameter `r (1 ± 10⁻ᵏ)`, k in 1..9, band `|δ| < 1e-5`).
+pub fn quadric_root_cases() -> Vec<RootCase> {
+    /// Relative impact-parameter band around tangency where hit or miss may go
+    /// either way in f32.
+    const BAND: f64 = 1e-5;
+    vec![
+        ("paraboloid, rays 1e-1..1e-8 rad off its axis", |n| {
+            let q = crate::geometry::Quadric::paraboloid(Vec3::ZERO, Vec3::Z, 0.25)
+                .expect("valid paraboloid");
+            let c = q.coefficients();
+            roots(
+                n,
+                &q,
+                |g| {
+                    let o = DVec3::new(g.range(-1.0, 1.0), g.range(-1.0, 1.0), -1.0);
+                    let e = g.tiny(1.0, 8.0);
+                    let d = (DVec3::Z + g.perpendicular(DVec3::Z) * e).normalize();
+                    (ray32(o, d), false)
+                },
+                |r| r64::quadric::quadric(r, &c, None, 0.0),
+                |p| quadric_dist(&c, p),
+            )
+        }),
+        ("cone quadric, rays 1e-1..1e-8 rad off a generator", |n| {
+            let q = crate::geometry::Quadric::cone(Vec3::ZERO, Vec3::Z, 0.5).expect("valid cone");
+            let c = q.coefficients();
+            roots(
+                n,
+                &q,
+                |g| {
+                    let a = g.range(0.0, std::f64::consts::TAU);
+                    let gen = DVec3::new(0.5 * a.cos(), 0.5 * a.sin(), 1.0).normalize();
+                    let o = DVec3::new(g.range(-1.0, 1.0), g.range(-1.0, 1.0), -2.0);
+                    let d = (gen + g.perpendicular(gen) * g.tiny(1.0, 8.0)).normalize();
+                    (ray32(o, d), false)
+                },
+                |r| r64::quadric::quadric(r, &c, None, 0.0),
+                |p| quadric_dist(&c, p),
+            )
+        }),
+        ("cone primitive, rays 1e-1..1e-8 rad off a generator", |n| {
+            // Base radius 1 at z = 0, apex radius 0 at z = 2: generators of slope 1/2.
+            let cone = crate::geometry::Cone::new(Vec3::ZERO, 1.0, 2.0 * Vec3::Z, 0.0);
+            roots(
+                n,
+                &cone,
+                |g| {
+                    let a = g.range(0.0, std::f64::consts::TAU);
+                    let gen = DVec3::new(-0.5 * a.cos(), -0.5 * a.sin(), 1.0).normalize();
+                    let o = DVec3::new(g.range(-0.5, 0.5), g.range(-0.5, 0.5), -1.0);
+                    let d = (gen + g.perpendicular(gen) * g.tiny(1.0, 8.0)).normalize();
+                    (ray32(o, d), false)
+                },
+                |r| r64::cone(r, DVec3::ZERO, 1.0, 2.0 * DVec3::Z, 0.0, false, 0.0),
+                |p| {
+                    // Distance to the lateral surface r = 1 − z/2 (half-angle atan ½).
+                    let rad = (p.x * p.x + p.y * p.y).sqrt();
+                    (rad - (1.0 - 0.5 * p.z)).abs() * (2.0 / 5f64.sqrt())
+                },
+            )
+        }),
+        ("sphere primitive, tangent rays", |n| {
+            let s = crate::geometry::Sphere::new(Vec3::ZERO, 1.0);
+            roots(
+                n,
+                &s,
+                |g| tangent_ray(g, DVec3::ZERO, None, 1.0, BAND),
+                |r| r64::sphere(r, DVec3::ZERO, 1.0, false, 0.0),
+                |p| (p.length() - 1.0).abs(),
+            )
+        }),
+        ("sphere quadric, tangent rays", |n| {
+            let q = crate::geometry::Quadric::sphere(Vec3::ZERO, 1.0).expect("valid sphere");
+            let c = q.coefficients();
+            roots(
+                n,
+                &q,
+                |g| tangent_ray(g, DVec3::ZERO, None, 1.0, BAND),
+                |r| r64::quadric::quadric(r, &c, None, 0.0),
+                |p| quadric_dist(&c, p),
+            )
+        }),
+        ("cylinder quadric, tangent rays", |n| {
+            let q = crate::geometry::Quadric::cylinder(Vec3::ZERO, Vec3::Z, 1.0)
+                .expect("valid cylinder");
+            let c = q.coefficients();
+            roots(
+                n,
+                &q,
+                |g| tangent_ray(g, DVec3::ZERO, Some(DVec3::Z), 1.0, BAND),
+                |r| r64::quadric::quadric(r, &c, None, 0.0),
+                |p| quadric_dist(&c, p),
+            )
+        }),
+        ("cylinder primitive, tangent rays", |n| {
+            // Radius 1 from z = −2 to z = 2; the rays cross the axis near z = 0.
+            let cyl = crate::geometry::Cone::new(-2.0 * Vec3::Z, 1.0, 2.0 * Vec3::Z, 1.0);
+            roots(
+                n,
+                &cyl,
+                |g| tangent_ray(g, DVec3::ZERO, Some(DVec3::Z), 1.0, BAND),
+                |r| r64::cone(r, -2.0 * DVec3::Z, 1.0, 2.0 * DVec3::Z, 1.0, false, 0.0),
+                |p| ((p.x * p.x + p.y * p.y).sqrt() - 1.0).abs(),
+            )
+        }),
+    ]
+}
+
+/// A ray passing at distance `r (1 + δ)` from `center` (from the line through it along
+/// `axis` for a cylinder), δ = ±10⁻ᵏ, k in 1..9; whether its exact (f64) distance is
+/// within `band` of tangency.
+fn tangent_ray(g: &mut Rng, center: DVec3, axis: Option<DVec3>, r: f64, band: f64) -> (Ray, bool) {
+    let delta = g.tiny(1.0, 9.0);
+    // Direction: any for the sphere, perpendicular to the axis (± 30°) for a cylinder.
+    let d = match axis {
+        None => {
+            let z = g.range(-1.0, 1.0);
+            let a = g.range(0.0, std::f64::consts::TAU);
+            let s = (1.0 - z * z).sqrt();
+            DVec3::new(s * a.cos(), s * a.sin(), z)
+        }
+        Some(w) => (g.perpendicular(w) + w * g.range(-0.5, 0.5)).normalize(),
+    };
+    // The offset from the centre (line) to the ray, perpendicular to both.
+    let side = match axis {
+        None => g.perpendicular(d),
+        Some(w) => d.cross(w).normalize(),
+    };
+    let o = center + side * (r * (1.0 + delta)) - d * g.range(3.0, 6.0);
+    let ray = ray32(o, d);
+    // The exact distance of the f32 ray actually cast.
+    let dr = DRay::from(&ray);
+    let u = dr.dir.normalize();
+    let f = dr.org - center;
+    let dist = match axis {
+        None => (f - u * f.dot(u)).length(),
+        Some(w) => f.dot(u.cross(w).normalize()).abs(),
+    };
+    (ray, ((dist - r) / r).abs() < band)
 }

@@ -105,6 +105,43 @@ fn skipping_changes_no_pixel_and_saves_rays() {
     );
 }
 
+/// Each backend holds, and so dispatches to, only the kinds the scene contains (with
+/// their counts), and `--stats` says which.
+#[test]
+fn backends_hold_only_the_kinds_present() {
+    use emray::accel::{bvh::Bvh, Accel};
+    use emray::geometry::Kind;
+    let head = "v\nfrom 0 -6 0\nat 0 0 0\nup 0 0 1\nangle 40\nhither 0\nresolution 8 8\n\
+        l 2 -3 4\nf 0.8 0.8 0.8 0.9 0.2 10 0 1\n";
+    let spheres = scene(&format!("{head}s 0 0 0 1\ns 1 0 0 0.5\ns -1 0 0 0.5\n"));
+    let mixed = scene(&format!(
+        "{head}s 0 0 0 1\nc\n0 0 -1 0.5\n0 0 1 0.2\np 3 0 0 0 1 0 0 0 1 0\n"
+    ));
+    let want_spheres = vec![(Kind::Sphere, 3)];
+    let want_mixed = vec![(Kind::Triangle, 1), (Kind::Sphere, 1), (Kind::Cone, 1)];
+    assert_eq!(Bvh::build(&spheres).stats().kinds, want_spheres);
+    assert_eq!(Bvh::build(&mixed).stats().kinds, want_mixed);
+    #[cfg(feature = "embree")]
+    {
+        use emray::accel::embree::EmbreeAccel;
+        assert_eq!(
+            EmbreeAccel::build(&spheres).unwrap().stats().kinds,
+            want_spheres
+        );
+        assert_eq!(
+            EmbreeAccel::build(&mixed).unwrap().stats().kinds,
+            want_mixed
+        );
+    }
+    let (_, report) = render(&spheres, &RenderSettings::for_scene(&spheres));
+    assert_eq!(report.kinds, "spheres×3");
+    assert!(
+        report.summary().contains("kinds      spheres×3"),
+        "{}",
+        report.summary()
+    );
+}
+
 fn emray() -> Command {
     Command::new(env!("CARGO_BIN_EXE_emray"))
 }

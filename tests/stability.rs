@@ -49,11 +49,46 @@ fn translated_scenes_have_no_acne_and_a_bounded_change() {
 
 #[test]
 fn rays_at_shared_edges_and_vertices_never_miss_on_the_bvh() {
-    let (scene, targets) = stress::tessellated_sphere(2);
-    let bvh = Bvh::build(&scene);
-    let (rays, misses) = stress::watertight(&bvh, &targets, &stress::origins(6, 3.0));
-    assert!(rays > 300, "{rays}");
-    assert_eq!(misses, 0, "{misses} of {rays}");
+    for case in [
+        stress::tessellated_sphere(2, Vec3::ZERO),
+        stress::bipyramid(100, Vec3::new(1e3, -2e3, 5e2)),
+    ] {
+        let bvh = Bvh::build(&case.scene);
+        let st = case.run(&bvh, 6, 3.0);
+        assert!(st.rays > 300, "{st:?}");
+        assert_eq!(st.misses, 0, "{st:?}");
+    }
+}
+
+/// Quadratics that degenerate (a → 0: rays almost parallel to a paraboloid's axis or
+/// a cone's generator) or nearly so (discriminant ≈ 0: tangent rays): no NaN, the same
+/// hit or miss as the f64 reference outside a 1e-5 band around tangency, and hit
+/// points on the surface.
+#[test]
+fn near_degenerate_quadric_roots_match_the_f64_reference() {
+    for (name, case) in stress::quadric_root_cases() {
+        let st = case(3000);
+        assert!(st.hits > 300, "{name}: {st:?}");
+        assert_eq!((st.nan, st.disagree), (0, 0), "{name}: {st:?}");
+        assert!(st.worst_dist < stress::ROOT_DIST_BOUND, "{name}: {st:?}");
+    }
+}
+
+/// Embree with and without `RTC_SCENE_FLAG_ROBUST` (`--embree-robust`): the flag
+/// reaches the scene (the backend says so) and rays that must enter the thin-triangle
+/// mesh never miss either way.
+#[cfg(feature = "embree")]
+#[test]
+fn embree_with_and_without_the_robust_flag_never_misses_rays_that_must_enter() {
+    use emray::accel::embree::EmbreeAccel;
+    let case = stress::bipyramid(100, Vec3::new(1e3, -2e3, 5e2));
+    for (robust, word) in [(false, "fast traversal"), (true, "robust traversal")] {
+        let e = EmbreeAccel::build_with(&case.scene, "", Default::default(), robust).unwrap();
+        assert!(e.stats().detail.contains(word), "{}", e.stats().detail);
+        let st = case.run(&e, 6, 3.0);
+        assert!(st.rays > 300, "{st:?}");
+        assert_eq!(st.misses, 0, "robust {robust}: {st:?}");
+    }
 }
 
 #[test]

@@ -53,6 +53,34 @@ pub struct AccelStats {
     pub bytes: usize,
     /// Free-form details (Embree version, ISA, ...).
     pub detail: String,
+    /// The primitive kinds the structure holds, with their counts (the scene's own and
+    /// each instanced object's once), in [`Kind`] order. Only these are ever dispatched
+    /// to: Embree holds one geometry per kind present, the BVH's leaves only the
+    /// primitives present.
+    pub kinds: Vec<(Kind, usize)>,
+}
+
+/// Add `n` primitives of `kind` to a [`AccelStats::kinds`] list (nothing when `n` is 0).
+pub(crate) fn add_kind(kinds: &mut Vec<(Kind, usize)>, kind: Kind, n: usize) {
+    if n == 0 {
+        return;
+    }
+    match kinds.binary_search_by_key(&kind, |&(k, _)| k) {
+        Ok(i) => kinds[i].1 += n,
+        Err(i) => kinds.insert(i, (kind, n)),
+    }
+}
+
+/// `sphere×12, cone×3` for [`AccelStats::kinds`] (`none` when empty).
+pub fn kinds_summary(kinds: &[(Kind, usize)]) -> String {
+    if kinds.is_empty() {
+        return "none".into();
+    }
+    let parts: Vec<String> = kinds
+        .iter()
+        .map(|(k, n)| format!("{}×{n}", k.name()))
+        .collect();
+    parts.join(", ")
 }
 
 /// A ray-query structure built over a [`Scene`].

@@ -36,6 +36,9 @@ pub struct RenderSettings {
     pub area_samples: u32,
     /// Embree build quality (the BVH backend ignores it).
     pub embree_quality: crate::accel::EmbreeQuality,
+    /// Embree's `RTC_SCENE_FLAG_ROBUST` on every scene it commits (the BVH backend is
+    /// watertight anyway and ignores it).
+    pub embree_robust: bool,
     /// Antialiasing: uniform `spp` samples per pixel, or adaptive subdivision.
     pub aa: Aa,
     /// Hall & Greenberg's adaptive ray-tree depth: a reflected or refracted ray whose
@@ -141,6 +144,7 @@ impl RenderSettings {
             tile: 16,
             area_samples: 4,
             embree_quality: crate::accel::EmbreeQuality::Medium,
+            embree_robust: false,
             aa: Aa::Uniform,
             bailout: 0.0,
             skip: true,

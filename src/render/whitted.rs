@@ -4,7 +4,7 @@ use super::{RayGen, RenderSettings};
 use crate::accel::Accel;
 use crate::math::{next_float_down, offset_ray_origin, Ray, Vec3};
 use crate::radiosity::{area, Solution};
-use crate::scene::{Scene, Surface};
+use crate::scene::{Light, Material, Scene, Surface};
 
 /// Rays cast, by type.
 #[derive(Clone, Copy, Debug, Default, PartialEq, Eq)]
@@ -260,34 +260,8 @@ impl<'a, A: Accel> Tracer<'a, A> {
             Some(b) => b,
             None => self.local_diffuse(surf, m, ng, ns, entering, counts),
         };
-        let view = -d;
         for light in &scene.lights {
-            let to_light = light.pos - p;
-            // No shadow ray when the shading normal faces away from the light or the
-            // light sends nothing here (with `skip` off the ray is cast and ignored,
-            // to measure what skipping saves).
-            let intensity = light.intensity_at(p);
-            let useless = ns.dot(to_light) <= 0.0 || intensity == Vec3::ZERO;
-            if useless && self.skip {
-                counts.skipped_shadow += 1;
-                continue;
-            }
-            counts.shadow += 1;
-            let mut shadow = spawn(to_light);
-            shadow.dir = light.pos - shadow.org;
-            shadow.tmax = next_float_down(1.0);
-            if self.accel.occluded(&shadow) || useless {
-                continue;
-            }
-            let l = to_light.normalize();
-            let ndotl = ns.dot(l);
-            let mut c = m.color * (m.kd * ndotl);
-            if m.ks > 0.0 {
-                let r = reflect(-l, ns);
-                let rv = r.dot(view).max(0.0);
-                c += Vec3::splat(m.ks * rv.powf(m.shine));
-            }
-            color += intensity * c;
+            color += self.direct(light, surf, m, ng, ns, d, counts);
         }
 
         if depth >= self.max_depth {
@@ -342,6 +316,47 @@ impl<'a, A: Accel> Tracer<'a, A> {
 }
 
 impl<A: Accel> Tracer<'_, A> {
+    /// The diffuse and highlight light `light` sends to `surf` (material `m`, normals
+    /// `ng`, `ns` facing the ray of unit direction `d`), after its shadow ray.
+    #[allow(clippy::too_many_arguments)]
+    #[inline(always)]
+    fn direct(
+        &self,
+        light: &Light,
+        surf: &Surface,
+        m: &Material,
+        ng: Vec3,
+        ns: Vec3,
+        d: Vec3,
+        counts: &mut RayCounts,
+    ) -> Vec3 {
+        let p = surf.point.p;
+        let to_light = light.pos - p;
+        // No shadow ray when the shading normal faces away from the light or the
+        // light sends nothing here (with `skip` off the ray is cast and ignored,
+        // to measure what skipping saves).
+        let intensity = light.intensity_at(p);
+        let useless = ns.dot(to_light) <= 0.0 || intensity == Vec3::ZERO;
+        if useless && self.skip {
+            counts.skipped_shadow += 1;
+            return Vec3::ZERO;
+        }
+        counts.shadow += 1;
+        let org = offset_ray_origin(p, surf.point.err, ng, to_light);
+        let mut shadow = Ray::new(org, light.pos - org);
+        shadow.tmax = next_float_down(1.0);
+        if self.accel.occluded(&shadow) || useless {
+            return Vec3::ZERO;
+        }
+        let l = to_light.normalize();
+        let mut c = m.color * (m.kd * ns.dot(l));
+        if m.ks > 0.0 {
+            let rv = reflect(-l, ns).dot(-d).max(0.0);
+            c += Vec3::splat(m.ks * rv.powf(m.shine));
+        }
+        intensity * c
+    }
+
     /// Ambient, emission (front side) and the area lights' diffuse light.
     fn local_diffuse(
         &self,

@@ -307,6 +307,28 @@ impl Bvh {
     }
 }
 
+impl Bvh {
+    /// The kinds in the leaves and the unbounded list, each instanced object counted
+    /// once (see [`AccelStats::kinds`]).
+    fn kinds(&self) -> Vec<(Kind, usize)> {
+        let mut kinds = Vec::new();
+        let mut levels: Vec<&Bvh> = vec![self];
+        for inst in &self.instances {
+            if !levels.iter().any(|l| std::ptr::eq(*l, &*inst.object)) {
+                levels.push(&inst.object);
+            }
+        }
+        for level in levels {
+            for &(geom_id, _) in &level.ids {
+                if let Some(kind) = Kind::from_id(geom_id) {
+                    crate::accel::add_kind(&mut kinds, kind, 1);
+                }
+            }
+        }
+        kinds
+    }
+}
+
 impl Accel for Bvh {
     fn intersect(&self, ray: &Ray) -> Option<Hit> {
         self.nearest(ray)
@@ -329,6 +351,7 @@ impl Accel for Bvh {
                 build::BINS,
                 build::MAX_LEAF
             ),
+            kinds: self.kinds(),
         }
     }
 }

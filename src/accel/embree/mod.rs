@@ -56,22 +56,27 @@ impl EmbreeAccel {
     /// Build with an Embree device configuration string, e.g. `"threads=2"` (see
     /// `rtcNewDevice`).
     pub fn build_with_config(scene: &Scene, config: &str) -> Result<EmbreeAccel, EmbreeError> {
-        EmbreeAccel::build_with(scene, config, EmbreeQuality::default())
+        EmbreeAccel::build_with(scene, config, EmbreeQuality::default(), false)
     }
 
-    /// Build with a device configuration string and a build quality.
+    /// Build with a device configuration string, a build quality, and with or without
+    /// `RTC_SCENE_FLAG_ROBUST` on every scene (the top level and each instanced
+    /// object's): robust traversal avoids the arithmetic shortcuts that can let a ray
+    /// slip between two triangles sharing an edge, at some cost in speed.
     pub fn build_with(
         scene: &Scene,
         config: &str,
         quality: EmbreeQuality,
+        robust: bool,
     ) -> Result<EmbreeAccel, EmbreeError> {
         let device = Device::new(config)?;
-        let committed = CommittedScene::build(&device, scene, quality)?;
+        let committed = CommittedScene::build(&device, scene, quality, robust)?;
         let api = if cfg!(embree4) { "embree4" } else { "embree3" };
         let detail = format!(
-            "{}, {api} API (headers {}), robust traversal, {} build quality",
+            "{}, {api} API (headers {}), {} traversal, {} build quality",
             device.describe(),
             env!("EMRAY_EMBREE_HEADER_VERSION"),
+            if robust { "robust" } else { "fast" },
             quality.name(),
         );
         Ok(EmbreeAccel {
@@ -113,6 +118,7 @@ impl Accel for EmbreeAccel {
             nodes: 0,
             bytes: self.bytes,
             detail: self.detail.clone(),
+            kinds: self.scene.kinds.clone(),
         }
     }
 }

@@ -5,7 +5,7 @@ use super::device::Device;
 use super::error::EmbreeError;
 use super::sys;
 use super::user::{self, UserPrims, UserShape};
-use crate::accel::{Hit, NO_INSTANCE};
+use crate::accel::{add_kind, Hit, NO_INSTANCE};
 use crate::geometry::{Cone, Intersect, Kind, Shape, Sphere, Triangle};
 use crate::math::{Ray, Vec3, Xform};
 use crate::scene::Geometry as SceneGeometry;
@@ -113,6 +113,8 @@ pub(super) struct CommittedScene {
     top: Level,
     _objects: Vec<Level>,
     unbounded: Vec<Unbounded>,
+    /// The kinds attached, with counts (see [`crate::accel::AccelStats::kinds`]).
+    pub(super) kinds: Vec<(Kind, usize)>,
 }
 
 // SAFETY: the handles refer to Embree's reference-counted scene objects; they are only
@@ -124,8 +126,8 @@ unsafe impl Send for CommittedScene {}
 unsafe impl Sync for CommittedScene {}
 
 impl Level {
-    /// A new, empty scene with robust traversal.
-    fn new(device: &Device) -> Result<Level, EmbreeError> {
+    /// A new, empty scene, with robust traversal if `robust`.
+    fn new(device: &Device, robust: bool) -> Result<Level, EmbreeError> {
         // SAFETY: `device` is live.
         let raw = unsafe { sys::rtcNewScene(device.raw()) };
         if raw.is_null() {
@@ -139,23 +141,34 @@ impl Level {
             raw,
             user: UserData::default(),
         };
-        // Robust traversal: no arithmetic shortcuts that can miss grazing rays.
-        // SAFETY: `raw` is a live, uncommitted scene.
-        unsafe { sys::rtcSetSceneFlags(raw, sys::RTCSceneFlags::RTC_SCENE_FLAG_ROBUST) };
+        // Robust traversal: no arithmetic shortcuts that can miss rays through shared
+        // edges and vertices.
+        let flags = if robust {
+            sys::RTCSceneFlags::RTC_SCENE_FLAG_ROBUST
+        } else {
+            sys::RTCSceneFlags::RTC_SCENE_FLAG_NONE
+        };
+        // SAFETY: `raw` is a live, uncommitted scene; both flag values are valid.
+        unsafe { sys::rtcSetSceneFlags(raw, flags) };
         device.check("rtcSetSceneFlags")?;
         Ok(level)
     }
 
-    /// Attach every bounded primitive of `geometry`; returns the unbounded ones as
+    /// Attach every bounded primitive of `geometry`, one geometry per kind present,
+    /// adding what it attaches to `kinds`; returns the unbounded ones (also counted) as
     /// `(kind, prim_id, shape)`.
     fn attach_geometry(
         &mut self,
         device: &Device,
         geometry: &SceneGeometry,
+        kinds: &mut Vec<(Kind, usize)>,
     ) -> Result<Vec<(Kind, u32, Shape)>, EmbreeError> {
         if !geometry.triangles.is_empty() {
             attach_triangles(device, self, &geometry.triangles.items)?;
+            add_kind(kinds, Kind::Triangle, geometry.triangles.len());
         }
+        add_kind(kinds, Kind::Sphere, geometry.spheres.len());
+        add_kind(kinds, Kind::Cone, geometry.cones.len());
         let all = |n: usize| (0..n as u32).collect::<Vec<u32>>();
         self.user._spheres = attach_user(
             device,
@@ -179,6 +192,7 @@ impl Level {
                 if shape.kind() != kind {
                     continue;
                 }
+                add_kind(kinds, kind, 1);
                 if shape.bounds().is_finite() {
                     items.push(shape.clone());
                     ids.push(i);
@@ -207,11 +221,13 @@ impl Level {
 }
 
 impl CommittedScene {
-    /// Build and commit the scene of `scene`'s primitives at build quality `quality`.
+    /// Build and commit the scene of `scene`'s primitives at build quality `quality`,
+    /// every level with `RTC_SCENE_FLAG_ROBUST` if `robust`.
     pub(super) fn build(
         device: &Device,
         scene: &crate::scene::Scene,
         quality: crate::accel::EmbreeQuality,
+        robust: bool,
     ) -> Result<CommittedScene, EmbreeError> {
         use crate::accel::EmbreeQuality as Q;
         let quality = match quality {
@@ -219,17 +235,18 @@ impl CommittedScene {
             Q::Medium => sys::RTCBuildQuality::RTC_BUILD_QUALITY_MEDIUM,
             Q::High => sys::RTCBuildQuality::RTC_BUILD_QUALITY_HIGH,
         };
+        let mut kinds = Vec::new();
         let mut objects = Vec::with_capacity(scene.objects.len());
         let mut object_unbounded = Vec::with_capacity(scene.objects.len());
         for object in &scene.objects {
-            let mut level = Level::new(device)?;
-            object_unbounded.push(level.attach_geometry(device, object)?);
+            let mut level = Level::new(device, robust)?;
+            object_unbounded.push(level.attach_geometry(device, object, &mut kinds)?);
             level.commit(device, quality)?;
             objects.push(level);
         }
-        let mut top = Level::new(device)?;
+        let mut top = Level::new(device, robust)?;
         let mut unbounded: Vec<Unbounded> = top
-            .attach_geometry(device, &scene.geometry)?
+            .attach_geometry(device, &scene.geometry, &mut kinds)?
             .into_iter()
             .map(|(kind, prim, shape)| Unbounded {
                 shape,
@@ -258,6 +275,7 @@ impl CommittedScene {
             top,
             _objects: objects,
             unbounded,
+            kinds,
         })
     }
 
