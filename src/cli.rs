@@ -50,6 +50,15 @@ pub enum SolverArg {
     GaussSeidel,
 }
 
+/// Form-factor methods as named on the command line.
+#[derive(Clone, Copy, Debug, ValueEnum, PartialEq, Eq)]
+pub enum FormFactorArg {
+    /// Exact point-to-polygon form factors with ray-cast visibility (either backend).
+    Raycast,
+    /// Hemicube (Cohen & Greenberg 1985): item buffers on the five faces.
+    Hemicube,
+}
+
 /// `emray radiosity`.
 #[derive(Args, Debug, Clone)]
 pub struct RadiosityArgs {
@@ -74,6 +83,22 @@ pub struct RadiosityArgs {
     /// Solver.
     #[arg(long, value_enum, default_value_t = SolverArg::Progressive)]
     pub solver: SolverArg,
+    /// Form-factor method.
+    #[arg(long, value_enum, default_value_t = FormFactorArg::Raycast)]
+    pub form_factors: FormFactorArg,
+    /// Hemicube resolution: pixels across the top face (even).
+    #[arg(long, default_value_t = 128, value_parser = clap::value_parser!(u32).range(2..=4096))]
+    pub hemicube_res: u32,
+    /// Adaptive subdivision: split elements whose radiosity differs from a neighbour's
+    /// by more than this fraction of the largest reflected radiosity, then solve again.
+    #[arg(long, value_name = "FRACTION")]
+    pub subdiv_threshold: Option<f32>,
+    /// Smallest element edge adaptive subdivision makes [default: patch size / 8].
+    #[arg(long, value_name = "SIZE")]
+    pub min_patch_size: Option<f32>,
+    /// Most rounds of adaptive subdivision.
+    #[arg(long, default_value_t = 3)]
+    pub subdiv_passes: u32,
     /// Stop when the unshot power is below this fraction of the emitted power.
     #[arg(long, default_value_t = 1e-3)]
     pub epsilon: f64,

@@ -286,7 +286,7 @@ fn radiosity(a: &cli::RadiosityArgs) -> ExitCode {
 }
 
 fn radiosity_run(a: &cli::RadiosityArgs) -> Result<()> {
-    use emray::radiosity::{RadiositySettings, SolverKind};
+    use emray::radiosity::{FormFactorMethod, RadiositySettings, SolverKind};
     emray::output::Format::from_path(&a.output)?;
     let mut builder = rayon::ThreadPoolBuilder::new();
     if let Some(t) = a.threads {
@@ -304,6 +304,13 @@ fn radiosity_run(a: &cli::RadiosityArgs) -> Result<()> {
             cli::SolverArg::Progressive => SolverKind::Progressive,
             cli::SolverArg::GaussSeidel => SolverKind::GaussSeidel,
         },
+        form_factors: match a.form_factors {
+            cli::FormFactorArg::Raycast => FormFactorMethod::RayCast,
+            cli::FormFactorArg::Hemicube => FormFactorMethod::Hemicube(a.hemicube_res),
+        },
+        subdiv_threshold: a.subdiv_threshold,
+        min_patch_size: a.min_patch_size,
+        subdiv_passes: a.subdiv_passes,
     };
     let (w, h) = a.res.unwrap_or((scene.camera.width, scene.camera.height));
     let spp = (a.spp as f32).sqrt().floor().max(1.0) as u32;

@@ -1,8 +1,11 @@
 //! Meshing for the radiosity pass: every triangle of the scene (top level and
 //! instanced) is split by repeated midpoint subdivision (each triangle into four
-//! similar ones) until its longest edge is at most the patch size. The elements of one
-//! source triangle are stored in subdivision order, so a hit's barycentric coordinates
-//! on the source triangle find its element directly.
+//! similar ones) until its longest edge is at most the patch size. Each source triangle
+//! keeps its subdivision as a quadtree, so a hit's barycentric coordinates on the source
+//! triangle find its element by descending the tree, and any element can be split again
+//! later ([`Mesh::split`], adaptive subdivision). Elements split to different depths
+//! leave T-junctions: [`Mesh::hanging_vertices`] lists the vertices that lie inside
+//! another element's edge, so that the display can interpolate them along that edge.
 
 use super::RadiosityError;
 use crate::accel::NO_INSTANCE;
@@ -45,12 +48,9 @@ impl Element {
     }
 }
 
-/// Where the elements of one source triangle are.
-#[derive(Clone, Copy, Debug, PartialEq, Eq)]
-struct Source {
-    first: u32,
-    level: u32,
-}
+/// Marks a quadtree slot that holds an element index (otherwise it holds the index of
+/// the first of four consecutive child slots).
+const LEAF: u32 = 1 << 31;
 
 /// The radiosity mesh.
 #[derive(Clone, Debug, Default)]
@@ -66,7 +66,13 @@ pub struct Mesh {
     pub emission: Vec<Vec3>,
     /// Analytic primitives that are not meshed (they still occlude).
     pub unmeshed: usize,
-    sources: HashMap<(u32, u32), Source>,
+    /// Root quadtree slot per source triangle.
+    sources: HashMap<(u32, u32), u32>,
+    /// Quadtree slots: `LEAF | element` or the first of four child slots.
+    slots: Vec<u32>,
+    /// The slot of each element.
+    slot_of: Vec<u32>,
+    welder: HashMap<VertexKey, u32>,
 }
 
 /// Corner order of the four children of a triangle `(a, b, c)` whose edge midpoints
@@ -111,7 +117,7 @@ pub fn centroid_pattern(level: u32) -> Vec<(f32, f32)> {
         .collect()
 }
 
-#[derive(Clone, Copy, PartialEq, Eq, Hash)]
+#[derive(Clone, Copy, Debug, PartialEq, Eq, Hash)]
 struct VertexKey {
     pos: [u32; 3],
     normal: [i32; 3],
@@ -143,7 +149,6 @@ impl Mesh {
                 .collect(),
             ..Default::default()
         };
-        let mut welder: HashMap<VertexKey, u32> = HashMap::new();
         let top = |g: &Geometry| g.count_unmeshed();
         mesh.unmeshed = top(&scene.geometry);
         for (k, tri) in scene.triangles.items.iter().enumerate() {
@@ -154,7 +159,6 @@ impl Mesh {
                 Vec3::ZERO,
                 material,
                 patch_size,
-                &mut welder,
             )?;
         }
         for (ii, inst) in scene.instances.iter().enumerate() {
@@ -171,14 +175,7 @@ impl Mesh {
                     err = err.max(e);
                     q
                 });
-                mesh.add_source(
-                    (ii as u32, k as u32),
-                    p,
-                    err,
-                    material,
-                    patch_size,
-                    &mut welder,
-                )?;
+                mesh.add_source((ii as u32, k as u32), p, err, material, patch_size)?;
             }
         }
         Ok(mesh)
@@ -191,7 +188,6 @@ impl Mesh {
         err: Vec3,
         material: u32,
         patch_size: f32,
-        welder: &mut HashMap<VertexKey, u32>,
     ) -> Result<(), RadiosityError> {
         let n = (p[1] - p[0]).cross(p[2] - p[0]);
         let len = n.length();
@@ -199,76 +195,175 @@ impl Mesh {
             return Ok(());
         }
         let n = n / len;
-        let longest = (p[1] - p[0])
-            .length()
-            .max((p[2] - p[1]).length())
-            .max((p[0] - p[2]).length());
+        let longest = longest_edge(&p);
         let mut level = 0;
         while level < MAX_LEVEL && longest / (1u32 << level) as f32 > patch_size {
             level += 1;
         }
         if self.elements.len() + (1usize << (2 * level)) > MAX_ELEMENTS {
-            return Err(RadiosityError::Settings(format!(
-                "patch size {patch_size} gives more than {MAX_ELEMENTS} elements; use a larger --patch-size"
-            )));
+            return Err(too_many(patch_size));
         }
         let magnitude = p[0].abs().max(p[1].abs()).max(p[2].abs()).max_element();
         let err = err + Vec3::splat(magnitude * gamma(12));
-        self.sources.insert(
-            key,
-            Source {
-                first: self.elements.len() as u32,
-                level,
-            },
-        );
-        let mut tris = vec![p];
-        for _ in 0..level {
-            tris = tris.iter().flat_map(|t| children(*t)).collect();
+        let root = self.slots.len() as u32;
+        self.slots.push(0);
+        self.sources.insert(key, root);
+        let proto = Element {
+            p,
+            err,
+            n,
+            area: 0.0,
+            material,
+            verts: [0; 3],
+        };
+        self.fill(root, p, level, &proto);
+        Ok(())
+    }
+
+    /// Fill `slot` with triangle `t` subdivided `level` times.
+    fn fill(&mut self, slot: u32, t: [Vec3; 3], level: u32, proto: &Element) {
+        if level == 0 {
+            let k = self.elements.len() as u32;
+            let e = self.element(t, proto);
+            self.elements.push(e);
+            self.slot_of.push(slot);
+            self.slots[slot as usize] = LEAF | k;
+            return;
         }
-        let normal = (n * 1024.0).round().as_ivec3().to_array();
-        for t in tris {
-            let verts = t.map(|q| {
-                let k = VertexKey {
-                    pos: q.to_array().map(f32::to_bits),
-                    normal,
-                    material,
+        let first = self.slots.len() as u32;
+        self.slots.extend([0; 4]);
+        self.slots[slot as usize] = first;
+        for (c, child) in children(t).into_iter().enumerate() {
+            self.fill(first + c as u32, child, level - 1, proto);
+        }
+    }
+
+    /// An element on triangle `t` with `proto`'s normal, error bound and material, its
+    /// corners welded to the mesh's vertices.
+    fn element(&mut self, t: [Vec3; 3], proto: &Element) -> Element {
+        let verts = t.map(|q| {
+            let key = self.key(q, proto);
+            let next = self.vertices.len() as u32;
+            *self.welder.entry(key).or_insert_with(|| {
+                self.vertices.push(q);
+                next
+            })
+        });
+        Element {
+            p: t,
+            area: 0.5 * (t[1] - t[0]).cross(t[2] - t[0]).length(),
+            verts,
+            ..*proto
+        }
+    }
+
+    fn key(&self, q: Vec3, e: &Element) -> VertexKey {
+        VertexKey {
+            pos: q.to_array().map(f32::to_bits),
+            normal: (e.n * 1024.0).round().as_ivec3().to_array(),
+            material: e.material,
+        }
+    }
+
+    /// Split each listed element into four (midpoint subdivision): the first child
+    /// takes the element's index, the others are appended.
+    ///
+    /// # Errors
+    /// The mesh would exceed [`MAX_ELEMENTS`].
+    pub fn split(&mut self, which: &[usize]) -> Result<(), RadiosityError> {
+        if self.elements.len() + 3 * which.len() > MAX_ELEMENTS {
+            return Err(RadiosityError::Settings(format!(
+                "adaptive subdivision would exceed {MAX_ELEMENTS} elements; raise --subdiv-threshold or --min-patch-size"
+            )));
+        }
+        for &k in which {
+            let proto = self.elements[k];
+            let slot = self.slot_of[k];
+            let first = self.slots.len() as u32;
+            self.slots.extend([0; 4]);
+            self.slots[slot as usize] = first;
+            for (c, child) in children(proto.p).into_iter().enumerate() {
+                let e = self.element(child, &proto);
+                let index = if c == 0 {
+                    self.elements[k] = e;
+                    self.slot_of[k] = first;
+                    k as u32
+                } else {
+                    self.elements.push(e);
+                    self.slot_of.push(first + c as u32);
+                    self.elements.len() as u32 - 1
                 };
-                let next = self.vertices.len() as u32;
-                *welder.entry(k).or_insert_with(|| {
-                    self.vertices.push(q);
-                    next
-                })
-            });
-            self.elements.push(Element {
-                p: t,
-                err,
-                n,
-                area: 0.5 * (t[1] - t[0]).cross(t[2] - t[0]).length(),
-                material,
-                verts,
-            });
+                self.slots[(first + c as u32) as usize] = LEAF | index;
+            }
         }
         Ok(())
+    }
+
+    /// The T-junctions: `(m, a, b)` where vertex `m` is the midpoint of the edge `a b`
+    /// of an element (so `m` belongs only to finer elements on the other side), longest
+    /// edges first, so that interpolating `m` from `a` and `b` in this order sees final
+    /// values at `a` and `b`.
+    pub fn hanging_vertices(&self) -> Vec<(u32, u32, u32)> {
+        let mut found: HashMap<u32, (u32, u32)> = HashMap::new();
+        let mut stack = Vec::new();
+        for e in &self.elements {
+            for k in 0..3 {
+                stack.push((e.verts[k], e.verts[(k + 1) % 3]));
+                while let Some((a, b)) = stack.pop() {
+                    let mid = (self.vertices[a as usize] + self.vertices[b as usize]) * 0.5;
+                    if let Some(&m) = self.welder.get(&self.key(mid, e)) {
+                        if m != a && m != b {
+                            found.insert(m, (a, b));
+                            stack.push((a, m));
+                            stack.push((m, b));
+                        }
+                    }
+                }
+            }
+        }
+        let len = |&(_, a, b): &(u32, u32, u32)| {
+            (self.vertices[a as usize] - self.vertices[b as usize]).length_squared()
+        };
+        let mut out: Vec<(u32, u32, u32)> =
+            found.into_iter().map(|(m, (a, b))| (m, a, b)).collect();
+        out.sort_by(|x, y| len(y).total_cmp(&len(x)).then(x.0.cmp(&y.0)));
+        out
     }
 
     /// The element at barycentric `(u, v)` of triangle `prim` of instance `inst`
     /// ([`NO_INSTANCE`] for the top level), with the point's coordinates in it.
     pub fn locate(&self, inst: u32, prim: u32, u: f32, v: f32) -> Option<(usize, f32, f32)> {
-        let s = self.sources.get(&(inst, prim))?;
+        let mut slot = *self.sources.get(&(inst, prim))?;
         let (mut u, mut v) = (u.clamp(0.0, 1.0), v.clamp(0.0, 1.0));
-        let mut index = 0usize;
-        for _ in 0..s.level {
+        loop {
+            let s = self.slots[slot as usize];
+            if s & LEAF != 0 {
+                return Some(((s & !LEAF) as usize, u, v));
+            }
             let (c, cu, cv) = descend(u, v);
-            index = index * 4 + c;
+            slot = s + c as u32;
             (u, v) = (cu, cv);
         }
-        Some((s.first as usize + index, u, v))
     }
 
     /// Total area.
     pub fn area(&self) -> f64 {
         self.elements.iter().map(|e| e.area as f64).sum()
     }
+}
+
+/// The longest edge of a triangle.
+pub fn longest_edge(p: &[Vec3; 3]) -> f32 {
+    (p[1] - p[0])
+        .length()
+        .max((p[2] - p[1]).length())
+        .max((p[0] - p[2]).length())
+}
+
+fn too_many(patch_size: f32) -> RadiosityError {
+    RadiosityError::Settings(format!(
+        "patch size {patch_size} gives more than {MAX_ELEMENTS} elements; use a larger --patch-size"
+    ))
 }
 
 impl Geometry {

@@ -15,6 +15,7 @@
 
 pub mod area;
 pub mod formfactor;
+pub mod hemicube;
 pub mod mesh;
 pub mod solver;
 
@@ -56,6 +57,17 @@ pub enum SolverKind {
     GaussSeidel,
 }
 
+/// How form factors are computed.
+#[derive(Clone, Copy, Debug, PartialEq, Eq, Serialize)]
+pub enum FormFactorMethod {
+    /// Exact point-to-polygon form factors at sample points on the shooter, times the
+    /// visibility from `Accel::occluded` rays (either backend).
+    RayCast,
+    /// A hemicube of this many pixels across its top face on each shooter's centroid,
+    /// visibility from its depth buffer (meshed triangles only).
+    Hemicube(u32),
+}
+
 /// How to solve.
 #[derive(Clone, Debug, PartialEq)]
 pub struct RadiositySettings {
@@ -74,6 +86,16 @@ pub struct RadiositySettings {
     pub max_iterations: usize,
     /// Solver.
     pub solver: SolverKind,
+    /// Form-factor method.
+    pub form_factors: FormFactorMethod,
+    /// Adaptive subdivision: after a solve, split the elements whose radiosity differs
+    /// from a neighbour's by more than this fraction of the largest reflected radiosity,
+    /// and solve again; `None`: uniform mesh.
+    pub subdiv_threshold: Option<f32>,
+    /// Smallest element edge adaptive subdivision makes; `None`: 1/8 of the patch size.
+    pub min_patch_size: Option<f32>,
+    /// Most rounds of adaptive subdivision.
+    pub subdiv_passes: u32,
 }
 
 impl Default for RadiositySettings {
@@ -85,6 +107,10 @@ impl Default for RadiositySettings {
             epsilon: 1e-3,
             max_iterations: 1_000_000,
             solver: SolverKind::Progressive,
+            form_factors: FormFactorMethod::RayCast,
+            subdiv_threshold: None,
+            min_patch_size: None,
+            subdiv_passes: 3,
         }
     }
 }
@@ -131,11 +157,17 @@ impl Solution {
                 weight[v as usize] += e.area;
             }
         }
-        let vertex_radiosity = sum
+        let mut vertex_radiosity: Vec<Vec3> = sum
             .iter()
             .zip(&weight)
             .map(|(&s, &w)| if w > 0.0 { s / w } else { Vec3::ZERO })
             .collect();
+        // T-junctions: a vertex inside a coarser element's edge takes the value the
+        // coarser element interpolates there, so the shading has no crack.
+        for (m, a, b) in mesh.hanging_vertices() {
+            let v = &mut vertex_radiosity;
+            v[m as usize] = (v[a as usize] + v[b as usize]) * 0.5;
+        }
         Solution {
             mesh,
             solve,
@@ -205,20 +237,105 @@ pub fn solve<A: Accel>(
         Some(p) => p,
         None => default_patch_size(scene),
     };
-    let mesh = Mesh::build(scene, patch)?;
+    let mut mesh = Mesh::build(scene, patch)?;
     if mesh.elements.is_empty() {
         return Err(RadiosityError::Empty);
     }
-    let s = Sampling::new(settings.shooter_level, settings.visibility_level);
-    let solve = match settings.solver {
-        SolverKind::Progressive => {
-            solver::progressive(&mesh, accel, &s, settings.epsilon, settings.max_iterations)?
+    let mut solve = solve_mesh(&mesh, accel, settings)?;
+    let (mut form_factor_ms, mut total_ms, mut refinements) =
+        (solve.form_factor_ms, solve.total_ms, Vec::new());
+    if let Some(threshold) = settings.subdiv_threshold {
+        let min = settings.min_patch_size.unwrap_or(patch / 8.0);
+        if !(threshold.is_finite() && threshold > 0.0 && min.is_finite() && min > 0.0) {
+            return Err(RadiosityError::Settings(format!(
+                "subdivision threshold {threshold} and minimum patch size {min} must be positive"
+            )));
         }
-        SolverKind::GaussSeidel => {
-            solver::gauss_seidel(&mesh, accel, &s, settings.epsilon, settings.max_iterations)?
+        for _ in 0..settings.subdiv_passes {
+            let marked = marked_for_split(&mesh, &solve.radiosity, threshold, min);
+            if marked.is_empty() {
+                break;
+            }
+            mesh.split(&marked)?;
+            refinements.push(marked.len());
+            // A fresh solve on the refined mesh: every element starts with its emission
+            // unshot, so the energy bookkeeping is that of a first solve.
+            solve = solve_mesh(&mesh, accel, settings)?;
+            form_factor_ms += solve.form_factor_ms;
+            total_ms += solve.total_ms;
         }
-    };
+    }
+    solve.form_factor_ms = form_factor_ms;
+    solve.total_ms = total_ms;
+    solve.refinements = refinements;
     Ok(Solution::new(mesh, solve))
+}
+
+/// The elements to split: those whose radiosity differs from a neighbour's (an element
+/// sharing a corner, on any plane) by more than `threshold` times the largest radiosity
+/// of a non-emitting element, in some channel, and whose halves would still have edges
+/// of at least `min`. Emitters are not split.
+pub fn marked_for_split(mesh: &Mesh, radiosity: &[Vec3], threshold: f32, min: f32) -> Vec<usize> {
+    let emits = |k: usize| mesh.emission[mesh.elements[k].material as usize].max_element() > 0.0;
+    let scale = (0..mesh.elements.len())
+        .filter(|&k| !emits(k))
+        .map(|k| radiosity[k].max_element())
+        .fold(0.0f32, f32::max);
+    if scale <= 0.0 {
+        return Vec::new();
+    }
+    let mut at: std::collections::HashMap<[u32; 3], Vec<usize>> = Default::default();
+    for (k, e) in mesh.elements.iter().enumerate() {
+        if !emits(k) {
+            for p in e.p {
+                at.entry(p.to_array().map(f32::to_bits))
+                    .or_default()
+                    .push(k);
+            }
+        }
+    }
+    let mut mark = vec![false; mesh.elements.len()];
+    for around in at.values() {
+        for (x, &i) in around.iter().enumerate() {
+            for &j in &around[x + 1..] {
+                let d = (radiosity[i] - radiosity[j]).abs().max_element();
+                if d > threshold * scale {
+                    mark[i] = true;
+                    mark[j] = true;
+                }
+            }
+        }
+    }
+    (0..mesh.elements.len())
+        .filter(|&k| mark[k] && mesh::longest_edge(&mesh.elements[k].p) * 0.5 >= min)
+        .collect()
+}
+
+/// Solve the radiosity system of `mesh` with the settings' form factors and solver.
+fn solve_mesh<A: Accel>(
+    mesh: &Mesh,
+    accel: &A,
+    settings: &RadiositySettings,
+) -> Result<Solve, RadiosityError> {
+    let (eps, max) = (settings.epsilon, settings.max_iterations);
+    match settings.form_factors {
+        FormFactorMethod::RayCast => {
+            let s = Sampling::new(settings.shooter_level, settings.visibility_level);
+            let row = |i| solver::form_factor_row(mesh, accel, &s, i);
+            match settings.solver {
+                SolverKind::Progressive => solver::progressive_rows(mesh, row, eps, max),
+                SolverKind::GaussSeidel => solver::gauss_seidel_rows(mesh, row, eps, max),
+            }
+        }
+        FormFactorMethod::Hemicube(res) => {
+            let h = hemicube::Hemicube::new(res)?;
+            let row = |i| h.row(mesh, i);
+            match settings.solver {
+                SolverKind::Progressive => solver::progressive_rows(mesh, row, eps, max),
+                SolverKind::GaussSeidel => solver::gauss_seidel_rows(mesh, row, eps, max),
+            }
+        }
+    }
 }
 
 /// 1/12 of the diagonal of the bounds of the scene's top-level and instanced
@@ -296,10 +413,14 @@ pub struct RadiosityReport {
     pub backend: &'static str,
     /// Solver.
     pub solver: SolverKind,
+    /// Form-factor method.
+    pub form_factors: FormFactorMethod,
     /// Patch size used.
     pub patch_size: f32,
-    /// Elements.
+    /// Elements (after adaptive subdivision).
     pub elements: usize,
+    /// Elements split in each round of adaptive subdivision.
+    pub refinements: Vec<usize>,
     /// Shared vertices.
     pub vertices: usize,
     /// Analytic primitives left out of the mesh.
@@ -326,9 +447,19 @@ impl RadiosityReport {
     /// Human-readable summary.
     pub fn summary(&self) -> String {
         let last = self.residuals.last().copied().unwrap_or(0.0);
+        let method = match self.form_factors {
+            FormFactorMethod::RayCast => format!(
+                "ray cast, {} points per shooter, {} visibility rays per element pair",
+                self.shooter_samples, self.visibility_samples
+            ),
+            FormFactorMethod::Hemicube(res) => {
+                format!("hemicube, {res}x{res} top face, on each shooter's centroid")
+            }
+        };
         format!(
             "backend    {}\nmesh       {} elements, {} vertices (patch size {}), {} analytic primitives not meshed\n\
-             samples    {} per shooter, {} visibility rays per element pair\n\
+             subdivide  {:?} elements split per round\n\
+             ff         {}\n\
              solver     {:?}: {} iterations, final residual {:.3e}\n\
              time       build {:.1} ms, form factors {:.1} ms, solve {:.1} ms, view {:.1} ms",
             self.backend,
@@ -336,8 +467,8 @@ impl RadiosityReport {
             self.vertices,
             self.patch_size,
             self.unmeshed,
-            self.shooter_samples,
-            self.visibility_samples,
+            self.refinements,
+            method,
             self.solver,
             self.iterations,
             last,
@@ -363,10 +494,12 @@ fn solve_and_view<A: Accel>(
     let report = RadiosityReport {
         backend: accel.stats().backend,
         solver: settings.solver,
+        form_factors: settings.form_factors,
         patch_size: settings
             .patch_size
             .unwrap_or_else(|| default_patch_size(scene)),
         elements: sol.mesh.elements.len(),
+        refinements: sol.solve.refinements.clone(),
         vertices: sol.mesh.vertices.len(),
         unmeshed: sol.mesh.unmeshed,
         shooter_samples: 1 << (2 * settings.shooter_level),

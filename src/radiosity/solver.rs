@@ -32,6 +32,9 @@ pub struct Solve {
     pub form_factor_ms: f64,
     /// Milliseconds for the whole solve.
     pub total_ms: f64,
+    /// Elements split in each round of adaptive subdivision (each round is followed by
+    /// a fresh solve; the other fields describe the last one, the times cover all).
+    pub refinements: Vec<usize>,
 }
 
 fn power(v: Vec3) -> f64 {
@@ -67,6 +70,22 @@ pub fn progressive<A: Accel>(
     epsilon: f64,
     max_shots: usize,
 ) -> Result<Solve, RadiosityError> {
+    progressive_rows(
+        mesh,
+        |i| form_factor_row(mesh, accel, s, i),
+        epsilon,
+        max_shots,
+    )
+}
+
+/// Progressive refinement with the rows of form factors `F_ij` (all `j`) from `row(i)`,
+/// whatever computes them (ray casting, hemicube).
+pub fn progressive_rows<R: Fn(usize) -> Vec<f32>>(
+    mesh: &Mesh,
+    row: R,
+    epsilon: f64,
+    max_shots: usize,
+) -> Result<Solve, RadiosityError> {
     let start = Instant::now();
     let emission = emitted(mesh)?;
     let n = mesh.elements.len();
@@ -93,7 +112,7 @@ pub fn progressive<A: Accel>(
             })
             .expect("non-empty mesh");
         let t = Instant::now();
-        let row = form_factor_row(mesh, accel, s, i);
+        let row = row(i);
         ff_ms += t.elapsed().as_secs_f64() * 1e3;
         let shot = out.unshot[i];
         out.unshot[i] = Vec3::ZERO;
@@ -122,6 +141,21 @@ pub fn gauss_seidel<A: Accel>(
     tolerance: f64,
     max_sweeps: usize,
 ) -> Result<Solve, RadiosityError> {
+    gauss_seidel_rows(
+        mesh,
+        |i| form_factor_row(mesh, accel, s, i),
+        tolerance,
+        max_sweeps,
+    )
+}
+
+/// Gauss–Seidel with the rows of form factors from `row(i)`.
+pub fn gauss_seidel_rows<R: Fn(usize) -> Vec<f32>>(
+    mesh: &Mesh,
+    row: R,
+    tolerance: f64,
+    max_sweeps: usize,
+) -> Result<Solve, RadiosityError> {
     let start = Instant::now();
     let emission = emitted(mesh)?;
     let n = mesh.elements.len();
@@ -132,7 +166,7 @@ pub fn gauss_seidel<A: Accel>(
     }
     let t = Instant::now();
     // f[i][j] = F_ij, from i to j.
-    let f: Vec<Vec<f32>> = (0..n).map(|i| form_factor_row(mesh, accel, s, i)).collect();
+    let f: Vec<Vec<f32>> = (0..n).map(&row).collect();
     let ff_ms = t.elapsed().as_secs_f64() * 1e3;
     let scale = emission
         .iter()
