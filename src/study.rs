@@ -1,7 +1,7 @@
 //! `emray study`: the f64 reference once, then a sweep of settings (uniform spp,
 //! adaptive thresholds, bailout weights, depth limits, backends, f32 against f64),
 //! each run's wall time, rays and error metrics to CSV, and error against time on
-//! log-log axes to SVG, one curve per knob.
+//! log-log axes to SVG and PNG (plotters), one curve per knob.
 
 use crate::accel::{AccelError, Backend};
 use crate::metrics::{compare, Metrics};
@@ -125,111 +125,146 @@ pub fn csv(rows: &[Row]) -> String {
     s
 }
 
-/// RMSE against render time on log-log axes, one polyline per knob, as SVG.
-pub fn svg(rows: &[Row], title: &str) -> String {
+/// Plot size in pixels.
+const PLOT_SIZE: (u32, u32) = (800, 520);
+
+/// The curves' colours, one per knob (in sweep order).
+pub const COLOURS: [(u8, u8, u8); 6] = [
+    (31, 119, 180),
+    (214, 39, 40),
+    (44, 160, 44),
+    (148, 103, 189),
+    (255, 127, 14),
+    (140, 86, 75),
+];
+
+/// DejaVu Sans (Bitstream Vera licence, see `assets/DejaVuSans.LICENSE`): the PNG's text
+/// is rasterised from it, so no system font is needed.
+static FONT: &[u8] = include_bytes!("../assets/DejaVuSans.ttf");
+
+/// Register the embedded font as plotters' `sans-serif` (once).
+fn register_font() {
+    static ONCE: std::sync::Once = std::sync::Once::new();
+    ONCE.call_once(|| {
+        // The font is valid (a test plots with it); a failure only loses the text.
+        let _ =
+            plotters::style::register_font("sans-serif", plotters::style::FontStyle::Normal, FONT);
+    });
+}
+
+/// Draw RMSE against render time on log-log axes, one curve per knob, on `root`.
+fn plot<DB: plotters::prelude::DrawingBackend>(
+    root: plotters::prelude::DrawingArea<DB, plotters::coord::Shift>,
+    rows: &[Row],
+    title: &str,
+) -> Result<(), String> {
+    use plotters::prelude::*;
+    register_font();
+    let e = |e: DrawingAreaErrorKind<DB::ErrorType>| format!("plotting: {e}");
     let pts: Vec<(f64, f64)> = rows
         .iter()
-        .map(|r| (r.ms.max(1e-3).log10(), r.m.rmse.max(1e-9).log10()))
+        .map(|r| (r.ms.max(1e-3), r.m.rmse.max(1e-9)))
         .collect();
+    // Whole decades around the points.
+    let decade = |v: f64, up: bool| {
+        let l = v.log10();
+        10f64.powf(if up { l.ceil() } else { l.floor() })
+    };
     let (mut x0, mut x1, mut y0, mut y1) = (f64::MAX, f64::MIN, f64::MAX, f64::MIN);
     for &(x, y) in &pts {
-        x0 = x0.min(x.floor());
-        x1 = x1.max(x.ceil());
-        y0 = y0.min(y.floor());
-        y1 = y1.max(y.ceil());
+        x0 = x0.min(decade(x, false));
+        x1 = x1.max(decade(x, true));
+        y0 = y0.min(decade(y, false));
+        y1 = y1.max(decade(y, true));
+    }
+    if pts.is_empty() {
+        (x0, x1, y0, y1) = (1.0, 10.0, 1e-3, 1.0);
     }
     if x1 <= x0 {
-        x1 = x0 + 1.0;
+        x1 = x0 * 10.0;
     }
     if y1 <= y0 {
-        y1 = y0 + 1.0;
+        y1 = y0 * 10.0;
     }
-    let (w, h, l, r, t, b) = (720.0, 480.0, 70.0, 160.0, 40.0, 50.0);
-    let px = |x: f64| l + (x - x0) / (x1 - x0) * (w - l - r);
-    let py = |y: f64| h - b - (y - y0) / (y1 - y0) * (h - t - b);
-    let mut s = format!(
-        "<svg xmlns=\"http://www.w3.org/2000/svg\" width=\"{w}\" height=\"{h}\" \
-         font-family=\"sans-serif\" font-size=\"12\">\n\
-         <rect width=\"100%\" height=\"100%\" fill=\"white\"/>\n\
-         <text x=\"{}\" y=\"22\" text-anchor=\"middle\" font-size=\"15\">{}</text>\n",
-        w / 2.0,
-        xml(title)
-    );
-    for k in x0 as i32..=x1 as i32 {
-        let x = px(k as f64);
-        let _ = writeln!(
-            s,
-            "<line x1=\"{x}\" y1=\"{t}\" x2=\"{x}\" y2=\"{}\" stroke=\"#ddd\"/>\
-             <text x=\"{x}\" y=\"{}\" text-anchor=\"middle\">1e{k}</text>",
-            h - b,
-            h - b + 16.0
-        );
-    }
-    for k in y0 as i32..=y1 as i32 {
-        let y = py(k as f64);
-        let _ = writeln!(
-            s,
-            "<line x1=\"{l}\" y1=\"{y}\" x2=\"{}\" y2=\"{y}\" stroke=\"#ddd\"/>\
-             <text x=\"{}\" y=\"{}\" text-anchor=\"end\">1e{k}</text>",
-            w - r,
-            l - 6.0,
-            y + 4.0
-        );
-    }
-    let _ = writeln!(
-        s,
-        "<text x=\"{}\" y=\"{}\" text-anchor=\"middle\">render time (ms)</text>\
-         <text x=\"16\" y=\"{}\" text-anchor=\"middle\" transform=\"rotate(-90 16 {})\">RMSE vs f64 reference</text>",
-        (l + w - r) / 2.0,
-        h - 12.0,
-        h / 2.0,
-        h / 2.0
-    );
-    const COLOURS: [&str; 6] = [
-        "#1f77b4", "#d62728", "#2ca02c", "#9467bd", "#ff7f0e", "#8c564b",
-    ];
+    root.fill(&WHITE).map_err(e)?;
+    let mut chart = ChartBuilder::on(&root)
+        .caption(title, ("sans-serif", 20))
+        .margin(12)
+        .x_label_area_size(42)
+        .y_label_area_size(64)
+        .build_cartesian_2d((x0..x1).log_scale(), (y0..y1).log_scale())
+        .map_err(e)?;
+    chart
+        .configure_mesh()
+        .x_desc("render time (ms)")
+        .y_desc("RMSE vs f64 reference")
+        .x_label_formatter(&|v| format!("{v:.0e}"))
+        .y_label_formatter(&|v| format!("{v:.0e}"))
+        .label_style(("sans-serif", 13))
+        .draw()
+        .map_err(e)?;
     let mut knobs: Vec<&str> = rows.iter().map(|r| r.knob).collect();
     knobs.dedup();
     for (k, knob) in knobs.iter().enumerate() {
-        let c = COLOURS[k % COLOURS.len()];
-        let line: Vec<String> = rows
+        let (r, g, b) = COLOURS[k % COLOURS.len()];
+        let colour = RGBColor(r, g, b);
+        let curve: Vec<(f64, f64)> = rows
             .iter()
             .zip(&pts)
-            .filter(|(r, _)| r.knob == *knob)
-            .map(|(_, &(x, y))| format!("{:.1},{:.1}", px(x), py(y)))
+            .filter(|(row, _)| row.knob == *knob)
+            .map(|(_, &p)| p)
             .collect();
-        let _ = writeln!(
-            s,
-            "<polyline fill=\"none\" stroke=\"{c}\" stroke-width=\"2\" points=\"{}\"/>",
-            line.join(" ")
-        );
-        for p in &line {
-            let (x, y) = p.split_once(',').expect("x,y");
-            let _ = writeln!(s, "<circle cx=\"{x}\" cy=\"{y}\" r=\"3\" fill=\"{c}\"/>");
-        }
-        let ly = t + 10.0 + 18.0 * k as f64;
-        let _ = writeln!(
-            s,
-            "<line x1=\"{}\" y1=\"{ly}\" x2=\"{}\" y2=\"{ly}\" stroke=\"{c}\" stroke-width=\"3\"/>\
-             <text x=\"{}\" y=\"{}\">{}</text>",
-            w - r + 10.0,
-            w - r + 30.0,
-            w - r + 36.0,
-            ly + 4.0,
-            xml(knob)
-        );
+        chart
+            .draw_series(LineSeries::new(curve.clone(), colour.stroke_width(2)))
+            .map_err(e)?
+            .label(*knob)
+            .legend(move |(x, y)| Rectangle::new([(x, y - 2), (x + 18, y + 2)], colour.filled()));
+        chart
+            .draw_series(curve.iter().map(|&p| Circle::new(p, 3, colour.filled())))
+            .map_err(e)?;
     }
-    s.push_str("</svg>\n");
-    s
+    chart
+        .configure_series_labels()
+        .position(SeriesLabelPosition::UpperRight)
+        .background_style(WHITE.mix(0.85))
+        .border_style(BLACK)
+        .label_font(("sans-serif", 13))
+        .draw()
+        .map_err(e)?;
+    root.present().map_err(e)
 }
 
-fn xml(s: &str) -> String {
-    s.replace('&', "&amp;")
-        .replace('<', "&lt;")
-        .replace('>', "&gt;")
+/// The plot as SVG.
+pub fn svg(rows: &[Row], title: &str) -> Result<String, String> {
+    let mut out = String::new();
+    {
+        let root = plotters::prelude::SVGBackend::with_string(&mut out, PLOT_SIZE);
+        plot(
+            plotters::prelude::IntoDrawingArea::into_drawing_area(root),
+            rows,
+            title,
+        )?;
+    }
+    Ok(out)
 }
 
-/// Run the study and write `study.csv` and `study.svg` into `dir` (created).
+/// The plot as an RGB image.
+pub fn raster(rows: &[Row], title: &str) -> Result<image::RgbImage, String> {
+    let (w, h) = PLOT_SIZE;
+    let mut buf = vec![0u8; (w * h * 3) as usize];
+    {
+        let root = plotters::prelude::BitMapBackend::with_buffer(&mut buf, (w, h));
+        plot(
+            plotters::prelude::IntoDrawingArea::into_drawing_area(root),
+            rows,
+            title,
+        )?;
+    }
+    image::RgbImage::from_raw(w, h, buf).ok_or_else(|| "plotting: bad buffer size".into())
+}
+
+/// Run the study and write `study.csv`, `study.svg` and `study.png` into `dir`
+/// (created).
 pub fn write(
     scene: &Scene,
     name: &str,
@@ -243,7 +278,15 @@ pub fn write(
     std::fs::create_dir_all(dir).map_err(|e| format!("{}: cannot create: {e}", dir.display()))?;
     let title = format!("{name}, {w}x{h}: error vs time");
     crate::output::write_text(&dir.join("study.csv"), &csv(&rows)).map_err(|e| e.to_string())?;
-    crate::output::write_text(&dir.join("study.svg"), &svg(&rows, &title))
+    crate::output::write_text(&dir.join("study.svg"), &svg(&rows, &title)?)
         .map_err(|e| e.to_string())?;
+    let png = raster(&rows, &title)?;
+    crate::output::write_atomic(&dir.join("study.png"), |f| {
+        let mut f = std::io::BufWriter::new(f);
+        png.write_to(&mut f, image::ImageFormat::Png)
+            .map_err(|e| e.to_string())?;
+        std::io::Write::flush(&mut f).map_err(|e| e.to_string())
+    })
+    .map_err(|e| e.to_string())?;
     Ok(rows)
 }

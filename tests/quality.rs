@@ -274,7 +274,16 @@ fn study_writes_a_row_per_setting_and_a_curve_per_knob() {
     let svg = std::fs::read_to_string(dir.path().join("study.svg")).unwrap();
     for knob in ["spp", "adaptive", "bailout", "depth", "backend", "f64"] {
         assert!(rows.iter().any(|r| r.knob == knob), "{knob}");
-        assert!(svg.contains(&format!(">{knob}</text>")), "{knob}");
+        assert!(svg.contains(&format!(">\n{knob}\n</text>")), "{knob}");
     }
-    assert_eq!(svg.matches("<polyline").count(), 6);
+    // One 2-pixel curve per knob (axes and ticks are 1 pixel wide).
+    assert_eq!(svg.matches("stroke-width=\"2\"").count(), 6);
+    // The PNG: the plot's size, with every curve's colour and dark (text) pixels.
+    let png = image::open(dir.path().join("study.png")).unwrap().to_rgb8();
+    assert_eq!(png.dimensions(), (800, 520));
+    for (r, g, b) in emray::study::COLOURS {
+        assert!(png.pixels().any(|p| p.0 == [r, g, b]), "{r} {g} {b}");
+    }
+    let dark = png.pixels().filter(|p| p.0.iter().all(|&c| c < 80)).count();
+    assert!(dark > 500, "{dark} dark pixels: no text?");
 }

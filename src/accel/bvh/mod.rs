@@ -1,6 +1,7 @@
 //! The pure-Rust backend: a binned-SAH bounding volume hierarchy over every primitive
 //! kind, stored as a flat node array (left child next to its parent), traversed
-//! near-child-first with the far interval shrinking as hits are found.
+//! nearer-child-first (both children's boxes tested at the parent), skipping pushed
+//! nodes that lie beyond the nearest hit found meanwhile.
 
 mod build;
 
@@ -155,47 +156,68 @@ impl Bvh {
     }
 
     /// Walk the tree; `leaf` is called for each primitive index of every leaf the ray
-    /// reaches and returns the new `tmax` (or `None` to stop at once).
+    /// reaches and returns the new `tmax` (or `None` to stop at once). Both children's
+    /// boxes are tested at their parent: the nearer one (by entry distance) is visited
+    /// first, the other is pushed with its entry distance and skipped when it comes off
+    /// the stack if a hit closer than that was found meanwhile.
     #[inline]
     fn traverse(&self, ray: &Ray, mut leaf: impl FnMut(usize, f32) -> Option<f32>) {
-        if self.nodes.is_empty() {
+        let Some(root) = self.nodes.first() else {
+            return;
+        };
+        let inv = ray.dir.recip();
+        let mut tmax = ray.tmax;
+        if root.bounds.hit(ray.org, inv, ray.tmin, tmax).is_none() {
             return;
         }
-        let inv = ray.dir.recip();
-        let neg = [inv.x < 0.0, inv.y < 0.0, inv.z < 0.0];
-        let mut tmax = ray.tmax;
-        let mut stack = [0u32; STACK];
+        let mut stack = [(0u32, 0f32); STACK];
         let mut sp = 0usize;
         let mut idx = 0usize;
         loop {
             let node = &self.nodes[idx];
-            if node.bounds.hit(ray.org, inv, ray.tmin, tmax).is_some() {
-                if node.count > 0 {
-                    let start = node.offset as usize;
-                    for i in start..start + node.count as usize {
-                        match leaf(i, tmax) {
-                            Some(t) => tmax = t,
-                            None => return,
-                        }
+            if node.count == 0 {
+                let (l, r) = (idx + 1, node.offset as usize);
+                let hl = self.nodes[l].bounds.hit(ray.org, inv, ray.tmin, tmax);
+                let hr = self.nodes[r].bounds.hit(ray.org, inv, ray.tmin, tmax);
+                match (hl, hr) {
+                    (Some(tl), Some(tr)) => {
+                        let (near, far, tfar) = if tl <= tr { (l, r, tr) } else { (r, l, tl) };
+                        stack[sp] = (far as u32, tfar);
+                        sp += 1;
+                        idx = near;
+                        continue;
                     }
-                } else {
-                    // Visit the child on the ray's side of the split first.
-                    let (near, far) = if neg[node.axis as usize] {
-                        (node.offset as usize, idx + 1)
-                    } else {
-                        (idx + 1, node.offset as usize)
-                    };
-                    stack[sp] = far as u32;
-                    sp += 1;
-                    idx = near;
-                    continue;
+                    (Some(_), None) => {
+                        idx = l;
+                        continue;
+                    }
+                    (None, Some(_)) => {
+                        idx = r;
+                        continue;
+                    }
+                    (None, None) => {}
+                }
+            } else {
+                let start = node.offset as usize;
+                for i in start..start + node.count as usize {
+                    match leaf(i, tmax) {
+                        Some(t) => tmax = t,
+                        None => return,
+                    }
                 }
             }
-            if sp == 0 {
-                return;
+            // Next: the nearest pushed node that may still hold a closer hit.
+            loop {
+                if sp == 0 {
+                    return;
+                }
+                sp -= 1;
+                let (next, tentry) = stack[sp];
+                if tentry <= tmax {
+                    idx = next as usize;
+                    break;
+                }
             }
-            sp -= 1;
-            idx = stack[sp] as usize;
         }
     }
 }
