@@ -35,7 +35,8 @@ pub enum Command {
     /// with their measured numbers; exit status 1 if a bound is broken.
     Stress(crate::quality_cmd::StressArgs),
     /// Error against time: the f64 reference once, then a sweep of spp, adaptive AA,
-    /// bailout, depth and backends, to DIR/study.csv and DIR/study.svg.
+    /// bailout, depth and backends, to DIR/study.csv; the error-against-time plot to
+    /// DIR/study.svg and DIR/study.png.
     Study(crate::quality_cmd::StudyArgs),
     /// Solve a scene's diffuse interreflection by radiosity and render a view of it.
     Radiosity(RadiosityArgs),

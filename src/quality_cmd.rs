@@ -225,7 +225,7 @@ pub struct StudyArgs {
     /// reference refuses the rest).
     #[arg(value_name = "SCENE")]
     pub scene: PathBuf,
-    /// Output directory for study.csv and study.svg.
+    /// Output directory for study.csv, study.svg and study.png.
     #[arg(long, value_name = "DIR")]
     pub out: PathBuf,
     /// Image size of every run.
