@@ -1,7 +1,7 @@
 //! Whitted shading (DESIGN.md §4).
 
-use super::{RayGen, RenderSettings};
-use crate::accel::Accel;
+use super::{RayGen, Region, RenderSettings};
+use crate::accel::{Accel, Hit};
 use crate::math::{next_float_down, offset_ray_origin, Ray, Vec3};
 use crate::radiosity::{area, Solution};
 use crate::scene::{Light, Material, Scene, Surface};
@@ -68,6 +68,9 @@ pub(super) struct Tracer<'a, A: Accel> {
     bailout: f32,
     /// Skip work that cannot change the image (see [`RenderSettings::skip`]).
     skip: bool,
+    /// Primary rays of a tile in packets of this many (see
+    /// [`RenderSettings::packet_width`]); 0 = one by one.
+    packet_width: u32,
 }
 
 /// A 32-bit integer hash (Wellons' lowbias32) for per-pixel sample offsets.
@@ -126,6 +129,7 @@ impl<'a, A: Accel> Tracer<'a, A> {
                 0.0
             },
             skip: s.skip,
+            packet_width: s.packet_width,
         }
     }
 
@@ -152,6 +156,31 @@ impl<'a, A: Accel> Tracer<'a, A> {
             sum += self.eye(gen.ray(i as f32 + sx, j as f32 + sy), counts);
         }
         sum / n as f32
+    }
+
+    /// The values of the grid positions of tile `t`, row by row, pushed onto `px`: as
+    /// [`Tracer::pixel`] gives them, but with one sample per pixel the tile's eye rays
+    /// are cast together first (packets on backends that have them; see
+    /// [`RenderSettings::packet_width`]), then each is shaded from its hit.
+    pub(super) fn tile(&self, gen: &RayGen, t: Region, px: &mut Vec<Vec3>, counts: &mut RayCounts) {
+        if self.spp != 1 || self.packet_width == 0 {
+            for j in t.y0..t.y1 {
+                for i in t.x0..t.x1 {
+                    px.push(self.pixel(gen, i, j, counts));
+                }
+            }
+            return;
+        }
+        let rays: Vec<Ray> = (t.y0..t.y1)
+            .flat_map(|j| (t.x0..t.x1).map(move |i| gen.ray(i as f32 + 0.5, j as f32 + 0.5)))
+            .collect();
+        let mut hits = vec![None; rays.len()];
+        self.accel
+            .intersect_coherent(&rays, &mut hits, self.packet_width as usize);
+        for (ray, hit) in rays.iter().zip(hits) {
+            counts.eye += 1;
+            px.push(self.trace_from(ray, hit, 1, Media::AIR, Vec3::ONE, counts));
+        }
     }
 
     /// The value of the eye ray through continuous film position `(px, py)`.
@@ -185,14 +214,29 @@ impl<'a, A: Accel> Tracer<'a, A> {
         weight: Vec3,
         counts: &mut RayCounts,
     ) -> Vec3 {
+        let first = self.accel.intersect(ray);
+        self.trace_from(ray, first, depth, media, weight, counts)
+    }
+
+    /// [`Tracer::trace`] given the ray's nearest hit, `first`.
+    fn trace_from(
+        &self,
+        ray: &Ray,
+        first: Option<Hit>,
+        depth: u32,
+        media: Media,
+        weight: Vec3,
+        counts: &mut RayCounts,
+    ) -> Vec3 {
         let scene = self.scene;
         let mut ray = *ray;
         let mut media = media;
+        let mut next = first;
         // Surfaces of lower-priority media inside a higher-priority one are skipped
         // (nested dielectrics): the ray goes on through them, at most this many times.
         let mut skips = 0;
         loop {
-            let Some(hit) = self.accel.intersect(&ray) else {
+            let Some(hit) = next else {
                 return scene.escape(ray.dir);
             };
             let surf = scene.surface(&hit, &ray);
@@ -218,6 +262,7 @@ impl<'a, A: Accel> Tracer<'a, A> {
                     offset_ray_origin(surf.point.p, surf.point.err, ng, d),
                     ray.dir,
                 );
+                next = self.accel.intersect(&ray);
                 continue;
             }
             if depth == 1 {
