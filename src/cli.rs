@@ -378,7 +378,8 @@ pub struct RenderArgs {
     pub embree_robust: bool,
     /// Cast each tile's primary rays together, as Embree packets of this many rays
     /// (`rtcIntersect4/8/16`); 0 casts them one by one. Used with one sample per pixel
-    /// (SPD mode included); the image is the same either way.
+    /// (SPD mode included). Analytic shapes give the same hits either way; Embree's
+    /// packet triangle test may round a ray through a shared edge to the other triangle.
     #[arg(long, value_name = "N", default_value_t = 8, value_parser = packet_width)]
     pub packet_width: u32,
     /// Antialiasing: `uniform` (`--spp` stratified samples) or `adaptive` (corner rays
