@@ -2,7 +2,7 @@
 
 use super::{RayGen, Region, RenderSettings};
 use crate::accel::{Accel, Hit};
-use crate::math::{next_float_down, offset_ray_origin, Ray, Vec3};
+use crate::math::{next_float_down, offset_ray_origin, Ray, RayOrigins, Vec3};
 use crate::radiosity::{area, Solution};
 use crate::scene::{Light, Material, Scene, Surface};
 
@@ -298,15 +298,15 @@ impl<'a, A: Accel> Tracer<'a, A> {
         // Both sides are surfaces: face the normals towards the incoming ray.
         let ng = if entering { ng_out } else { -ng_out };
         let ns = if ns.dot(d) > 0.0 { -ns } else { ns };
-        let spawn =
-            |dir: Vec3| -> Ray { Ray::new(offset_ray_origin(p, surf.point.err, ng, dir), dir) };
+        // Every ray leaving this hit starts from one of the two offset points.
+        let mut origins = RayOrigins::new(p, surf.point.err, ng);
 
         let mut color = match gi {
             Some(b) => b,
             None => self.local_diffuse(surf, m, ng, ns, entering, counts),
         };
         for light in &scene.lights {
-            color += self.direct(light, surf, m, ng, ns, d, counts);
+            color += self.direct(light, surf, m, &mut origins, ns, d, counts);
         }
 
         if depth >= self.max_depth {
@@ -331,7 +331,7 @@ impl<'a, A: Accel> Tracer<'a, A> {
                     let w = m.t * filter;
                     if self.worth(weight * w, counts) {
                         counts.refraction += 1;
-                        let ray = spawn(dir);
+                        let ray = Ray::new(origins.towards(dir), dir);
                         color += w * self.trace(&ray, depth + 1, inside, weight * w, counts);
                     }
                 }
@@ -349,11 +349,19 @@ impl<'a, A: Accel> Tracer<'a, A> {
             } else {
                 // Cast and thrown away: only to measure what skipping saves.
                 counts.reflection += 1;
-                self.trace(&spawn(reflect(d, ns)), depth + 1, media, w, counts);
+                let dir = reflect(d, ns);
+                self.trace(
+                    &Ray::new(origins.towards(dir), dir),
+                    depth + 1,
+                    media,
+                    w,
+                    counts,
+                );
             }
         } else if self.worth(w, counts) {
             counts.reflection += 1;
-            let ray = spawn(reflect(d, ns));
+            let dir = reflect(d, ns);
+            let ray = Ray::new(origins.towards(dir), dir);
             color += reflect_weight * self.trace(&ray, depth + 1, media, w, counts);
         }
         color
@@ -361,8 +369,9 @@ impl<'a, A: Accel> Tracer<'a, A> {
 }
 
 impl<A: Accel> Tracer<'_, A> {
-    /// The diffuse and highlight light `light` sends to `surf` (material `m`, normals
-    /// `ng`, `ns` facing the ray of unit direction `d`), after its shadow ray.
+    /// The diffuse and highlight light `light` sends to `surf` (material `m`, shading
+    /// normal `ns` facing the ray of unit direction `d`), after its shadow ray from one
+    /// of `origins`.
     #[allow(clippy::too_many_arguments)]
     #[inline(always)]
     fn direct(
@@ -370,7 +379,7 @@ impl<A: Accel> Tracer<'_, A> {
         light: &Light,
         surf: &Surface,
         m: &Material,
-        ng: Vec3,
+        origins: &mut RayOrigins,
         ns: Vec3,
         d: Vec3,
         counts: &mut RayCounts,
@@ -387,7 +396,7 @@ impl<A: Accel> Tracer<'_, A> {
             return Vec3::ZERO;
         }
         counts.shadow += 1;
-        let org = offset_ray_origin(p, surf.point.err, ng, to_light);
+        let org = origins.towards(to_light);
         let mut shadow = Ray::new(org, light.pos - org);
         shadow.tmax = next_float_down(1.0);
         if self.accel.occluded(&shadow) || useless {
