@@ -210,12 +210,17 @@ pub fn render_with_gi<A: Accel>(
         // The rays through every pixel corner, then each pixel refined from its four.
         let gen = RayGen::new(&scene.camera, w, h);
         let (cw, ch) = (r.width() + 1, r.height() + 1);
-        let (corners, mut rays) =
-            sample_grid(r.x0, r.y0, cw, ch, settings.tile, None, |i, j, c| {
-                tracer.sample(&gen, i as f32, j as f32, c)
-            });
+        let (corners, mut rays) = sample_grid(
+            r.x0,
+            r.y0,
+            cw,
+            ch,
+            settings.tile,
+            None,
+            per_position(|i, j, c| tracer.sample(&gen, i as f32, j as f32, c)),
+        );
         let (rw, rh) = (r.width(), r.height());
-        let (film, more) = sample_grid(r.x0, r.y0, rw, rh, settings.tile, progress, |i, j, c| {
+        let refine = per_position(|i, j, c| {
             let (ci, cj) = (i - r.x0, j - r.y0);
             let k = [
                 corners.get(ci, cj),
@@ -226,6 +231,7 @@ pub fn render_with_gi<A: Accel>(
             let s = |x: f32, y: f32, c: &mut RayCounts| tracer.sample(&gen, x, y, c);
             adaptive(&s, i as f32, j as f32, 1.0, k, threshold, depth, c)
         });
+        let (film, more) = sample_grid(r.x0, r.y0, rw, rh, settings.tile, progress, refine);
         rays += more;
         let render_ms = start.elapsed().as_secs_f64() * 1e3;
         return (film, RenderStats { rays, render_ms });
@@ -235,7 +241,7 @@ pub fn render_with_gi<A: Accel>(
     let gen = RayGen::new(&scene.camera, gw, gh);
     let extra = u32::from(settings.spd);
     let (rw, rh) = (r.width() + extra, r.height() + extra);
-    let (grid, rays) = sample_tiles(r.x0, r.y0, rw, rh, settings.tile, progress, |t, px, c| {
+    let (grid, rays) = sample_grid(r.x0, r.y0, rw, rh, settings.tile, progress, |t, px, c| {
         tracer.tile(&gen, t, px, c);
     });
     let film = if settings.spd {
@@ -250,33 +256,26 @@ pub fn render_with_gi<A: Accel>(
     (film, stats)
 }
 
-/// Evaluate `f(i, j)` over the `gw × gh` grid whose top-left is `(ox, oy)`, in parallel
-/// square tiles of edge `tile`, the result independent of the schedule; the film's
-/// pixel `(i, j)` is `f(ox + i, oy + j)`.
-fn sample_grid<F>(
-    ox: u32,
-    oy: u32,
-    gw: u32,
-    gh: u32,
-    tile: u32,
-    progress: Option<Progress<'_>>,
-    f: F,
-) -> (Film, RayCounts)
+/// A per-position function `f(i, j, counts)` as a tile function for [`sample_grid`]:
+/// the tile's positions row by row.
+fn per_position<F>(f: F) -> impl Fn(Region, &mut Vec<glam::Vec3>, &mut RayCounts) + Sync
 where
     F: Fn(u32, u32, &mut RayCounts) -> glam::Vec3 + Sync,
 {
-    sample_tiles(ox, oy, gw, gh, tile, progress, |t, px, counts| {
+    move |t, px, counts| {
         for j in t.y0..t.y1 {
             for i in t.x0..t.x1 {
                 px.push(f(i, j, counts));
             }
         }
-    })
+    }
 }
 
-/// [`sample_grid`] with a function of a whole tile: `f(tile, px, counts)` pushes the
-/// values of the tile's grid positions (absolute coordinates, row by row) onto `px`.
-fn sample_tiles<F>(
+/// Evaluate the `gw × gh` grid whose top-left is `(ox, oy)` in parallel square tiles
+/// of edge `tile`, the result independent of the schedule: `f(tile, px, counts)` pushes
+/// the values of the tile's grid positions (absolute coordinates, row by row) onto
+/// `px`, and the film's pixel `(i, j)` is the value of position `(ox + i, oy + j)`.
+fn sample_grid<F>(
     ox: u32,
     oy: u32,
     gw: u32,

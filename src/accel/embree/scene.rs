@@ -578,19 +578,30 @@ mod query {
         ctx
     }
 
+    /// As `rtcInitIntersectArguments` with `flags`: all features, no filter or argument
+    /// callbacks; plus our context.
     #[inline(always)]
-    pub(super) fn intersect(scene: sys::RTCScene, rayhit: &mut sys::RTCRayHit) {
-        let mut ctx = context();
-        // As `rtcInitIntersectArguments`: incoherent, all features, no filter or
-        // argument callbacks; plus our context.
-        let mut args = sys::RTCIntersectArguments {
-            flags: sys::RTCRayQueryFlags::RTC_RAY_QUERY_FLAG_INCOHERENT,
+    fn intersect_args(
+        ctx: &mut sys::RTCRayQueryContext,
+        flags: sys::RTCRayQueryFlags,
+    ) -> sys::RTCIntersectArguments {
+        sys::RTCIntersectArguments {
+            flags,
             feature_mask: sys::RTCFeatureFlags::RTC_FEATURE_FLAG_ALL,
-            context: &mut ctx,
+            context: ctx,
             filter: None,
             intersect: None,
             ..Default::default()
-        };
+        }
+    }
+
+    #[inline(always)]
+    pub(super) fn intersect(scene: sys::RTCScene, rayhit: &mut sys::RTCRayHit) {
+        let mut ctx = context();
+        let mut args = intersect_args(
+            &mut ctx,
+            sys::RTCRayQueryFlags::RTC_RAY_QUERY_FLAG_INCOHERENT,
+        );
         // SAFETY: `scene` is live and committed; `args` and the context it points to are
         // initialised as the header's init functions do and outlive the call; `rayhit`
         // is a valid, 16-byte aligned `RTCRayHit` with mask, tnear <= tfar and invalid
@@ -619,14 +630,8 @@ mod query {
             #[inline(always)]
             pub(super) fn $name(valid: &[i32; $n], scene: sys::RTCScene, rayhit: &mut sys::$ty) {
                 let mut ctx = context();
-                let mut args = sys::RTCIntersectArguments {
-                    flags: sys::RTCRayQueryFlags::RTC_RAY_QUERY_FLAG_COHERENT,
-                    feature_mask: sys::RTCFeatureFlags::RTC_FEATURE_FLAG_ALL,
-                    context: &mut ctx,
-                    filter: None,
-                    intersect: None,
-                    ..Default::default()
-                };
+                let mut args =
+                    intersect_args(&mut ctx, sys::RTCRayQueryFlags::RTC_RAY_QUERY_FLAG_COHERENT);
                 // SAFETY: as in `intersect`; `valid` has N entries; `rayhit` is an
                 // aligned packet whose active rays have mask, tnear <= tfar and invalid
                 // ids set.
