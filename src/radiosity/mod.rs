@@ -1,6 +1,7 @@
 //! Radiosity: diffuse interreflection between the scene's surfaces, view-independent.
 //!
-//! The phases: [`mesh`] splits every triangle into elements of at most the patch size;
+//! The phases: [`mesh`] splits every triangle, and the faces of the analytic shapes
+//! [`tessellate`] handles, into elements of at most the patch size;
 //! [`formfactor`] estimates form factors by ray casting (exact point-to-polygon form
 //! factors with visibility from `Accel::occluded`, either backend); [`solver`] solves
 //! the system by progressive refinement (or Gauss–Seidel on the full matrix); a
@@ -18,6 +19,7 @@ pub mod formfactor;
 pub mod hemicube;
 pub mod mesh;
 pub mod solver;
+pub mod tessellate;
 
 use crate::accel::{Accel, AccelError, Backend, Hit};
 use crate::geometry::Kind;
@@ -64,7 +66,8 @@ pub enum FormFactorMethod {
     /// visibility from `Accel::occluded` rays (either backend).
     RayCast,
     /// A hemicube of this many pixels across its top face on each shooter's centroid,
-    /// visibility from its depth buffer (meshed triangles only).
+    /// visibility from its depth buffer (meshed elements only: analytic shapes that
+    /// are not tessellated do not occlude).
     Hemicube(u32),
 }
 
@@ -177,17 +180,32 @@ impl Solution {
         }
     }
 
-    /// The Gouraud-interpolated radiosity at a hit on a meshed triangle seen along
-    /// `dir` (zero on its back side); `None` for primitives that are not meshed.
-    pub fn radiosity_at(&self, hit: &Hit, dir: Vec3) -> Option<Vec3> {
-        if hit.kind() != Kind::Triangle {
-            return None;
-        }
-        let (k, u, v) = self.mesh.locate(hit.inst_id, hit.prim_id, hit.u, hit.v)?;
+    /// The Gouraud-interpolated radiosity at a hit at point `p` seen along `dir`: on a
+    /// meshed triangle, at the hit's barycentric coordinates (zero on its back side); on
+    /// a tessellated analytic shape, at the projection of `p` onto the face under it (see
+    /// [`tessellate`]; the back side of an open cone is not meshed: `None`); `None` for
+    /// primitives that are not meshed.
+    pub fn radiosity_at(&self, hit: &Hit, p: Vec3, dir: Vec3) -> Option<Vec3> {
+        let (k, u, v) = match hit.kind() {
+            Kind::Triangle => {
+                let (k, u, v) = self.mesh.locate(hit.inst_id, hit.prim_id, hit.u, hit.v)?;
+                if self.mesh.elements[k].n.dot(dir) >= 0.0 {
+                    return Some(Vec3::ZERO);
+                }
+                (k, u, v)
+            }
+            _ if hit.inst_id != crate::accel::NO_INSTANCE => return None,
+            kind => {
+                let (k, u, v, open) = self.mesh.locate_analytic(kind, hit.prim_id, p, hit.ng)?;
+                // A closed shape shows only its meshed side; an open one shows both.
+                let n = self.mesh.elements[k].n;
+                if open && (hit.ng.dot(n) > 0.0) != (hit.ng.dot(dir) < 0.0) {
+                    return None;
+                }
+                (k, u, v)
+            }
+        };
         let e = &self.mesh.elements[k];
-        if e.n.dot(dir) >= 0.0 {
-            return Some(Vec3::ZERO);
-        }
         let c = e.verts.map(|i| self.vertex_radiosity[i as usize]);
         Some(c[0] * (1.0 - u - v) + c[1] * u + c[2] * v)
     }
@@ -359,7 +377,7 @@ pub fn default_patch_size(scene: &Scene) -> f32 {
 }
 
 /// Look at a solution from the scene's camera (`width × height`, `spp²` stratified
-/// samples per pixel): Gouraud radiosity on meshed triangles, the material colour
+/// samples per pixel): Gouraud radiosity on meshed surfaces, the material colour
 /// times the scene's ambient on other primitives, the background on misses.
 pub fn render_view<A: Accel>(
     scene: &Scene,
@@ -385,10 +403,13 @@ pub fn render_view<A: Accel>(
                             );
                             sum += match accel.intersect(&ray) {
                                 None => scene.background,
-                                Some(hit) => sol.radiosity_at(&hit, ray.dir).unwrap_or_else(|| {
-                                    let surf = scene.surface(&hit, &ray);
-                                    scene.materials[surf.material as usize].color * scene.ambient
-                                }),
+                                Some(hit) => sol
+                                    .radiosity_at(&hit, ray.at(hit.t), ray.dir)
+                                    .unwrap_or_else(|| {
+                                        let surf = scene.surface(&hit, &ray);
+                                        scene.materials[surf.material as usize].color
+                                            * scene.ambient
+                                    }),
                             };
                         }
                     }
