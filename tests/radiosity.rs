@@ -999,3 +999,37 @@ fn tessellated_shapes_receive_reflect_and_shadow() {
         }
     }
 }
+
+#[test]
+fn adaptive_rounds_go_on_from_the_previous_solution() {
+    let scene = shadow_scene();
+    let accel = Bvh::build(&scene);
+    for solver in [SolverKind::Progressive, SolverKind::GaussSeidel] {
+        let settings = RadiositySettings {
+            patch_size: Some(0.26),
+            epsilon: 1e-5,
+            subdiv_threshold: Some(0.2),
+            min_patch_size: Some(0.03),
+            subdiv_passes: 2,
+            solver,
+            ..Default::default()
+        };
+        let sol = radiosity::solve(&scene, &accel, &settings).unwrap();
+        assert_eq!(sol.solve.refinements.len(), 2);
+        if solver == SolverKind::Progressive {
+            assert!(sol.solve.regathered > 0);
+            assert!(sol.solve.total_iterations > sol.solve.iterations);
+        }
+        // A solve from the emission alone on the same final mesh.
+        let fresh = radiosity::solve_mesh(&sol.mesh, &accel, &settings, None).unwrap();
+        let m = &sol.mesh;
+        let scale = (m.elements.iter().zip(&fresh.radiosity))
+            .filter(|(e, _)| m.emission[e.material as usize] == Vec3::ZERO)
+            .map(|(_, b)| b.max_element())
+            .fold(0.0, f32::max);
+        for (k, (a, b)) in sol.solve.radiosity.iter().zip(&fresh.radiosity).enumerate() {
+            let d = (*a - *b).abs().max_element();
+            assert!(d <= 1e-3 * scale, "{solver:?} element {k}: {a} vs {b}");
+        }
+    }
+}

@@ -1,5 +1,6 @@
 //! Meshing for the radiosity pass: every triangle of the scene (top level and
-//! instanced) is split by repeated midpoint subdivision (each triangle into four
+//! instanced), and every face of the top-level analytic shapes
+//! [`super::tessellate`] handles, is split by repeated midpoint subdivision (each triangle into four
 //! similar ones) until its longest edge is at most the patch size. Each source triangle
 //! keeps its subdivision as a quadtree, so a hit's barycentric coordinates on the source
 //! triangle find its element by descending the tree, and any element can be split again

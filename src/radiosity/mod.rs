@@ -259,9 +259,10 @@ pub fn solve<A: Accel>(
     if mesh.elements.is_empty() {
         return Err(RadiosityError::Empty);
     }
-    let mut solve = solve_mesh(&mesh, accel, settings)?;
+    let mut solve = solve_mesh(&mesh, accel, settings, None)?;
     let (mut form_factor_ms, mut total_ms, mut refinements) =
         (solve.form_factor_ms, solve.total_ms, Vec::new());
+    let (mut shots, mut regathered) = (solve.iterations, 0);
     if let Some(threshold) = settings.subdiv_threshold {
         let min = settings.min_patch_size.unwrap_or(patch / 8.0);
         if !(threshold.is_finite() && threshold > 0.0 && min.is_finite() && min > 0.0) {
@@ -274,18 +275,33 @@ pub fn solve<A: Accel>(
             if marked.is_empty() {
                 break;
             }
+            // Children inherit their parent's state: the radiosity it has shot
+            // (progressive) or holds (Gauss–Seidel). `split` keeps the first child at
+            // the parent's index and appends the other three in order.
+            let mut state: Vec<Vec3> = match settings.solver {
+                SolverKind::Progressive => (solve.radiosity.iter())
+                    .zip(&solve.unshot)
+                    .map(|(&b, &u)| b - u)
+                    .collect(),
+                SolverKind::GaussSeidel => solve.radiosity.clone(),
+            };
+            for &k in &marked {
+                state.extend([state[k]; 3]);
+            }
             mesh.split(&marked)?;
             refinements.push(marked.len());
-            // A fresh solve on the refined mesh: every element starts with its emission
-            // unshot, so the energy bookkeeping is that of a first solve.
-            solve = solve_mesh(&mesh, accel, settings)?;
+            solve = solve_mesh(&mesh, accel, settings, Some(&state))?;
             form_factor_ms += solve.form_factor_ms;
             total_ms += solve.total_ms;
+            shots += solve.iterations;
+            regathered += solve.regathered;
         }
     }
     solve.form_factor_ms = form_factor_ms;
     solve.total_ms = total_ms;
     solve.refinements = refinements;
+    solve.total_iterations = shots;
+    solve.regathered = regathered;
     Ok(Solution::new(mesh, solve))
 }
 
@@ -329,29 +345,29 @@ pub fn marked_for_split(mesh: &Mesh, radiosity: &[Vec3], threshold: f32, min: f3
         .collect()
 }
 
-/// Solve the radiosity system of `mesh` with the settings' form factors and solver.
-fn solve_mesh<A: Accel>(
+/// Solve the radiosity system of `mesh` with the settings' form factors and solver,
+/// from the emission (`start` `None`) or from a previous state: per element, the
+/// radiosity already shot (progressive refinement) or the current radiosity
+/// (Gauss–Seidel).
+pub fn solve_mesh<A: Accel>(
     mesh: &Mesh,
     accel: &A,
     settings: &RadiositySettings,
+    start: Option<&[Vec3]>,
 ) -> Result<Solve, RadiosityError> {
     let (eps, max) = (settings.epsilon, settings.max_iterations);
+    let run = |row: &dyn Fn(usize) -> Vec<f32>| match settings.solver {
+        SolverKind::Progressive => solver::progressive_rows_from(mesh, row, eps, max, start),
+        SolverKind::GaussSeidel => solver::gauss_seidel_rows_from(mesh, row, eps, max, start),
+    };
     match settings.form_factors {
         FormFactorMethod::RayCast => {
             let s = Sampling::new(settings.shooter_level, settings.visibility_level);
-            let row = |i| solver::form_factor_row(mesh, accel, &s, i);
-            match settings.solver {
-                SolverKind::Progressive => solver::progressive_rows(mesh, row, eps, max),
-                SolverKind::GaussSeidel => solver::gauss_seidel_rows(mesh, row, eps, max),
-            }
+            run(&|i| solver::form_factor_row(mesh, accel, &s, i))
         }
         FormFactorMethod::Hemicube(res) => {
             let h = hemicube::Hemicube::new(res)?;
-            let row = |i| h.row(mesh, i);
-            match settings.solver {
-                SolverKind::Progressive => solver::progressive_rows(mesh, row, eps, max),
-                SolverKind::GaussSeidel => solver::gauss_seidel_rows(mesh, row, eps, max),
-            }
+            run(&|i| h.row(mesh, i))
         }
     }
 }
@@ -450,8 +466,12 @@ pub struct RadiosityReport {
     pub shooter_samples: usize,
     /// Visibility rays per pair of elements.
     pub visibility_samples: usize,
-    /// Shots or sweeps.
+    /// Shots or sweeps (the last round of adaptive subdivision).
     pub iterations: usize,
+    /// Shots or sweeps in all rounds.
+    pub total_iterations: usize,
+    /// Form-factor rows computed to gather each round's start from the previous one.
+    pub regathered: usize,
     /// Residual curve.
     pub residuals: Vec<f64>,
     /// Milliseconds: building the backend, form factors, whole solve, one view.
@@ -479,7 +499,7 @@ impl RadiosityReport {
         };
         format!(
             "backend    {}\nmesh       {} elements, {} vertices (patch size {}), {} analytic primitives not meshed\n\
-             subdivide  {:?} elements split per round\n\
+             subdivide  {:?} elements split per round; {} iterations and {} re-gather rows in all rounds\n\
              ff         {}\n\
              solver     {:?}: {} iterations, final residual {:.3e}\n\
              time       build {:.1} ms, form factors {:.1} ms, solve {:.1} ms, view {:.1} ms",
@@ -489,6 +509,8 @@ impl RadiosityReport {
             self.patch_size,
             self.unmeshed,
             self.refinements,
+            self.total_iterations,
+            self.regathered,
             method,
             self.solver,
             self.iterations,
@@ -526,6 +548,8 @@ fn solve_and_view<A: Accel>(
         shooter_samples: 1 << (2 * settings.shooter_level),
         visibility_samples: 1 << (2 * settings.visibility_level),
         iterations: sol.solve.iterations,
+        total_iterations: sol.solve.total_iterations,
+        regathered: sol.solve.regathered,
         residuals: sol.solve.residuals.clone(),
         build_ms,
         form_factor_ms: sol.solve.form_factor_ms,
