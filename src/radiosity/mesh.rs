@@ -438,7 +438,7 @@ impl Mesh {
         let src = self.analytic.get(&(kind as u32, prim))?;
         let fan = src.faces.get(src.lookup.face(p, ng))?;
         let score = |&(t, _): &&([Vec3; 3], u32)| {
-            let (u, v) = tessellate::barycentric(&t, p);
+            let (u, v) = tessellate::barycentric(t, p);
             u.min(v).min(1.0 - u - v)
         };
         let best = fan.iter().max_by(|a, b| score(a).total_cmp(&score(b)))?;

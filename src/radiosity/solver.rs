@@ -155,8 +155,8 @@ pub fn progressive_rows_from<R: Fn(usize) -> Vec<f32>>(
                 out.regathered += 1;
             }
         }
-        for i in 0..n {
-            out.unshot[i] = out.radiosity[i] - shot[i];
+        for ((u, &b), &s) in out.unshot.iter_mut().zip(&out.radiosity).zip(shot) {
+            *u = b - s;
         }
     }
     let abs_power = |v: Vec3| power(v.abs());

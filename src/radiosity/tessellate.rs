@@ -147,7 +147,7 @@ fn cells(len: f32, patch: f32, min: u32, max: u32) -> u32 {
 }
 
 /// Orient `poly` counterclockwise about `front` and drop repeated corners (poles and
-/// apices); `None` when fewer than three corners remain.
+/// apices); empty when fewer than three corners remain.
 fn oriented(mut poly: Vec<Vec3>, front: Vec3) -> Vec<Vec3> {
     poly.dedup();
     while poly.len() > 1 && poly.first() == poly.last() {
