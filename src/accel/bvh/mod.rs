@@ -1,17 +1,21 @@
 //! The pure-Rust backend: a binned-SAH bounding volume hierarchy over every primitive
-//! kind, stored as a flat node array (left child next to its parent), traversed
-//! nearer-child-first (both children's boxes tested at the parent), skipping pushed
-//! nodes that lie beyond the nearest hit found meanwhile.
+//! kind, built binary and collapsed into 4-wide nodes (the four children's boxes stored
+//! axis by axis and tested together). Nearest-hit queries visit the children a ray
+//! reaches nearest entry first and skip pushed ones that lie beyond the nearest hit
+//! found meanwhile; any-hit (shadow) queries visit them in slot order.
 
 mod build;
+mod wide;
 
 use crate::accel::{Accel, AccelStats, Hit, NO_INSTANCE};
 use crate::geometry::{Intersect, Kind, Shape, Triangle, WatertightRay};
 use crate::math::{Aabb, Ray, Xform};
 use crate::scene::{Geometry, Scene};
 use std::sync::Arc;
+use wide::{Node4, Visit};
 
-/// One node: 32 bytes.
+/// One node of the binary tree the builder makes (then collapsed into [`Node4`]s): 32
+/// bytes.
 #[derive(Clone, Copy, Debug)]
 #[repr(C)]
 struct Node {
@@ -21,7 +25,7 @@ struct Node {
     offset: u32,
     /// Number of primitives; 0 for an interior node.
     count: u16,
-    /// Split axis of an interior node (decides which child is near).
+    /// Split axis of an interior node.
     axis: u16,
 }
 
@@ -54,7 +58,13 @@ struct PlacedObject {
 /// The built hierarchy: two levels when the scene has instances (the top level's
 /// leaves hold instances, whose objects have hierarchies of their own).
 pub struct Bvh {
-    nodes: Vec<Node>,
+    nodes: Vec<Node4>,
+    /// `(first primitive, count)` of each leaf.
+    leaves: Vec<(u32, u32)>,
+    /// Stack depth a traversal needs (see [`wide::collapse`]).
+    stack_need: usize,
+    /// Bounds of the tree (not of the unbounded primitives).
+    tree_bounds: Aabb,
     prims: Vec<Prim>,
     /// `(geom_id, prim_id)` of each entry of `prims` (`(u32::MAX, instance)` for
     /// instances).
@@ -119,7 +129,9 @@ impl Bvh {
             .filter(|&i| all_bounds[i].is_finite())
             .collect();
         let bounds: Vec<Aabb> = bounded.iter().map(|&i| all_bounds[i]).collect();
-        let (nodes, order) = build::build(&bounds);
+        let (binary, order) = build::build(&bounds);
+        let tree_bounds = binary.first().map_or(Aabb::EMPTY, |n| n.bounds);
+        let (nodes, leaves, stack_need) = wide::collapse(&binary);
         let mut out_prims: Vec<Prim> = order
             .iter()
             .map(|&k| prims[bounded[k as usize]].clone())
@@ -134,6 +146,9 @@ impl Bvh {
         }
         Bvh {
             nodes,
+            leaves,
+            stack_need,
+            tree_bounds,
             prims: out_prims,
             ids: out_ids,
             unbounded,
@@ -143,7 +158,7 @@ impl Bvh {
 
     /// Bounds of everything in this level (infinite with unbounded primitives).
     fn bounds(&self) -> Aabb {
-        let mut b = self.nodes.first().map_or(Aabb::EMPTY, |n| n.bounds);
+        let mut b = self.tree_bounds;
         for &i in &self.unbounded {
             b = b.union(&self.prims[i].bounds(&self.instances));
         }
@@ -155,69 +170,13 @@ impl Bvh {
         self.nodes.len()
     }
 
-    /// Walk the tree; `leaf` is called for each primitive index of every leaf the ray
-    /// reaches and returns the new `tmax` (or `None` to stop at once). Both children's
-    /// boxes are tested at their parent: the nearer one (by entry distance) is visited
-    /// first, the other is pushed with its entry distance and skipped when it comes off
-    /// the stack if a hit closer than that was found meanwhile.
+    /// Walk the tree (see [`wide::traverse`]), ordered for nearest-hit queries.
     #[inline]
-    fn traverse(&self, ray: &Ray, mut leaf: impl FnMut(usize, f32) -> Option<f32>) {
-        let Some(root) = self.nodes.first() else {
-            return;
-        };
-        let inv = ray.dir.recip();
-        let mut tmax = ray.tmax;
-        if root.bounds.hit(ray.org, inv, ray.tmin, tmax).is_none() {
-            return;
-        }
-        let mut stack = [(0u32, 0f32); STACK];
-        let mut sp = 0usize;
-        let mut idx = 0usize;
-        loop {
-            let node = &self.nodes[idx];
-            if node.count == 0 {
-                let (l, r) = (idx + 1, node.offset as usize);
-                let hl = self.nodes[l].bounds.hit(ray.org, inv, ray.tmin, tmax);
-                let hr = self.nodes[r].bounds.hit(ray.org, inv, ray.tmin, tmax);
-                match (hl, hr) {
-                    (Some(tl), Some(tr)) => {
-                        let (near, far, tfar) = if tl <= tr { (l, r, tr) } else { (r, l, tl) };
-                        stack[sp] = (far as u32, tfar);
-                        sp += 1;
-                        idx = near;
-                        continue;
-                    }
-                    (Some(_), None) => {
-                        idx = l;
-                        continue;
-                    }
-                    (None, Some(_)) => {
-                        idx = r;
-                        continue;
-                    }
-                    (None, None) => {}
-                }
-            } else {
-                let start = node.offset as usize;
-                for i in start..start + node.count as usize {
-                    match leaf(i, tmax) {
-                        Some(t) => tmax = t,
-                        None => return,
-                    }
-                }
-            }
-            // Next: the nearest pushed node that may still hold a closer hit.
-            loop {
-                if sp == 0 {
-                    return;
-                }
-                sp -= 1;
-                let (next, tentry) = stack[sp];
-                if tentry <= tmax {
-                    idx = next as usize;
-                    break;
-                }
-            }
+    fn traverse<const ORDERED: bool>(&self, ray: &Ray, leaf: impl FnMut(usize, f32) -> Visit) {
+        if self.stack_need <= wide::STACK_SMALL {
+            wide::traverse::<ORDERED, { wide::STACK_SMALL }>(&self.nodes, &self.leaves, ray, leaf)
+        } else {
+            wide::traverse::<ORDERED, { wide::STACK4 }>(&self.nodes, &self.leaves, ray, leaf)
         }
     }
 }
@@ -277,13 +236,13 @@ impl Bvh {
             }
         }
         let ray = Ray { tmax, ..*ray };
-        self.traverse(&ray, |i, tmax| {
+        self.traverse::<true>(&ray, |i, tmax| {
             match self.hit_prim(i, &ray, &mut wt, tmax) {
                 Some(h) => {
                     best = Some(h);
-                    Some(h.t)
+                    Visit::Continue(h.t)
                 }
-                None => Some(tmax),
+                None => Visit::Continue(tmax),
             }
         });
         best
@@ -295,12 +254,12 @@ impl Bvh {
             return true;
         }
         let mut hit = false;
-        self.traverse(ray, |i, tmax| {
+        self.traverse::<false>(ray, |i, tmax| {
             if self.occludes(i, ray, &wt) {
                 hit = true;
-                None
+                Visit::Stop
             } else {
-                Some(tmax)
+                Visit::Continue(tmax)
             }
         });
         hit
@@ -343,11 +302,12 @@ impl Accel for Bvh {
             backend: "bvh",
             prims: self.prims.len(),
             nodes: self.nodes.len(),
-            bytes: self.nodes.len() * std::mem::size_of::<Node>()
+            bytes: self.nodes.len() * std::mem::size_of::<Node4>()
+                + self.leaves.len() * std::mem::size_of::<(u32, u32)>()
                 + self.prims.len()
                     * (std::mem::size_of::<Prim>() + std::mem::size_of::<(u32, u32)>()),
             detail: format!(
-                "binned SAH, {} bins, max leaf {}",
+                "binned SAH, {} bins, max leaf {}, 4-wide nodes",
                 build::BINS,
                 build::MAX_LEAF
             ),
@@ -361,8 +321,11 @@ mod tests {
     use super::*;
 
     #[test]
-    fn node_is_32_bytes() {
+    fn node_sizes() {
         assert_eq!(std::mem::size_of::<Node>(), 32);
+        // A 4-wide node fills exactly two cache lines and starts on one.
+        assert_eq!(std::mem::size_of::<Node4>(), 128);
+        assert_eq!(std::mem::align_of::<Node4>(), 64);
     }
 }
 
@@ -370,6 +333,7 @@ mod tests {
 mod agreement {
     //! The BVH against a brute-force loop over the same intersectors: it must find
     //! exactly the same nearest hit (the same `t`, bit for bit).
+    use super::wide::LEAF;
     use super::*;
     use crate::geometry::{Cone, Sphere};
     use crate::math::Vec3;
@@ -477,29 +441,44 @@ mod agreement {
         let mut seed = 3u64;
         let scene = random_scene(5000, &mut seed);
         let bvh = Bvh::build(&scene);
-        // Every primitive in exactly one leaf, every child inside its parent.
+        // Every primitive in exactly one leaf, every child inside its parent's slot.
         let mut seen = vec![0u32; bvh.prims.len()];
         let mut stack = vec![(0usize, 0usize)];
         let mut max_depth = 0;
+        let mut slots = 0;
         while let Some((i, depth)) = stack.pop() {
             max_depth = max_depth.max(depth);
             let n = bvh.nodes[i];
-            if n.count > 0 {
-                let range = n.offset as usize..(n.offset + n.count as u32) as usize;
-                for (k, prim) in bvh.prims[range.clone()].iter().enumerate() {
-                    seen[range.start + k] += 1;
-                    let b = prim.bounds(&bvh.instances);
-                    assert!(n.bounds.contains(b.min) && n.bounds.contains(b.max));
+            for slot in 0..4 {
+                let (child, b) = (n.child[slot], n.slot_bounds(slot));
+                if child == u32::MAX {
+                    assert!(b.is_empty());
+                    continue;
                 }
-            } else {
-                for c in [i + 1, n.offset as usize] {
-                    let cb = bvh.nodes[c].bounds;
-                    assert!(n.bounds.contains(cb.min) && n.bounds.contains(cb.max));
-                    stack.push((c, depth + 1));
+                slots += 1;
+                if child & LEAF != 0 {
+                    let (start, count) = bvh.leaves[(child & !LEAF) as usize];
+                    let range = start as usize..(start + count) as usize;
+                    for (k, prim) in bvh.prims[range.clone()].iter().enumerate() {
+                        seen[range.start + k] += 1;
+                        let pb = prim.bounds(&bvh.instances);
+                        assert!(b.contains(pb.min) && b.contains(pb.max));
+                    }
+                } else {
+                    let c = bvh.nodes[child as usize];
+                    for cs in 0..4 {
+                        let cb = c.slot_bounds(cs);
+                        assert!(cb.is_empty() || (b.contains(cb.min) && b.contains(cb.max)));
+                    }
+                    stack.push((child as usize, depth + 1));
                 }
             }
         }
         assert!(seen.iter().all(|&c| c == 1));
+        assert!(bvh.stack_need <= wide::STACK4, "stack {}", bvh.stack_need);
+        assert!(bvh.stack_need >= max_depth, "stack {}", bvh.stack_need);
+        // Collapsing fills the nodes: far fewer than one per two children.
+        assert!(slots as f64 > 3.0 * bvh.nodes.len() as f64, "{slots} slots");
         assert!(max_depth < STACK, "depth {max_depth}");
         // A SAH tree over 5000 scattered primitives is far shallower than a list.
         assert!(max_depth < 40, "depth {max_depth}");
