@@ -239,6 +239,7 @@ fn bench(b: &cli::BenchArgs) -> ExitCode {
         raw: !b.no_raw,
         peer: !b.no_peer,
         embree_quality: b.embree_quality.into(),
+        packet_width: b.packet_width,
     };
     for s in &cfg.scenes {
         if let Err(e) = Database::parse_spec(s) {
@@ -469,6 +470,7 @@ fn render_one(args: &RenderArgs, scene_path: Option<&Path>, out: &Path) -> Resul
     }
     settings.embree_quality = args.embree_quality.into();
     settings.embree_robust = args.embree_robust;
+    settings.packet_width = args.packet_width;
     settings.bailout = args.bailout.unwrap_or(if args.spd {
         0.0
     } else {

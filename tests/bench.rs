@@ -124,6 +124,10 @@ fn raw_casting_replays_exactly_the_rays_of_the_render() {
     assert_eq!(queries.len() as u64, counts.total());
     let shadow = queries.iter().filter(|q| q.occluded).count() as u64;
     assert_eq!(shadow, counts.shadow);
+    // The eye rays went in batches, one per tile, which raw casting replays as batches.
+    let batches: Vec<raw::Batch> = queries.iter().filter_map(|q| q.batch).collect();
+    assert_eq!(batches.len(), 1, "13x13 corner rays: one 16x16 tile");
+    assert_eq!(batches[0], raw::Batch { len: 169, width: 8 });
     let cast = pool.install(|| raw::cast(&accel, &queries));
     assert_eq!(cast.queries, counts.total());
     // Eye rays that hit, reflection rays that hit and occluded shadow rays, found again
@@ -153,6 +157,7 @@ fn child_runs_report_the_same_rays_on_both_modes() {
         spd: false,
         mode: Mode::Raw,
         embree_quality: Default::default(),
+        packet_width: 8,
     };
     let raw = bench::run_child(&spec).unwrap();
     let render = bench::run_child(&RunSpec {

@@ -89,6 +89,16 @@ pub trait Accel: Sync {
     fn intersect(&self, ray: &Ray) -> Option<Hit>;
     /// Whether anything lies in `(ray.tmin, ray.tmax)` (any-hit, for shadow rays).
     fn occluded(&self, ray: &Ray) -> bool;
+    /// The nearest hits of a batch of coherent rays (`hits[i]` for `rays[i]`; the
+    /// slices have the same length), each as [`Accel::intersect`] would find it.
+    /// `width` asks for packets of that many rays (4, 8 or 16) where the backend has
+    /// them (Embree); the default, and width 0, cast the rays one at a time.
+    fn intersect_coherent(&self, rays: &[Ray], hits: &mut [Option<Hit>], width: usize) {
+        let _ = width;
+        for (ray, hit) in rays.iter().zip(hits.iter_mut()) {
+            *hit = self.intersect(ray);
+        }
+    }
     /// Statistics about the built structure.
     fn stats(&self) -> AccelStats;
 }

@@ -47,6 +47,15 @@ pub struct RunSpec {
     /// Embree build quality.
     #[serde(default)]
     pub embree_quality: crate::accel::EmbreeQuality,
+    /// Eye rays per packet (see [`RenderSettings::packet_width`]).
+    #[serde(default = "default_packet_width")]
+    pub packet_width: u32,
+}
+
+/// What runs recorded before `packet_width` existed are read with: the renderer's
+/// default.
+fn default_packet_width() -> u32 {
+    8
 }
 
 /// Rays by type, as the render counted them.
@@ -146,6 +155,7 @@ pub fn run_child(spec: &RunSpec) -> Result<RunResult, String> {
         settings.max_depth = 5;
     }
     settings.embree_quality = spec.embree_quality;
+    settings.packet_width = spec.packet_width;
     let (build_ms, ms, rays, accel) = pool.install(|| match spec.mode {
         Mode::Render => {
             let (_, rep) =
@@ -171,6 +181,11 @@ pub fn run_child(spec: &RunSpec) -> Result<RunResult, String> {
             Ok((build_ms, cast.ms, Rays::from(counts), detail))
         }
     })?;
+    let accel = match (backend, spec.packet_width) {
+        (Backend::Embree, 0) => format!("{accel}, eye rays one by one"),
+        (Backend::Embree, w) => format!("{accel}, eye rays in packets of {w}"),
+        _ => accel,
+    };
     Ok(RunResult {
         prims: scene.prim_count(),
         load_ms,
@@ -238,6 +253,8 @@ pub struct Config {
     pub peer: bool,
     /// Embree build quality.
     pub embree_quality: crate::accel::EmbreeQuality,
+    /// Eye rays per packet (see [`RenderSettings::packet_width`]).
+    pub packet_width: u32,
 }
 
 /// The default suite: the eight SPD scenes at their default sizes, then balls and jacks
@@ -370,6 +387,7 @@ pub fn run_suite(cfg: &Config, exe: &Path, log: &mut dyn FnMut(&str)) -> Result<
                             spd: cfg.spd,
                             mode,
                             embree_quality: cfg.embree_quality,
+                            packet_width: cfg.packet_width,
                         };
                         let result = run_in_child(exe, &spec)?;
                         log(&format!(
@@ -542,6 +560,7 @@ mod tests {
             spd: true,
             mode: Mode::Render,
             embree_quality: Default::default(),
+            packet_width: 8,
         };
         let r = run_child(&spec).unwrap();
         assert_eq!(r.rays.eye, 17 * 17);

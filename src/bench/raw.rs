@@ -16,6 +16,19 @@ pub struct Query {
     pub ray: Ray,
     /// `true` for [`Accel::occluded`], `false` for [`Accel::intersect`].
     pub occluded: bool,
+    /// Set on the first query of a batch of `len` nearest-hit queries the renderer cast
+    /// together through [`Accel::intersect_coherent`] with this packet `width` (the
+    /// batch's other queries follow it); `None` for everything else.
+    pub batch: Option<Batch>,
+}
+
+/// A batch of coherent rays (see [`Query::batch`]).
+#[derive(Clone, Copy, Debug, PartialEq, Eq)]
+pub struct Batch {
+    /// Queries in the batch, this one included.
+    pub len: u32,
+    /// The packet width asked for.
+    pub width: u32,
 }
 
 /// A backend that records every query passed through it, per worker thread (one
@@ -35,13 +48,13 @@ impl<'a, A: Accel> Recorder<'a, A> {
         }
     }
 
-    fn push(&self, q: Query) {
+    fn push(&self, queries: impl IntoIterator<Item = Query>) {
         // Threads outside the pool share the last buffer.
         let k = rayon::current_thread_index()
             .map_or(self.buffers.len() - 1, |i| i.min(self.buffers.len() - 1));
         // A poisoned buffer only means another thread panicked; its data is intact.
         let mut b = self.buffers[k].lock().unwrap_or_else(|e| e.into_inner());
-        b.push(q);
+        b.extend(queries);
     }
 
     /// The recorded queries, thread by thread.
@@ -55,19 +68,34 @@ impl<'a, A: Accel> Recorder<'a, A> {
 
 impl<A: Accel> Accel for Recorder<'_, A> {
     fn intersect(&self, ray: &Ray) -> Option<Hit> {
-        self.push(Query {
+        self.push([Query {
             ray: *ray,
             occluded: false,
-        });
+            batch: None,
+        }]);
         self.inner.intersect(ray)
     }
 
     fn occluded(&self, ray: &Ray) -> bool {
-        self.push(Query {
+        self.push([Query {
             ray: *ray,
             occluded: true,
-        });
+            batch: None,
+        }]);
         self.inner.occluded(ray)
+    }
+
+    fn intersect_coherent(&self, rays: &[Ray], hits: &mut [Option<Hit>], width: usize) {
+        let batch = Batch {
+            len: u32::try_from(rays.len()).unwrap_or(u32::MAX),
+            width: u32::try_from(width).unwrap_or(0),
+        };
+        self.push(rays.iter().enumerate().map(|(i, ray)| Query {
+            ray: *ray,
+            occluded: false,
+            batch: (i == 0).then_some(batch),
+        }));
+        self.inner.intersect_coherent(rays, hits, width);
     }
 
     fn stats(&self) -> AccelStats {
@@ -90,20 +118,47 @@ pub struct RawCast {
 /// enough to balance two threads.
 const CHUNK: usize = 4096;
 
-/// Cast `queries` through `accel` on the current rayon pool, with no shading at all.
+/// Cast `queries` through `accel` on the current rayon pool, with no shading at all;
+/// a recorded batch of coherent rays is cast as one batch again.
 pub fn cast<A: Accel>(accel: &A, queries: &[Query]) -> RawCast {
+    // Work items of about CHUNK queries, never splitting a batch.
+    let mut cuts = vec![0];
+    let mut i = 0;
+    while i < queries.len() {
+        i += queries[i].batch.map_or(1, |b| (b.len as usize).max(1));
+        i = i.min(queries.len());
+        if i - cuts[cuts.len() - 1] >= CHUNK || i == queries.len() {
+            cuts.push(i);
+        }
+    }
     let start = Instant::now();
-    let hits: u64 = queries
-        .par_chunks(CHUNK)
-        .map(|chunk| {
+    let hits: u64 = cuts
+        .par_windows(2)
+        .map(|w| {
+            let chunk = &queries[w[0]..w[1]];
+            let (mut rays, mut found) = (Vec::new(), Vec::new());
             let mut n = 0u64;
-            for q in chunk {
+            let mut k = 0;
+            while k < chunk.len() {
+                let q = &chunk[k];
+                if let Some(b) = q.batch {
+                    let len = (b.len as usize).clamp(1, chunk.len() - k);
+                    rays.clear();
+                    rays.extend(chunk[k..k + len].iter().map(|q| q.ray));
+                    found.clear();
+                    found.resize(len, None);
+                    accel.intersect_coherent(&rays, &mut found, b.width as usize);
+                    n += found.iter().filter(|h| h.is_some()).count() as u64;
+                    k += len;
+                    continue;
+                }
                 let hit = if q.occluded {
                     accel.occluded(&q.ray)
                 } else {
                     accel.intersect(&q.ray).is_some()
                 };
                 n += u64::from(hit);
+                k += 1;
             }
             n
         })

@@ -504,6 +504,7 @@ mod tests {
                 spd: false,
                 mode,
                 embree_quality: Default::default(),
+                packet_width: 8,
             },
             rep: 0,
             result: RunResult {

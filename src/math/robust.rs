@@ -62,6 +62,48 @@ pub fn offset_ray_origin(p: Vec3, err: Vec3, n: Vec3, w: Vec3) -> Vec3 {
     po
 }
 
+/// The origins of the rays leaving one surface point, computed once per side: since
+/// [`offset_ray_origin`] depends on the direction only through the side it points to
+/// (the sign of `w·n`), every ray leaving a hit (shadow rays to each light, reflection,
+/// refraction) starts from one of two points, each computed at most once.
+#[derive(Clone, Copy, Debug)]
+pub struct RayOrigins {
+    p: Vec3,
+    err: Vec3,
+    n: Vec3,
+    front: Option<Vec3>,
+    back: Option<Vec3>,
+}
+
+impl RayOrigins {
+    /// The origins off point `p` (error bound `err`) of a surface with normal `n`.
+    #[inline]
+    pub fn new(p: Vec3, err: Vec3, n: Vec3) -> Self {
+        RayOrigins {
+            p,
+            err,
+            n,
+            front: None,
+            back: None,
+        }
+    }
+
+    /// `offset_ray_origin(p, err, n, w)`, bit for bit.
+    #[inline]
+    pub fn towards(&mut self, w: Vec3) -> Vec3 {
+        let (p, err, n) = (self.p, self.err, self.n);
+        if w.dot(n) < 0.0 {
+            *self
+                .back
+                .get_or_insert_with(|| offset_ray_origin(p, err, n, -n))
+        } else {
+            *self
+                .front
+                .get_or_insert_with(|| offset_ray_origin(p, err, n, n))
+        }
+    }
+}
+
 #[cfg(test)]
 mod tests {
     use super::*;
@@ -75,6 +117,33 @@ mod tests {
         assert!(next_float_down(0.0) < 0.0);
         assert!(next_float_up(-0.0) > 0.0);
         assert_eq!(next_float_up(f32::INFINITY), f32::INFINITY);
+    }
+
+    #[test]
+    fn cached_origins_equal_the_offset_for_every_direction() {
+        let mut seed = 0x9e37_79b9u32;
+        let mut r = || {
+            seed ^= seed << 13;
+            seed ^= seed >> 17;
+            seed ^= seed << 5;
+            seed as f32 / u32::MAX as f32 * 2.0 - 1.0
+        };
+        for _ in 0..200 {
+            let p = Vec3::new(r(), r(), r()) * 1e3;
+            let err = Vec3::new(r().abs(), r().abs(), r().abs()) * 1e-4;
+            let n = Vec3::new(r(), r(), r());
+            let mut o = RayOrigins::new(p, err, n);
+            for _ in 0..20 {
+                let w = Vec3::new(r(), r(), r());
+                let want = offset_ray_origin(p, err, n, w);
+                assert_eq!(o.towards(w).to_array(), want.to_array(), "{p} {n} {w}");
+            }
+            // Directions in the surface's plane and opposite the normal.
+            for w in [Vec3::ZERO, -n, n, n.cross(Vec3::X)] {
+                let want = offset_ray_origin(p, err, n, w);
+                assert_eq!(o.towards(w).to_array(), want.to_array(), "{p} {n} {w}");
+            }
+        }
     }
 
     #[test]

@@ -52,6 +52,11 @@ pub struct RenderSettings {
     /// Render only this part of the image (`None`: all of it). The film then holds
     /// the region alone; every pixel comes out as in the full render.
     pub region: Option<Region>,
+    /// Primary rays of a tile are cast together, in packets of this many rays (4, 8 or
+    /// 16: Embree's `rtcIntersect4/8/16`; the BVH casts them one by one); 0 casts
+    /// each primary ray on its own. Only with one sample per pixel and uniform
+    /// sampling (SPD mode included); secondary rays are always single.
+    pub packet_width: u32,
 }
 
 /// A rectangle of pixels, `x0..x1` by `y0..y1` (half-open, from the top-left).
@@ -149,6 +154,7 @@ impl RenderSettings {
             bailout: 0.0,
             skip: true,
             region: None,
+            packet_width: 8,
         }
     }
 }
@@ -229,8 +235,8 @@ pub fn render_with_gi<A: Accel>(
     let gen = RayGen::new(&scene.camera, gw, gh);
     let extra = u32::from(settings.spd);
     let (rw, rh) = (r.width() + extra, r.height() + extra);
-    let (grid, rays) = sample_grid(r.x0, r.y0, rw, rh, settings.tile, progress, |i, j, c| {
-        tracer.pixel(&gen, i, j, c)
+    let (grid, rays) = sample_tiles(r.x0, r.y0, rw, rh, settings.tile, progress, |t, px, c| {
+        tracer.tile(&gen, t, px, c);
     });
     let film = if settings.spd {
         grid.average_corners()
@@ -259,6 +265,29 @@ fn sample_grid<F>(
 where
     F: Fn(u32, u32, &mut RayCounts) -> glam::Vec3 + Sync,
 {
+    sample_tiles(ox, oy, gw, gh, tile, progress, |t, px, counts| {
+        for j in t.y0..t.y1 {
+            for i in t.x0..t.x1 {
+                px.push(f(i, j, counts));
+            }
+        }
+    })
+}
+
+/// [`sample_grid`] with a function of a whole tile: `f(tile, px, counts)` pushes the
+/// values of the tile's grid positions (absolute coordinates, row by row) onto `px`.
+fn sample_tiles<F>(
+    ox: u32,
+    oy: u32,
+    gw: u32,
+    gh: u32,
+    tile: u32,
+    progress: Option<Progress<'_>>,
+    f: F,
+) -> (Film, RayCounts)
+where
+    F: Fn(Region, &mut Vec<glam::Vec3>, &mut RayCounts) + Sync,
+{
     let ts = tile.max(1);
     let tiles: Vec<(u32, u32)> = (0..gh.div_ceil(ts))
         .flat_map(|ty| (0..gw.div_ceil(ts)).map(move |tx| (tx * ts, ty * ts)))
@@ -272,11 +301,13 @@ where
             let y1 = (y0 + ts).min(gh);
             let mut counts = RayCounts::default();
             let mut px = Vec::with_capacity(((x1 - x0) * (y1 - y0)) as usize);
-            for j in y0..y1 {
-                for i in x0..x1 {
-                    px.push(f(ox + i, oy + j, &mut counts));
-                }
-            }
+            let t = Region {
+                x0: ox + x0,
+                y0: oy + y0,
+                x1: ox + x1,
+                y1: oy + y1,
+            };
+            f(t, &mut px, &mut counts);
             if let Some(p) = progress {
                 p(done.fetch_add(1, Ordering::Relaxed) + 1, total);
             }

@@ -1,8 +1,10 @@
 //! Whitted shading (DESIGN.md §4).
 
-use super::{RayGen, RenderSettings};
-use crate::accel::Accel;
-use crate::math::{hash, hash_unit as unit, next_float_down, offset_ray_origin, Ray, Vec3};
+use super::{RayGen, Region, RenderSettings};
+use crate::accel::{Accel, Hit};
+use crate::math::{
+    hash, hash_unit as unit, next_float_down, offset_ray_origin, Ray, RayOrigins, Vec3,
+};
 use crate::radiosity::{area, Solution};
 use crate::scene::{Light, Material, Scene, Surface};
 
@@ -68,6 +70,9 @@ pub(super) struct Tracer<'a, A: Accel> {
     bailout: f32,
     /// Skip work that cannot change the image (see [`RenderSettings::skip`]).
     skip: bool,
+    /// Primary rays of a tile in packets of this many (see
+    /// [`RenderSettings::packet_width`]); 0 = one by one.
+    packet_width: u32,
 }
 
 /// Van der Corput radical inverse in base 2.
@@ -110,6 +115,7 @@ impl<'a, A: Accel> Tracer<'a, A> {
                 0.0
             },
             skip: s.skip,
+            packet_width: s.packet_width,
         }
     }
 
@@ -136,6 +142,31 @@ impl<'a, A: Accel> Tracer<'a, A> {
             sum += self.eye(gen.ray(i as f32 + sx, j as f32 + sy), counts);
         }
         sum / n as f32
+    }
+
+    /// The values of the grid positions of tile `t`, row by row, pushed onto `px`: as
+    /// [`Tracer::pixel`] gives them, but with one sample per pixel the tile's eye rays
+    /// are cast together first (packets on backends that have them; see
+    /// [`RenderSettings::packet_width`]), then each is shaded from its hit.
+    pub(super) fn tile(&self, gen: &RayGen, t: Region, px: &mut Vec<Vec3>, counts: &mut RayCounts) {
+        if self.spp != 1 || self.packet_width == 0 {
+            for j in t.y0..t.y1 {
+                for i in t.x0..t.x1 {
+                    px.push(self.pixel(gen, i, j, counts));
+                }
+            }
+            return;
+        }
+        let rays: Vec<Ray> = (t.y0..t.y1)
+            .flat_map(|j| (t.x0..t.x1).map(move |i| gen.ray(i as f32 + 0.5, j as f32 + 0.5)))
+            .collect();
+        let mut hits = vec![None; rays.len()];
+        self.accel
+            .intersect_coherent(&rays, &mut hits, self.packet_width as usize);
+        for (ray, hit) in rays.iter().zip(hits) {
+            counts.eye += 1;
+            px.push(self.trace_from(ray, hit, 1, Media::AIR, Vec3::ONE, counts));
+        }
     }
 
     /// The value of the eye ray through continuous film position `(px, py)`.
@@ -169,14 +200,29 @@ impl<'a, A: Accel> Tracer<'a, A> {
         weight: Vec3,
         counts: &mut RayCounts,
     ) -> Vec3 {
+        let first = self.accel.intersect(ray);
+        self.trace_from(ray, first, depth, media, weight, counts)
+    }
+
+    /// [`Tracer::trace`] given the ray's nearest hit, `first`.
+    fn trace_from(
+        &self,
+        ray: &Ray,
+        first: Option<Hit>,
+        depth: u32,
+        media: Media,
+        weight: Vec3,
+        counts: &mut RayCounts,
+    ) -> Vec3 {
         let scene = self.scene;
         let mut ray = *ray;
         let mut media = media;
+        let mut next = first;
         // Surfaces of lower-priority media inside a higher-priority one are skipped
         // (nested dielectrics): the ray goes on through them, at most this many times.
         let mut skips = 0;
         loop {
-            let Some(hit) = self.accel.intersect(&ray) else {
+            let Some(hit) = next else {
                 return scene.escape(ray.dir);
             };
             let surf = scene.surface(&hit, &ray);
@@ -202,6 +248,7 @@ impl<'a, A: Accel> Tracer<'a, A> {
                     offset_ray_origin(surf.point.p, surf.point.err, ng, d),
                     ray.dir,
                 );
+                next = self.accel.intersect(&ray);
                 continue;
             }
             if depth == 1 {
@@ -237,15 +284,15 @@ impl<'a, A: Accel> Tracer<'a, A> {
         // Both sides are surfaces: face the normals towards the incoming ray.
         let ng = if entering { ng_out } else { -ng_out };
         let ns = if ns.dot(d) > 0.0 { -ns } else { ns };
-        let spawn =
-            |dir: Vec3| -> Ray { Ray::new(offset_ray_origin(p, surf.point.err, ng, dir), dir) };
+        // Every ray leaving this hit starts from one of the two offset points.
+        let mut origins = RayOrigins::new(p, surf.point.err, ng);
 
         let mut color = match gi {
             Some(b) => b,
             None => self.local_diffuse(surf, m, ng, ns, entering, counts),
         };
         for light in &scene.lights {
-            color += self.direct(light, surf, m, ng, ns, d, counts);
+            color += self.direct(light, surf, m, &mut origins, ns, d, counts);
         }
 
         if depth >= self.max_depth {
@@ -270,7 +317,7 @@ impl<'a, A: Accel> Tracer<'a, A> {
                     let w = m.t * filter;
                     if self.worth(weight * w, counts) {
                         counts.refraction += 1;
-                        let ray = spawn(dir);
+                        let ray = Ray::new(origins.towards(dir), dir);
                         color += w * self.trace(&ray, depth + 1, inside, weight * w, counts);
                     }
                 }
@@ -288,11 +335,19 @@ impl<'a, A: Accel> Tracer<'a, A> {
             } else {
                 // Cast and thrown away: only to measure what skipping saves.
                 counts.reflection += 1;
-                self.trace(&spawn(reflect(d, ns)), depth + 1, media, w, counts);
+                let dir = reflect(d, ns);
+                self.trace(
+                    &Ray::new(origins.towards(dir), dir),
+                    depth + 1,
+                    media,
+                    w,
+                    counts,
+                );
             }
         } else if self.worth(w, counts) {
             counts.reflection += 1;
-            let ray = spawn(reflect(d, ns));
+            let dir = reflect(d, ns);
+            let ray = Ray::new(origins.towards(dir), dir);
             color += reflect_weight * self.trace(&ray, depth + 1, media, w, counts);
         }
         color
@@ -300,8 +355,9 @@ impl<'a, A: Accel> Tracer<'a, A> {
 }
 
 impl<A: Accel> Tracer<'_, A> {
-    /// The diffuse and highlight light `light` sends to `surf` (material `m`, normals
-    /// `ng`, `ns` facing the ray of unit direction `d`), after its shadow ray.
+    /// The diffuse and highlight light `light` sends to `surf` (material `m`, shading
+    /// normal `ns` facing the ray of unit direction `d`), after its shadow ray from one
+    /// of `origins`.
     #[allow(clippy::too_many_arguments)]
     #[inline(always)]
     fn direct(
@@ -309,7 +365,7 @@ impl<A: Accel> Tracer<'_, A> {
         light: &Light,
         surf: &Surface,
         m: &Material,
-        ng: Vec3,
+        origins: &mut RayOrigins,
         ns: Vec3,
         d: Vec3,
         counts: &mut RayCounts,
@@ -326,7 +382,7 @@ impl<A: Accel> Tracer<'_, A> {
             return Vec3::ZERO;
         }
         counts.shadow += 1;
-        let org = offset_ray_origin(p, surf.point.err, ng, to_light);
+        let org = origins.towards(to_light);
         let mut shadow = Ray::new(org, light.pos - org);
         shadow.tmax = next_float_down(1.0);
         if self.accel.occluded(&shadow) || useless {

@@ -111,6 +111,10 @@ impl Accel for EmbreeAccel {
         self.scene.occluded(ray)
     }
 
+    fn intersect_coherent(&self, rays: &[Ray], hits: &mut [Option<Hit>], width: usize) {
+        self.scene.intersect_packets(rays, hits, width);
+    }
+
     fn stats(&self) -> AccelStats {
         AccelStats {
             backend: "embree",

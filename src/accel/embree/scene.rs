@@ -390,6 +390,82 @@ impl CommittedScene {
     }
 }
 
+impl CommittedScene {
+    /// The nearest hits of `rays` (`hits[i]` for `rays[i]`), cast as packets of `width`
+    /// (4, 8 or 16) rays flagged coherent; any other width, or a scene with unbounded
+    /// primitives (tested outside Embree, one ray at a time), casts single rays.
+    pub(super) fn intersect_packets(&self, rays: &[Ray], hits: &mut [Option<Hit>], width: usize) {
+        let cast: fn(sys::RTCScene, &[Ray], &mut [Option<Hit>]) = match width {
+            4 if self.unbounded.is_empty() => packet4,
+            8 if self.unbounded.is_empty() => packet8,
+            16 if self.unbounded.is_empty() => packet16,
+            _ => {
+                for (ray, hit) in rays.iter().zip(hits.iter_mut()) {
+                    *hit = self.intersect(ray);
+                }
+                return;
+            }
+        };
+        for (r, h) in rays.chunks(width).zip(hits.chunks_mut(width)) {
+            cast(self.top.raw, r, h);
+        }
+    }
+}
+
+/// `packetN(scene, rays, hits)`: up to N rays through one `rtcIntersectN` call, with the
+/// same conventions as the single-ray query (`tnear = max(tmin, 0)`; a ray with a NaN or
+/// empty interval is left out of the packet and misses).
+macro_rules! packet_query {
+    ($name:ident, $n:literal, $ty:ident, $query:ident) => {
+        fn $name(scene: sys::RTCScene, rays: &[Ray], hits: &mut [Option<Hit>]) {
+            let mut p = sys::$ty::default();
+            let mut valid = [0i32; $n];
+            for (i, ray) in rays.iter().enumerate().take($n) {
+                let tnear = ray.tmin.max(0.0);
+                if ray.tmax.is_nan() || ray.tmax < tnear {
+                    continue;
+                }
+                valid[i] = -1;
+                let r = &mut p.ray;
+                (r.org_x[i], r.org_y[i], r.org_z[i]) = (ray.org.x, ray.org.y, ray.org.z);
+                (r.dir_x[i], r.dir_y[i], r.dir_z[i]) = (ray.dir.x, ray.dir.y, ray.dir.z);
+                (r.tnear[i], r.tfar[i], r.time[i]) = (tnear, ray.tmax, 0.0);
+                (r.mask[i], r.id[i], r.flags[i]) = (u32::MAX, 0, 0);
+                let h = &mut p.hit;
+                h.geomID[i] = sys::INVALID_GEOMETRY_ID;
+                h.primID[i] = sys::INVALID_GEOMETRY_ID;
+                for level in &mut h.instID {
+                    level[i] = sys::INVALID_GEOMETRY_ID;
+                }
+                #[cfg(embree_instance_array)]
+                for level in &mut h.instPrimID {
+                    level[i] = sys::INVALID_GEOMETRY_ID;
+                }
+            }
+            query::$query(&valid, scene, &mut p);
+            for (i, out) in hits.iter_mut().enumerate().take($n) {
+                let h = &p.hit;
+                *out = (valid[i] != 0 && h.geomID[i] != sys::INVALID_GEOMETRY_ID).then(|| Hit {
+                    t: p.ray.tfar[i],
+                    geom_id: h.geomID[i],
+                    prim_id: h.primID[i],
+                    u: h.u[i],
+                    v: h.v[i],
+                    ng: Vec3::new(h.Ng_x[i], h.Ng_y[i], h.Ng_z[i]),
+                    inst_id: match h.instID[0][i] {
+                        sys::INVALID_GEOMETRY_ID => NO_INSTANCE,
+                        id => id - INSTANCE_BASE,
+                    },
+                });
+            }
+        }
+    };
+}
+
+packet_query!(packet4, 4, RTCRayHit4, intersect4);
+packet_query!(packet8, 8, RTCRayHit8, intersect8);
+packet_query!(packet16, 16, RTCRayHit16, intersect16);
+
 // `rtcIntersect1` requires a 16-byte aligned `RTCRayHit`; bindgen carries the header's
 // `RTC_ALIGN(16)` over, so every `RTCRayHit` value on the stack is aligned.
 const _: () = assert!(std::mem::align_of::<sys::RTCRayHit>() == 16);
@@ -463,6 +539,25 @@ mod query {
         // SAFETY: as in `intersect`, for an `RTCRay`.
         unsafe { sys::rtcOccluded1(scene, &mut ctx, ray) }
     }
+
+    /// `intersectN(valid, scene, packet)`: `rtcIntersectN` with a coherent context.
+    macro_rules! packet {
+        ($name:ident, $n:literal, $ty:ident, $f:ident) => {
+            #[inline(always)]
+            pub(super) fn $name(valid: &[i32; $n], scene: sys::RTCScene, rayhit: &mut sys::$ty) {
+                let mut ctx = context();
+                ctx.flags = sys::RTCIntersectContextFlags::RTC_INTERSECT_CONTEXT_FLAG_COHERENT;
+                // SAFETY: `scene` is live and committed; `ctx` is initialised as in
+                // `intersect`; `valid` has N entries; `rayhit` is an aligned packet (its
+                // type carries the header's alignment) whose active rays have mask,
+                // tnear <= tfar and invalid ids set.
+                unsafe { sys::$f(valid.as_ptr(), scene, &mut ctx, rayhit) }
+            }
+        };
+    }
+    packet!(intersect4, 4, RTCRayHit4, rtcIntersect4);
+    packet!(intersect8, 8, RTCRayHit8, rtcIntersect8);
+    packet!(intersect16, 16, RTCRayHit16, rtcIntersect16);
 }
 
 /// `rtcIntersect1`/`rtcOccluded1`, whose arguments differ between Embree 3 and 4.
@@ -517,6 +612,31 @@ mod query {
         // SAFETY: as in `intersect`, for an `RTCRay`.
         unsafe { sys::rtcOccluded1(scene, ray, &mut args) }
     }
+
+    /// `intersectN(valid, scene, packet)`: `rtcIntersectN` flagged coherent.
+    macro_rules! packet {
+        ($name:ident, $n:literal, $ty:ident, $f:ident) => {
+            #[inline(always)]
+            pub(super) fn $name(valid: &[i32; $n], scene: sys::RTCScene, rayhit: &mut sys::$ty) {
+                let mut ctx = context();
+                let mut args = sys::RTCIntersectArguments {
+                    flags: sys::RTCRayQueryFlags::RTC_RAY_QUERY_FLAG_COHERENT,
+                    feature_mask: sys::RTCFeatureFlags::RTC_FEATURE_FLAG_ALL,
+                    context: &mut ctx,
+                    filter: None,
+                    intersect: None,
+                    ..Default::default()
+                };
+                // SAFETY: as in `intersect`; `valid` has N entries; `rayhit` is an
+                // aligned packet whose active rays have mask, tnear <= tfar and invalid
+                // ids set.
+                unsafe { sys::$f(valid.as_ptr(), scene, rayhit, &mut args) }
+            }
+        };
+    }
+    packet!(intersect4, 4, RTCRayHit4, rtcIntersect4);
+    packet!(intersect8, 8, RTCRayHit8, rtcIntersect8);
+    packet!(intersect16, 16, RTCRayHit16, rtcIntersect16);
 }
 
 /// One native triangle mesh holding all triangles, three vertices each, so that
