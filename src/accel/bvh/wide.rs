@@ -5,6 +5,7 @@
 
 use super::{Node, STACK};
 use crate::math::{Aabb, Ray};
+use glam::Vec4;
 
 /// Marks a child reference as a leaf (the rest is an index into the leaf table).
 pub(super) const LEAF: u32 = 1 << 31;
@@ -147,14 +148,15 @@ pub(super) fn traverse<const ORDERED: bool, const DEPTH: usize>(
         return;
     }
     let inv = ray.dir.recip();
-    let org = [ray.org.x, ray.org.y, ray.org.z];
-    let inv = [inv.x, inv.y, inv.z];
     // The plane a ray enters a slab through: the lower one for positive directions.
     let near = [
-        (inv[0] < 0.0) as usize,
-        (inv[1] < 0.0) as usize,
-        (inv[2] < 0.0) as usize,
+        (inv.x < 0.0) as usize,
+        (inv.y < 0.0) as usize,
+        (inv.z < 0.0) as usize,
     ];
+    let org = [0, 1, 2].map(|a| Vec4::splat(ray.org[a]));
+    let inv = [0, 1, 2].map(|a| Vec4::splat(inv[a]));
+    let far_scale = Vec4::splat(FAR_SCALE);
     let mut tmax = ray.tmax;
     let mut stack = [(0u32, 0f32); DEPTH];
     let mut sp = 0usize;
@@ -162,22 +164,18 @@ pub(super) fn traverse<const ORDERED: bool, const DEPTH: usize>(
     loop {
         if cur & LEAF == 0 {
             let node = &nodes[cur as usize];
-            let mut tn = [ray.tmin; 4];
-            let mut tf = [tmax; 4];
+            let mut tn = Vec4::splat(ray.tmin);
+            let mut tf = Vec4::splat(tmax);
             for a in 0..3 {
-                let lo = &node.bounds[near[a]][a];
-                let hi = &node.bounds[1 - near[a]][a];
-                // `max`/`min` ignore a NaN (a ray in a slab's plane with a zero direction
-                // component), leaving the interval as it was.
-                for i in 0..4 {
-                    tn[i] = tn[i].max((lo[i] - org[a]) * inv[a]);
-                    tf[i] = tf[i].min((hi[i] - org[a]) * inv[a] * FAR_SCALE);
-                }
+                let lo = Vec4::from_array(node.bounds[near[a]][a]);
+                let hi = Vec4::from_array(node.bounds[1 - near[a]][a]);
+                // `max`/`min` keep their argument when the distance is NaN (a ray in a
+                // slab's plane with a zero direction component), leaving the interval
+                // as it was (x86; on other targets such a ray may miss the box).
+                tn = ((lo - org[a]) * inv[a]).max(tn);
+                tf = ((hi - org[a]) * inv[a] * far_scale).min(tf);
             }
-            let mut mask = 0u32;
-            for i in 0..4 {
-                mask |= ((tn[i] <= tf[i]) as u32) << i;
-            }
+            let mut mask = tn.cmple(tf).bitmask();
             if mask != 0 {
                 let mut hits = [(0u32, 0f32); 4];
                 let mut k = 0;
