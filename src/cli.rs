@@ -72,6 +72,33 @@ pub struct RadiosityArgs {
     /// Also write the solved mesh with vertex colours as PLY.
     #[arg(long, value_name = "FILE.ply")]
     pub ply: Option<PathBuf>,
+    /// Meshing, form factors and solver.
+    #[command(flatten)]
+    pub solve: RadiositySolveArgs,
+    /// Ray-query backend for visibility and viewing.
+    #[arg(long, value_enum)]
+    pub backend: Option<BackendArg>,
+    /// Image size, overriding the scene's resolution.
+    #[arg(long, value_name = "WxH", value_parser = parse_res)]
+    pub res: Option<(u32, u32)>,
+    /// Samples per pixel of the view, rounded down to a square (1, 4, 9, ...).
+    #[arg(long, default_value_t = 4, value_parser = clap::value_parser!(u32).range(1..=4096))]
+    pub spp: u32,
+    /// Worker threads (default: all cores).
+    #[arg(short, long, value_name = "N", value_parser = clap::value_parser!(u32).range(1..=4096))]
+    pub threads: Option<u32>,
+    /// Print mesh size, iterations, residuals and timings.
+    #[arg(long)]
+    pub stats: bool,
+    /// Append the statistics (with the residual curve) as one JSON object to FILE.
+    #[arg(long, value_name = "FILE")]
+    pub stats_json: Option<PathBuf>,
+}
+
+/// The radiosity options `emray radiosity` and `emray render --gi radiosity` share.
+#[derive(Args, Debug, Clone, PartialEq)]
+#[command(next_help_heading = "Radiosity")]
+pub struct RadiositySolveArgs {
     /// Longest element edge, in scene units [default: 1/12 of the scene's diagonal].
     #[arg(long, value_name = "SIZE")]
     pub patch_size: Option<f32>,
@@ -106,24 +133,50 @@ pub struct RadiosityArgs {
     /// Most shots (progressive) or sweeps (Gauss–Seidel).
     #[arg(long, default_value_t = 1_000_000)]
     pub max_iterations: usize,
-    /// Ray-query backend for visibility and viewing.
-    #[arg(long, value_enum)]
-    pub backend: Option<BackendArg>,
-    /// Image size, overriding the scene's resolution.
-    #[arg(long, value_name = "WxH", value_parser = parse_res)]
-    pub res: Option<(u32, u32)>,
-    /// Samples per pixel of the view, rounded down to a square (1, 4, 9, ...).
-    #[arg(long, default_value_t = 4, value_parser = clap::value_parser!(u32).range(1..=4096))]
-    pub spp: u32,
-    /// Worker threads (default: all cores).
-    #[arg(short, long, value_name = "N", value_parser = clap::value_parser!(u32).range(1..=4096))]
-    pub threads: Option<u32>,
-    /// Print mesh size, iterations, residuals and timings.
-    #[arg(long)]
-    pub stats: bool,
-    /// Append the statistics (with the residual curve) as one JSON object to FILE.
-    #[arg(long, value_name = "FILE")]
-    pub stats_json: Option<PathBuf>,
+}
+
+impl Default for RadiositySolveArgs {
+    /// The same values as the options' defaults.
+    fn default() -> Self {
+        RadiositySolveArgs {
+            patch_size: None,
+            ff_samples: 1,
+            vis_samples: 0,
+            solver: SolverArg::Progressive,
+            form_factors: FormFactorArg::Raycast,
+            hemicube_res: 128,
+            subdiv_threshold: None,
+            min_patch_size: None,
+            subdiv_passes: 3,
+            epsilon: 1e-3,
+            max_iterations: 1_000_000,
+        }
+    }
+}
+
+impl RadiositySolveArgs {
+    /// The library settings.
+    pub fn settings(&self) -> emray::radiosity::RadiositySettings {
+        use emray::radiosity::{FormFactorMethod, RadiositySettings, SolverKind};
+        RadiositySettings {
+            patch_size: self.patch_size,
+            shooter_level: self.ff_samples,
+            visibility_level: self.vis_samples,
+            epsilon: self.epsilon,
+            max_iterations: self.max_iterations,
+            solver: match self.solver {
+                SolverArg::Progressive => SolverKind::Progressive,
+                SolverArg::GaussSeidel => SolverKind::GaussSeidel,
+            },
+            form_factors: match self.form_factors {
+                FormFactorArg::Raycast => FormFactorMethod::RayCast,
+                FormFactorArg::Hemicube => FormFactorMethod::Hemicube(self.hemicube_res),
+            },
+            subdiv_threshold: self.subdiv_threshold,
+            min_patch_size: self.min_patch_size,
+            subdiv_passes: self.subdiv_passes,
+        }
+    }
 }
 
 /// The level `l` of a count `4^l` in 1..=64.
@@ -441,10 +494,9 @@ pub struct RenderArgs {
     /// takes the diffuse term of polygons and meshes from it (two-pass).
     #[arg(long, value_enum)]
     pub gi: Option<GiArg>,
-    /// Radiosity patch size for `--gi radiosity` [default: 1/12 of the scene's
-    /// diagonal].
-    #[arg(long, value_name = "SIZE")]
-    pub patch_size: Option<f32>,
+    /// The radiosity pass of `--gi radiosity` (the same options as `emray radiosity`).
+    #[command(flatten)]
+    pub radiosity: RadiositySolveArgs,
     /// Shadow rays per emitting triangle (area light), a square number: 16 = 4×4
     /// strata.
     #[arg(long, default_value_t = 16, value_parser = clap::value_parser!(u32).range(1..=4096))]
@@ -489,7 +541,7 @@ impl RenderArgs {
             quiet: false,
             verbose: 0,
             gi: None,
-            patch_size: None,
+            radiosity: RadiositySolveArgs::default(),
             area_samples: 16,
         }
     }
@@ -557,6 +609,55 @@ mod tests {
         assert!(parse_res("abc").is_err());
         assert!(parse_res("100000x10").is_err());
         assert!(parse_res("60000x60000").is_err());
+    }
+
+    fn radiosity_options(cmd: &[&str]) -> RadiositySolveArgs {
+        match Cli::try_parse_from(cmd).unwrap().command {
+            Some(Command::Radiosity(a)) => a.solve,
+            Some(Command::Render(a)) => a.radiosity,
+            other => panic!("{other:?}"),
+        }
+    }
+
+    #[test]
+    fn render_and_radiosity_share_the_radiosity_options() {
+        let opts = [
+            "--patch-size",
+            "0.5",
+            "--form-factors",
+            "hemicube",
+            "--hemicube-res",
+            "64",
+            "--subdiv-threshold",
+            "0.1",
+            "--min-patch-size",
+            "0.05",
+            "--subdiv-passes",
+            "2",
+            "--ff-samples",
+            "16",
+            "--epsilon",
+            "1e-4",
+        ];
+        let rad = radiosity_options(&[&["emray", "radiosity", "s.toml"], &opts[..]].concat());
+        let gi = ["emray", "render", "s.toml", "--gi", "radiosity"];
+        let render = radiosity_options(&[&gi[..], &opts[..]].concat());
+        assert_eq!(rad, render);
+        let s = rad.settings();
+        assert_eq!(
+            s.form_factors,
+            emray::radiosity::FormFactorMethod::Hemicube(64)
+        );
+        assert_eq!((s.subdiv_threshold, s.subdiv_passes), (Some(0.1), 2));
+        assert_eq!((s.patch_size, s.shooter_level), (Some(0.5), 2));
+        // Without options: the defaults, which are the library's.
+        let none = radiosity_options(&["emray", "radiosity", "s.toml"]);
+        assert_eq!(none, RadiositySolveArgs::default());
+        assert_eq!(radiosity_options(&gi), none);
+        assert_eq!(
+            none.settings(),
+            emray::radiosity::RadiositySettings::default()
+        );
     }
 
     #[test]

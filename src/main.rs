@@ -287,7 +287,6 @@ fn radiosity(a: &cli::RadiosityArgs) -> ExitCode {
 }
 
 fn radiosity_run(a: &cli::RadiosityArgs) -> Result<()> {
-    use emray::radiosity::{FormFactorMethod, RadiositySettings, SolverKind};
     emray::output::Format::from_path(&a.output)?;
     let mut builder = rayon::ThreadPoolBuilder::new();
     if let Some(t) = a.threads {
@@ -295,24 +294,7 @@ fn radiosity_run(a: &cli::RadiosityArgs) -> Result<()> {
     }
     let pool = builder.build().context("cannot start the worker threads")?;
     let scene = load::load_path(&a.scene)?;
-    let settings = RadiositySettings {
-        patch_size: a.patch_size,
-        shooter_level: a.ff_samples,
-        visibility_level: a.vis_samples,
-        epsilon: a.epsilon,
-        max_iterations: a.max_iterations,
-        solver: match a.solver {
-            cli::SolverArg::Progressive => SolverKind::Progressive,
-            cli::SolverArg::GaussSeidel => SolverKind::GaussSeidel,
-        },
-        form_factors: match a.form_factors {
-            cli::FormFactorArg::Raycast => FormFactorMethod::RayCast,
-            cli::FormFactorArg::Hemicube => FormFactorMethod::Hemicube(a.hemicube_res),
-        },
-        subdiv_threshold: a.subdiv_threshold,
-        min_patch_size: a.min_patch_size,
-        subdiv_passes: a.subdiv_passes,
-    };
+    let settings = a.solve.settings();
     let (w, h) = a.res.unwrap_or((scene.camera.width, scene.camera.height));
     let spp = (a.spp as f32).sqrt().floor().max(1.0) as u32;
     let backend: Backend = a
@@ -548,10 +530,7 @@ fn render_one(args: &RenderArgs, scene_path: Option<&Path>, out: &Path) -> Resul
         emray::run::render_reference(&name, &scene, &settings, strata, load_ms)
             .map_err(|why| anyhow::anyhow!("{name}: {why}"))?
     } else if let Some(cli::GiArg::Radiosity) = args.gi {
-        let rad = emray::radiosity::RadiositySettings {
-            patch_size: args.patch_size,
-            ..Default::default()
-        };
+        let rad = args.radiosity.settings();
         emray::run::render_two_pass(
             &name,
             &scene,

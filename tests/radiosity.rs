@@ -872,3 +872,163 @@ fn classroom_ceiling_and_desk_undersides_are_lit_only_indirectly_but_lit() {
         "undersides {undersides}, floor {floor}"
     );
 }
+
+/// The white box of [`white_box`] with a sphere over the middle of the floor and a
+/// small box floating in a corner, all of the walls' reflectance.
+fn sphere_in_box(rho: f32) -> Scene {
+    use emray::geometry::{AaBox, Shape, Sphere};
+    let mut s = white_box(rho);
+    s.add_shape(
+        Shape::Sphere(Sphere::new(Vec3::new(0.5, 0.2, 0.5), 0.15)),
+        0,
+    );
+    let b = AaBox::new(Vec3::new(0.75, 0.05, 0.1), Vec3::new(0.9, 0.2, 0.25)).unwrap();
+    s.add_shape(Shape::Box(b), 0);
+    s
+}
+
+#[test]
+fn tessellated_shapes_receive_reflect_and_shadow() {
+    use emray::accel::{Accel, Hit};
+    use emray::math::Ray;
+    let rho = 0.5;
+    let scene = sphere_in_box(rho);
+    let bvh = Bvh::build(&scene);
+    let base = RadiositySettings {
+        patch_size: Some(0.36),
+        epsilon: 3e-3,
+        ..Default::default()
+    };
+    let hemicube = RadiositySettings {
+        form_factors: FormFactorMethod::Hemicube(32),
+        ..base.clone()
+    };
+    #[allow(unused_mut)]
+    let mut runs = vec![
+        (
+            "ray cast, bvh",
+            radiosity::solve(&scene, &bvh, &base).unwrap(),
+        ),
+        // The hemicube does not use the backend for its form factors.
+        (
+            "hemicube",
+            radiosity::solve(&scene, &bvh, &hemicube).unwrap(),
+        ),
+    ];
+    #[cfg(feature = "embree")]
+    {
+        let embree = emray::accel::embree::EmbreeAccel::build(&scene).unwrap();
+        let sol = radiosity::solve(&scene, &embree, &base).unwrap();
+        // Both backends agree.
+        for (x, y) in runs[0].1.solve.radiosity.iter().zip(&sol.solve.radiosity) {
+            assert!((*x - *y).abs().max_element() <= 1e-3 * x.max_element().max(1e-3));
+        }
+        runs.push(("ray cast, embree", sol));
+    }
+    for (name, sol) in &runs {
+        let m = &sol.mesh;
+        assert_eq!(m.unmeshed, 0, "{name}: sphere and box are meshed");
+        let b = |k: usize| sol.solve.radiosity[k].x;
+        let mean = |pick: &dyn Fn(&emray::radiosity::mesh::Element) -> bool| {
+            let (mut sum, mut area) = (0.0, 0.0);
+            for (k, e) in m.elements.iter().enumerate() {
+                if pick(e) {
+                    sum += b(k) * e.area;
+                    area += e.area;
+                }
+            }
+            assert!(area > 0.0, "{name}: no elements picked");
+            sum / area
+        };
+        let on_sphere = |e: &emray::radiosity::mesh::Element| {
+            (e.centroid() - Vec3::new(0.5, 0.2, 0.5)).length() < 0.16
+        };
+        let floor = |e: &emray::radiosity::mesh::Element| e.centroid().y < 1e-3 && e.n.y > 0.9;
+        let xz = |e: &emray::radiosity::mesh::Element| {
+            let c = e.centroid();
+            (c.x - 0.5).hypot(c.z - 0.5)
+        };
+        let underside = mean(&|e| on_sphere(e) && e.n.y < -0.7);
+        let top = mean(&|e| on_sphere(e) && e.n.y > 0.7);
+        let under = mean(&|e| floor(e) && xz(e) < 0.12);
+        let far = mean(&|e| floor(e) && xz(e) > 0.35);
+        assert!(
+            underside > 0.02 * far,
+            "{name}: the sphere's underside gets {underside} (floor {far})"
+        );
+        assert!(
+            top > underside,
+            "{name}: top {top} vs underside {underside}"
+        );
+        eprintln!("{name}: underside {underside} top {top} floor under {under} far {far}");
+        assert!(under < 0.8 * far, "{name}: no shadow: {under} vs {far}");
+        // Every element of the closed scene has the same reflectance: the power leaving
+        // all surfaces is the emitted power times 1/(1 − ρ).
+        let total: f64 = m
+            .elements
+            .iter()
+            .zip(&sol.solve.radiosity)
+            .map(|(e, b)| (b.x * e.area) as f64)
+            .sum();
+        let expect = 1.0 / (1.0 - rho as f64);
+        eprintln!(
+            "{name}: total power {total}, series {expect}, {} elements",
+            m.elements.len()
+        );
+        assert!(
+            ((total - expect) / expect).abs() < 0.01,
+            "{name}: total power {total}, series {expect}"
+        );
+        // The display maps hits on the true sphere to its elements: brighter on top.
+        let look = |from: Vec3, dir: Vec3| {
+            let ray = Ray::new(from, dir);
+            let hit: Hit = bvh.intersect(&ray).unwrap();
+            assert_eq!(hit.geom_id, emray::geometry::Kind::Sphere as u32);
+            sol.radiosity_at(&hit, ray.at(hit.t), dir).unwrap().x
+        };
+        let shown_top = look(Vec3::new(0.5, 0.9, 0.5), -Vec3::Y);
+        let shown_under = look(Vec3::new(0.5, 0.01, 0.5), Vec3::Y);
+        assert!(shown_under > 0.0 && shown_top > 1.5 * shown_under);
+        let lo = sol
+            .vertex_radiosity
+            .iter()
+            .map(|v| v.x)
+            .fold(f32::MAX, f32::min);
+        let hi = sol.vertex_radiosity.iter().map(|v| v.x).fold(0.0, f32::max);
+        assert!((lo..=hi).contains(&shown_under) && (lo..=hi).contains(&shown_top));
+    }
+}
+
+#[test]
+fn adaptive_rounds_go_on_from_the_previous_solution() {
+    let scene = shadow_scene();
+    let accel = Bvh::build(&scene);
+    for solver in [SolverKind::Progressive, SolverKind::GaussSeidel] {
+        let settings = RadiositySettings {
+            patch_size: Some(0.26),
+            epsilon: 1e-5,
+            subdiv_threshold: Some(0.2),
+            min_patch_size: Some(0.03),
+            subdiv_passes: 2,
+            solver,
+            ..Default::default()
+        };
+        let sol = radiosity::solve(&scene, &accel, &settings).unwrap();
+        assert_eq!(sol.solve.refinements.len(), 2);
+        if solver == SolverKind::Progressive {
+            assert!(sol.solve.regathered > 0);
+            assert!(sol.solve.total_iterations > sol.solve.iterations);
+        }
+        // A solve from the emission alone on the same final mesh.
+        let fresh = radiosity::solve_mesh(&sol.mesh, &accel, &settings, None).unwrap();
+        let m = &sol.mesh;
+        let scale = (m.elements.iter().zip(&fresh.radiosity))
+            .filter(|(e, _)| m.emission[e.material as usize] == Vec3::ZERO)
+            .map(|(_, b)| b.max_element())
+            .fold(0.0, f32::max);
+        for (k, (a, b)) in sol.solve.radiosity.iter().zip(&fresh.radiosity).enumerate() {
+            let d = (*a - *b).abs().max_element();
+            assert!(d <= 1e-3 * scale, "{solver:?} element {k}: {a} vs {b}");
+        }
+    }
+}

@@ -83,3 +83,21 @@ impl Frame {
         Frame { x, y, z: n }
     }
 }
+
+/// A 32-bit integer hash (Wellons' lowbias32): per-pixel sample offsets and the
+/// jittered shadow rays of area lights.
+#[inline]
+pub fn hash(mut x: u32) -> u32 {
+    x ^= x >> 16;
+    x = x.wrapping_mul(0x7feb_352d);
+    x ^= x >> 15;
+    x = x.wrapping_mul(0x846c_a68b);
+    x ^= x >> 16;
+    x
+}
+
+/// The top 24 bits of `x` as a float in `[0, 1)`.
+#[inline]
+pub fn hash_unit(x: u32) -> f32 {
+    (x >> 8) as f32 * (1.0 / (1u32 << 24) as f32)
+}

@@ -7,7 +7,7 @@
 //! `ρ` shows `ρ ×` it, the same units as the radiosity solution's `B`.
 
 use crate::accel::Accel;
-use crate::math::{gamma, next_float_down, offset_ray_origin, Ray, Vec3};
+use crate::math::{gamma, hash, hash_unit as unit, next_float_down, offset_ray_origin, Ray, Vec3};
 use crate::scene::{Scene, INHERIT};
 use std::f32::consts::FRAC_1_PI;
 
@@ -68,21 +68,6 @@ pub fn collect(scene: &Scene) -> Vec<AreaLight> {
         }
     }
     out
-}
-
-#[inline]
-fn hash(mut x: u32) -> u32 {
-    x ^= x >> 16;
-    x = x.wrapping_mul(0x7feb_352d);
-    x ^= x >> 15;
-    x = x.wrapping_mul(0x846c_a68b);
-    x ^= x >> 16;
-    x
-}
-
-#[inline]
-fn unit(x: u32) -> f32 {
-    (x >> 8) as f32 * (1.0 / (1u32 << 24) as f32)
 }
 
 /// `(irradiance / π)` from `lights` at point `p` (error bound `err`, unit geometric

@@ -1,5 +1,6 @@
 //! Meshing for the radiosity pass: every triangle of the scene (top level and
-//! instanced) is split by repeated midpoint subdivision (each triangle into four
+//! instanced), and every face of the top-level analytic shapes
+//! [`super::tessellate`] handles, is split by repeated midpoint subdivision (each triangle into four
 //! similar ones) until its longest edge is at most the patch size. Each source triangle
 //! keeps its subdivision as a quadtree, so a hit's barycentric coordinates on the source
 //! triangle find its element by descending the tree, and any element can be split again
@@ -7,8 +8,10 @@
 //! leave T-junctions: [`Mesh::hanging_vertices`] lists the vertices that lie inside
 //! another element's edge, so that the display can interpolate them along that edge.
 
+use super::tessellate::{self, Lookup, Tessellation};
 use super::RadiosityError;
 use crate::accel::NO_INSTANCE;
+use crate::geometry::{Kind, Shape};
 use crate::math::{gamma, Vec3};
 use crate::scene::{Geometry, Material, Scene, INHERIT};
 use std::collections::HashMap;
@@ -33,6 +36,9 @@ pub struct Element {
     pub material: u32,
     /// Indices into [`Mesh::vertices`] of the corners.
     pub verts: [u32; 3],
+    /// Nonzero for the faces of one curved analytic surface: its elements share the
+    /// corners they have in common whatever their normals (smooth display).
+    pub smooth: u32,
 }
 
 impl Element {
@@ -68,6 +74,8 @@ pub struct Mesh {
     pub unmeshed: usize,
     /// Root quadtree slot per source triangle.
     sources: HashMap<(u32, u32), u32>,
+    /// Tessellated analytic shapes by `(geometry id, primitive)`.
+    analytic: HashMap<(u32, u32), AnalyticSource>,
     /// Quadtree slots: `LEAF | element` or the first of four child slots.
     slots: Vec<u32>,
     /// The slot of each element.
@@ -117,6 +125,15 @@ pub fn centroid_pattern(level: u32) -> Vec<(f32, f32)> {
         .collect()
 }
 
+/// A tessellated analytic shape: its face lookup and, per face, the fan triangles and
+/// their quadtree roots.
+#[derive(Clone, Debug)]
+struct AnalyticSource {
+    lookup: Lookup,
+    faces: Vec<Vec<([Vec3; 3], u32)>>,
+    open: bool,
+}
+
 #[derive(Clone, Copy, Debug, PartialEq, Eq, Hash)]
 struct VertexKey {
     pos: [u32; 3],
@@ -150,17 +167,14 @@ impl Mesh {
             ..Default::default()
         };
         let top = |g: &Geometry| g.count_unmeshed();
-        mesh.unmeshed = top(&scene.geometry);
         for (k, tri) in scene.triangles.items.iter().enumerate() {
             let material = scene.triangles.material[k];
-            mesh.add_source(
-                (NO_INSTANCE, k as u32),
-                tri.p,
-                Vec3::ZERO,
-                material,
-                patch_size,
-            )?;
+            let root = mesh.add_source(tri.p, Vec3::ZERO, material, patch_size, 0)?;
+            if let Some(root) = root {
+                mesh.sources.insert((NO_INSTANCE, k as u32), root);
+            }
         }
+        mesh.unmeshed = mesh.add_shapes(&scene.geometry, patch_size)?;
         for (ii, inst) in scene.instances.iter().enumerate() {
             let object = &scene.objects[inst.object as usize];
             mesh.unmeshed += top(object);
@@ -175,24 +189,92 @@ impl Mesh {
                     err = err.max(e);
                     q
                 });
-                mesh.add_source((ii as u32, k as u32), p, err, material, patch_size)?;
+                let root = mesh.add_source(p, err, material, patch_size, 0)?;
+                if let Some(root) = root {
+                    mesh.sources.insert((ii as u32, k as u32), root);
+                }
             }
         }
         Ok(mesh)
     }
 
+    /// Tessellate and mesh the analytic shapes of `g` that [`tessellate`] handles; the
+    /// number of the others (left out of the mesh).
+    fn add_shapes(&mut self, g: &Geometry, patch_size: f32) -> Result<usize, RadiosityError> {
+        let mut unmeshed = 0;
+        for (k, s) in g.spheres.items.iter().enumerate() {
+            let t = tessellate::sphere(s, patch_size);
+            self.add_shape((Kind::Sphere, k), t, g.spheres.material[k], patch_size)?;
+        }
+        for (k, c) in g.cones.items.iter().enumerate() {
+            let t = tessellate::cone(c, patch_size);
+            self.add_shape((Kind::Cone, k), t, g.cones.material[k], patch_size)?;
+        }
+        for (k, shape) in g.shapes.items.iter().enumerate() {
+            let t = match shape {
+                Shape::Sphere(s) => tessellate::sphere(s, patch_size),
+                Shape::Cone(c) => tessellate::cone(c, patch_size),
+                Shape::CappedCone(c) => tessellate::capped(c, patch_size),
+                Shape::Box(b) => tessellate::aabox(b),
+                Shape::OBox(b) => tessellate::obox(b),
+                Shape::Polyhedron(p) => tessellate::polyhedron(p),
+                _ => {
+                    unmeshed += 1;
+                    continue;
+                }
+            };
+            self.add_shape((shape.kind(), k), t, g.shapes.material[k], patch_size)?;
+        }
+        Ok(unmeshed)
+    }
+
+    /// Mesh the faces of one tessellated shape (each a fan of source triangles).
+    fn add_shape(
+        &mut self,
+        (kind, prim): (Kind, usize),
+        t: Tessellation,
+        material: u32,
+        patch_size: f32,
+    ) -> Result<(), RadiosityError> {
+        let smooth = if t.smooth {
+            self.analytic.len() as u32 + 1
+        } else {
+            0
+        };
+        let mut faces = Vec::with_capacity(t.faces.len());
+        for (face, &depth) in t.faces.iter().zip(&t.depth) {
+            let mut fan = Vec::new();
+            for k in 1..face.len().saturating_sub(1) {
+                let tri = [face[0], face[k], face[k + 1]];
+                let err = Vec3::splat(depth);
+                if let Some(root) = self.add_source(tri, err, material, patch_size, smooth)? {
+                    fan.push((tri, root));
+                }
+            }
+            faces.push(fan);
+        }
+        let source = AnalyticSource {
+            lookup: t.lookup,
+            faces,
+            open: t.open,
+        };
+        self.analytic.insert((kind as u32, prim as u32), source);
+        Ok(())
+    }
+
+    /// Mesh one source triangle; its root quadtree slot (`None`: degenerate, skipped).
     fn add_source(
         &mut self,
-        key: (u32, u32),
         p: [Vec3; 3],
         err: Vec3,
         material: u32,
         patch_size: f32,
-    ) -> Result<(), RadiosityError> {
+        smooth: u32,
+    ) -> Result<Option<u32>, RadiosityError> {
         let n = (p[1] - p[0]).cross(p[2] - p[0]);
         let len = n.length();
         if !(len > 0.0 && len.is_finite()) {
-            return Ok(());
+            return Ok(None);
         }
         let n = n / len;
         let longest = longest_edge(&p);
@@ -207,7 +289,6 @@ impl Mesh {
         let err = err + Vec3::splat(magnitude * gamma(12));
         let root = self.slots.len() as u32;
         self.slots.push(0);
-        self.sources.insert(key, root);
         let proto = Element {
             p,
             err,
@@ -215,9 +296,10 @@ impl Mesh {
             area: 0.0,
             material,
             verts: [0; 3],
+            smooth,
         };
         self.fill(root, p, level, &proto);
-        Ok(())
+        Ok(Some(root))
     }
 
     /// Fill `slot` with triangle `t` subdivided `level` times.
@@ -258,9 +340,14 @@ impl Mesh {
     }
 
     fn key(&self, q: Vec3, e: &Element) -> VertexKey {
+        // A smooth surface's group takes the place of the normal (outside its range).
+        let normal = match e.smooth {
+            0 => (e.n * 1024.0).round().as_ivec3().to_array(),
+            g => [i32::MIN, g as i32, i32::MIN],
+        };
         VertexKey {
             pos: q.to_array().map(f32::to_bits),
-            normal: (e.n * 1024.0).round().as_ivec3().to_array(),
+            normal,
             material: e.material,
         }
     }
@@ -333,12 +420,41 @@ impl Mesh {
     /// The element at barycentric `(u, v)` of triangle `prim` of instance `inst`
     /// ([`NO_INSTANCE`] for the top level), with the point's coordinates in it.
     pub fn locate(&self, inst: u32, prim: u32, u: f32, v: f32) -> Option<(usize, f32, f32)> {
-        let mut slot = *self.sources.get(&(inst, prim))?;
+        let slot = *self.sources.get(&(inst, prim))?;
+        Some(self.descend_from(slot, u, v))
+    }
+
+    /// The element of a tessellated analytic shape (`kind`, top-level primitive
+    /// `prim`) under the point `p` of its true surface with geometric normal `ng`, the
+    /// coordinates of `p`'s projection in it, and whether the shape is an open surface;
+    /// `None` for shapes that are not tessellated.
+    pub fn locate_analytic(
+        &self,
+        kind: Kind,
+        prim: u32,
+        p: Vec3,
+        ng: Vec3,
+    ) -> Option<(usize, f32, f32, bool)> {
+        let src = self.analytic.get(&(kind as u32, prim))?;
+        let fan = src.faces.get(src.lookup.face(p, ng))?;
+        let score = |&(t, _): &&([Vec3; 3], u32)| {
+            let (u, v) = tessellate::barycentric(t, p);
+            u.min(v).min(1.0 - u - v)
+        };
+        let best = fan.iter().max_by(|a, b| score(a).total_cmp(&score(b)))?;
+        let (u, v) = tessellate::barycentric(&best.0, p);
+        let (u, v) = tessellate::clamp_barycentric(u, v);
+        let (k, u, v) = self.descend_from(best.1, u, v);
+        Some((k, u, v, src.open))
+    }
+
+    /// The leaf under `(u, v)` from quadtree slot `slot`.
+    fn descend_from(&self, mut slot: u32, u: f32, v: f32) -> (usize, f32, f32) {
         let (mut u, mut v) = (u.clamp(0.0, 1.0), v.clamp(0.0, 1.0));
         loop {
             let s = self.slots[slot as usize];
             if s & LEAF != 0 {
-                return Some(((s & !LEAF) as usize, u, v));
+                return ((s & !LEAF) as usize, u, v);
             }
             let (c, cu, cv) = descend(u, v);
             slot = s + c as u32;
@@ -367,7 +483,7 @@ fn too_many(patch_size: f32) -> RadiosityError {
 }
 
 impl Geometry {
-    /// Analytic primitives, which the radiosity mesh leaves out.
+    /// Analytic primitives of an instanced object, which the radiosity mesh leaves out.
     fn count_unmeshed(&self) -> usize {
         self.spheres.len() + self.cones.len() + self.shapes.len()
     }

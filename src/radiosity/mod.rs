@@ -1,6 +1,7 @@
 //! Radiosity: diffuse interreflection between the scene's surfaces, view-independent.
 //!
-//! The phases: [`mesh`] splits every triangle into elements of at most the patch size;
+//! The phases: [`mesh`] splits every triangle, and the faces of the analytic shapes
+//! [`tessellate`] handles, into elements of at most the patch size;
 //! [`formfactor`] estimates form factors by ray casting (exact point-to-polygon form
 //! factors with visibility from `Accel::occluded`, either backend); [`solver`] solves
 //! the system by progressive refinement (or Gauss–Seidel on the full matrix); a
@@ -18,6 +19,7 @@ pub mod formfactor;
 pub mod hemicube;
 pub mod mesh;
 pub mod solver;
+pub mod tessellate;
 
 use crate::accel::{Accel, AccelError, Backend, Hit};
 use crate::geometry::Kind;
@@ -64,7 +66,8 @@ pub enum FormFactorMethod {
     /// visibility from `Accel::occluded` rays (either backend).
     RayCast,
     /// A hemicube of this many pixels across its top face on each shooter's centroid,
-    /// visibility from its depth buffer (meshed triangles only).
+    /// visibility from its depth buffer (meshed elements only: analytic shapes that
+    /// are not tessellated do not occlude).
     Hemicube(u32),
 }
 
@@ -177,17 +180,32 @@ impl Solution {
         }
     }
 
-    /// The Gouraud-interpolated radiosity at a hit on a meshed triangle seen along
-    /// `dir` (zero on its back side); `None` for primitives that are not meshed.
-    pub fn radiosity_at(&self, hit: &Hit, dir: Vec3) -> Option<Vec3> {
-        if hit.kind() != Kind::Triangle {
-            return None;
-        }
-        let (k, u, v) = self.mesh.locate(hit.inst_id, hit.prim_id, hit.u, hit.v)?;
+    /// The Gouraud-interpolated radiosity at a hit at point `p` seen along `dir`: on a
+    /// meshed triangle, at the hit's barycentric coordinates (zero on its back side); on
+    /// a tessellated analytic shape, at the projection of `p` onto the face under it (see
+    /// [`tessellate`]; the back side of an open cone is not meshed: `None`); `None` for
+    /// primitives that are not meshed.
+    pub fn radiosity_at(&self, hit: &Hit, p: Vec3, dir: Vec3) -> Option<Vec3> {
+        let (k, u, v) = match hit.kind() {
+            Kind::Triangle => {
+                let (k, u, v) = self.mesh.locate(hit.inst_id, hit.prim_id, hit.u, hit.v)?;
+                if self.mesh.elements[k].n.dot(dir) >= 0.0 {
+                    return Some(Vec3::ZERO);
+                }
+                (k, u, v)
+            }
+            _ if hit.inst_id != crate::accel::NO_INSTANCE => return None,
+            kind => {
+                let (k, u, v, open) = self.mesh.locate_analytic(kind, hit.prim_id, p, hit.ng)?;
+                // A closed shape shows only its meshed side; an open one shows both.
+                let n = self.mesh.elements[k].n;
+                if open && (hit.ng.dot(n) > 0.0) != (hit.ng.dot(dir) < 0.0) {
+                    return None;
+                }
+                (k, u, v)
+            }
+        };
         let e = &self.mesh.elements[k];
-        if e.n.dot(dir) >= 0.0 {
-            return Some(Vec3::ZERO);
-        }
         let c = e.verts.map(|i| self.vertex_radiosity[i as usize]);
         Some(c[0] * (1.0 - u - v) + c[1] * u + c[2] * v)
     }
@@ -241,9 +259,10 @@ pub fn solve<A: Accel>(
     if mesh.elements.is_empty() {
         return Err(RadiosityError::Empty);
     }
-    let mut solve = solve_mesh(&mesh, accel, settings)?;
+    let mut solve = solve_mesh(&mesh, accel, settings, None)?;
     let (mut form_factor_ms, mut total_ms, mut refinements) =
         (solve.form_factor_ms, solve.total_ms, Vec::new());
+    let (mut shots, mut regathered) = (solve.iterations, 0);
     if let Some(threshold) = settings.subdiv_threshold {
         let min = settings.min_patch_size.unwrap_or(patch / 8.0);
         if !(threshold.is_finite() && threshold > 0.0 && min.is_finite() && min > 0.0) {
@@ -256,18 +275,33 @@ pub fn solve<A: Accel>(
             if marked.is_empty() {
                 break;
             }
+            // Children inherit their parent's state: the radiosity it has shot
+            // (progressive) or holds (Gauss–Seidel). `split` keeps the first child at
+            // the parent's index and appends the other three in order.
+            let mut state: Vec<Vec3> = match settings.solver {
+                SolverKind::Progressive => (solve.radiosity.iter())
+                    .zip(&solve.unshot)
+                    .map(|(&b, &u)| b - u)
+                    .collect(),
+                SolverKind::GaussSeidel => solve.radiosity.clone(),
+            };
+            for &k in &marked {
+                state.extend([state[k]; 3]);
+            }
             mesh.split(&marked)?;
             refinements.push(marked.len());
-            // A fresh solve on the refined mesh: every element starts with its emission
-            // unshot, so the energy bookkeeping is that of a first solve.
-            solve = solve_mesh(&mesh, accel, settings)?;
+            solve = solve_mesh(&mesh, accel, settings, Some(&state))?;
             form_factor_ms += solve.form_factor_ms;
             total_ms += solve.total_ms;
+            shots += solve.iterations;
+            regathered += solve.regathered;
         }
     }
     solve.form_factor_ms = form_factor_ms;
     solve.total_ms = total_ms;
     solve.refinements = refinements;
+    solve.total_iterations = shots;
+    solve.regathered = regathered;
     Ok(Solution::new(mesh, solve))
 }
 
@@ -311,29 +345,29 @@ pub fn marked_for_split(mesh: &Mesh, radiosity: &[Vec3], threshold: f32, min: f3
         .collect()
 }
 
-/// Solve the radiosity system of `mesh` with the settings' form factors and solver.
-fn solve_mesh<A: Accel>(
+/// Solve the radiosity system of `mesh` with the settings' form factors and solver,
+/// from the emission (`start` `None`) or from a previous state: per element, the
+/// radiosity already shot (progressive refinement) or the current radiosity
+/// (Gauss–Seidel).
+pub fn solve_mesh<A: Accel>(
     mesh: &Mesh,
     accel: &A,
     settings: &RadiositySettings,
+    start: Option<&[Vec3]>,
 ) -> Result<Solve, RadiosityError> {
     let (eps, max) = (settings.epsilon, settings.max_iterations);
+    let run = |row: &dyn Fn(usize) -> Vec<f32>| match settings.solver {
+        SolverKind::Progressive => solver::progressive_rows_from(mesh, row, eps, max, start),
+        SolverKind::GaussSeidel => solver::gauss_seidel_rows_from(mesh, row, eps, max, start),
+    };
     match settings.form_factors {
         FormFactorMethod::RayCast => {
             let s = Sampling::new(settings.shooter_level, settings.visibility_level);
-            let row = |i| solver::form_factor_row(mesh, accel, &s, i);
-            match settings.solver {
-                SolverKind::Progressive => solver::progressive_rows(mesh, row, eps, max),
-                SolverKind::GaussSeidel => solver::gauss_seidel_rows(mesh, row, eps, max),
-            }
+            run(&|i| solver::form_factor_row(mesh, accel, &s, i))
         }
         FormFactorMethod::Hemicube(res) => {
             let h = hemicube::Hemicube::new(res)?;
-            let row = |i| h.row(mesh, i);
-            match settings.solver {
-                SolverKind::Progressive => solver::progressive_rows(mesh, row, eps, max),
-                SolverKind::GaussSeidel => solver::gauss_seidel_rows(mesh, row, eps, max),
-            }
+            run(&|i| h.row(mesh, i))
         }
     }
 }
@@ -359,7 +393,7 @@ pub fn default_patch_size(scene: &Scene) -> f32 {
 }
 
 /// Look at a solution from the scene's camera (`width × height`, `spp²` stratified
-/// samples per pixel): Gouraud radiosity on meshed triangles, the material colour
+/// samples per pixel): Gouraud radiosity on meshed surfaces, the material colour
 /// times the scene's ambient on other primitives, the background on misses.
 pub fn render_view<A: Accel>(
     scene: &Scene,
@@ -385,10 +419,13 @@ pub fn render_view<A: Accel>(
                             );
                             sum += match accel.intersect(&ray) {
                                 None => scene.background,
-                                Some(hit) => sol.radiosity_at(&hit, ray.dir).unwrap_or_else(|| {
-                                    let surf = scene.surface(&hit, &ray);
-                                    scene.materials[surf.material as usize].color * scene.ambient
-                                }),
+                                Some(hit) => sol
+                                    .radiosity_at(&hit, ray.at(hit.t), ray.dir)
+                                    .unwrap_or_else(|| {
+                                        let surf = scene.surface(&hit, &ray);
+                                        scene.materials[surf.material as usize].color
+                                            * scene.ambient
+                                    }),
                             };
                         }
                     }
@@ -429,8 +466,12 @@ pub struct RadiosityReport {
     pub shooter_samples: usize,
     /// Visibility rays per pair of elements.
     pub visibility_samples: usize,
-    /// Shots or sweeps.
+    /// Shots or sweeps (the last round of adaptive subdivision).
     pub iterations: usize,
+    /// Shots or sweeps in all rounds.
+    pub total_iterations: usize,
+    /// Form-factor rows computed to gather each round's start from the previous one.
+    pub regathered: usize,
     /// Residual curve.
     pub residuals: Vec<f64>,
     /// Milliseconds: building the backend, form factors, whole solve, one view.
@@ -458,7 +499,7 @@ impl RadiosityReport {
         };
         format!(
             "backend    {}\nmesh       {} elements, {} vertices (patch size {}), {} analytic primitives not meshed\n\
-             subdivide  {:?} elements split per round\n\
+             subdivide  {:?} elements split per round; {} iterations and {} re-gather rows in all rounds\n\
              ff         {}\n\
              solver     {:?}: {} iterations, final residual {:.3e}\n\
              time       build {:.1} ms, form factors {:.1} ms, solve {:.1} ms, view {:.1} ms",
@@ -468,6 +509,8 @@ impl RadiosityReport {
             self.patch_size,
             self.unmeshed,
             self.refinements,
+            self.total_iterations,
+            self.regathered,
             method,
             self.solver,
             self.iterations,
@@ -505,6 +548,8 @@ fn solve_and_view<A: Accel>(
         shooter_samples: 1 << (2 * settings.shooter_level),
         visibility_samples: 1 << (2 * settings.visibility_level),
         iterations: sol.solve.iterations,
+        total_iterations: sol.solve.total_iterations,
+        regathered: sol.solve.regathered,
         residuals: sol.solve.residuals.clone(),
         build_ms,
         form_factor_ms: sol.solve.form_factor_ms,

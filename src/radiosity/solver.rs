@@ -28,13 +28,19 @@ pub struct Solve {
     pub residuals: Vec<f64>,
     /// Shots (progressive) or sweeps (Gauss–Seidel) done.
     pub iterations: usize,
+    /// Shots or sweeps in all rounds of adaptive subdivision together.
+    pub total_iterations: usize,
     /// Milliseconds spent computing form factors.
     pub form_factor_ms: f64,
     /// Milliseconds for the whole solve.
     pub total_ms: f64,
-    /// Elements split in each round of adaptive subdivision (each round is followed by
-    /// a fresh solve; the other fields describe the last one, the times cover all).
+    /// Elements split in each round of adaptive subdivision (each round goes on from
+    /// the previous round's solution; the other fields describe the last round, the
+    /// times and counts cover all).
     pub refinements: Vec<usize>,
+    /// Rows of form factors computed to gather a previous round's solution again on a
+    /// refined mesh (progressive refinement only).
+    pub regathered: usize,
 }
 
 fn power(v: Vec3) -> f64 {
@@ -86,6 +92,41 @@ pub fn progressive_rows<R: Fn(usize) -> Vec<f32>>(
     epsilon: f64,
     max_shots: usize,
 ) -> Result<Solve, RadiosityError> {
+    progressive_rows_from(mesh, row, epsilon, max_shots, None)
+}
+
+/// Add to `b` and `u` what the receivers of row `f` of element `i` gather from its
+/// radiosity `shot`.
+fn receive(mesh: &Mesh, i: usize, f: &[f32], shot: Vec3, b: &mut [Vec3], u: &mut [Vec3]) {
+    let ai = mesh.elements[i].area;
+    for (j, &f) in f.iter().enumerate() {
+        if f > 0.0 {
+            let el = &mesh.elements[j];
+            let rho = mesh.reflectance[el.material as usize];
+            let db = rho * shot * (f * ai / el.area);
+            b[j] += db;
+            u[j] += db;
+        }
+    }
+}
+
+/// Progressive refinement that starts, with `shot`, from a state in which each element
+/// has already shot that radiosity (a previous solve on a coarser mesh whose split
+/// elements passed theirs to their children): the radiosities are gathered again from
+/// it with this mesh's form factors (one row per element that has shot), what each
+/// element holds beyond what it has shot is its unshot radiosity (negative where a
+/// child received less than its parent), and shooting goes on from there. The
+/// invariant `B = E + K·shot` of progressive refinement holds from the start, so the
+/// solver converges to the same solution as from the emission alone. `None`: start
+/// from the emission. Shooters are picked, and the residual measured, by the absolute
+/// unshot power.
+pub fn progressive_rows_from<R: Fn(usize) -> Vec<f32>>(
+    mesh: &Mesh,
+    row: R,
+    epsilon: f64,
+    max_shots: usize,
+    shot: Option<&[Vec3]>,
+) -> Result<Solve, RadiosityError> {
     let start = Instant::now();
     let emission = emitted(mesh)?;
     let n = mesh.elements.len();
@@ -97,8 +138,32 @@ pub fn progressive_rows<R: Fn(usize) -> Vec<f32>>(
         ..Default::default()
     };
     let mut ff_ms = 0.0;
+    if let Some(shot) = shot {
+        if shot.len() != n {
+            return Err(RadiosityError::Settings(format!(
+                "a previous solution of {} elements does not fit a mesh of {n}",
+                shot.len()
+            )));
+        }
+        let mut u = vec![Vec3::ZERO; n];
+        for (i, &s) in shot.iter().enumerate() {
+            if s != Vec3::ZERO {
+                let t = Instant::now();
+                let f = row(i);
+                ff_ms += t.elapsed().as_secs_f64() * 1e3;
+                receive(mesh, i, &f, s, &mut out.radiosity, &mut u);
+                out.regathered += 1;
+            }
+        }
+        for ((u, &b), &s) in out.unshot.iter_mut().zip(&out.radiosity).zip(shot) {
+            *u = b - s;
+        }
+    }
+    let abs_power = |v: Vec3| power(v.abs());
     loop {
-        let unshot_power: f64 = (0..n).map(|i| power(out.unshot[i]) * area[i] as f64).sum();
+        let unshot_power: f64 = (0..n)
+            .map(|i| abs_power(out.unshot[i]) * area[i] as f64)
+            .sum();
         let residual = unshot_power / total_emitted;
         out.residuals.push(residual);
         if residual < epsilon || out.iterations >= max_shots {
@@ -106,8 +171,8 @@ pub fn progressive_rows<R: Fn(usize) -> Vec<f32>>(
         }
         let i = (0..n)
             .max_by(|&a, &b| {
-                let pa = power(out.unshot[a]) * area[a] as f64;
-                let pb = power(out.unshot[b]) * area[b] as f64;
+                let pa = abs_power(out.unshot[a]) * area[a] as f64;
+                let pb = abs_power(out.unshot[b]) * area[b] as f64;
                 pa.total_cmp(&pb)
             })
             .expect("non-empty mesh");
@@ -116,15 +181,7 @@ pub fn progressive_rows<R: Fn(usize) -> Vec<f32>>(
         ff_ms += t.elapsed().as_secs_f64() * 1e3;
         let shot = out.unshot[i];
         out.unshot[i] = Vec3::ZERO;
-        for (j, &f) in row.iter().enumerate() {
-            if f > 0.0 {
-                let el = &mesh.elements[j];
-                let rho = mesh.reflectance[el.material as usize];
-                let db = rho * shot * (f * area[i] / area[j]);
-                out.radiosity[j] += db;
-                out.unshot[j] += db;
-            }
-        }
+        receive(mesh, i, &row, shot, &mut out.radiosity, &mut out.unshot);
         out.iterations += 1;
     }
     out.form_factor_ms = ff_ms;
@@ -156,6 +213,18 @@ pub fn gauss_seidel_rows<R: Fn(usize) -> Vec<f32>>(
     tolerance: f64,
     max_sweeps: usize,
 ) -> Result<Solve, RadiosityError> {
+    gauss_seidel_rows_from(mesh, row, tolerance, max_sweeps, None)
+}
+
+/// Gauss–Seidel with the rows of form factors from `row(i)`, starting from the
+/// radiosities `initial` (a previous round's solution) or from the emission.
+pub fn gauss_seidel_rows_from<R: Fn(usize) -> Vec<f32>>(
+    mesh: &Mesh,
+    row: R,
+    tolerance: f64,
+    max_sweeps: usize,
+    initial: Option<&[Vec3]>,
+) -> Result<Solve, RadiosityError> {
     let start = Instant::now();
     let emission = emitted(mesh)?;
     let n = mesh.elements.len();
@@ -172,7 +241,10 @@ pub fn gauss_seidel_rows<R: Fn(usize) -> Vec<f32>>(
         .iter()
         .map(|e| e.max_element() as f64)
         .fold(0.0, f64::max);
-    let mut b = emission.clone();
+    let mut b = match initial {
+        Some(b) if b.len() == n => b.to_vec(),
+        _ => emission.clone(),
+    };
     let mut out = Solve::default();
     loop {
         let mut change = 0.0f64;

@@ -2,7 +2,9 @@
 
 use super::{RayGen, Region, RenderSettings};
 use crate::accel::{Accel, Hit};
-use crate::math::{next_float_down, offset_ray_origin, Ray, RayOrigins, Vec3};
+use crate::math::{
+    hash, hash_unit as unit, next_float_down, offset_ray_origin, Ray, RayOrigins, Vec3,
+};
 use crate::radiosity::{area, Solution};
 use crate::scene::{Light, Material, Scene, Surface};
 
@@ -71,22 +73,6 @@ pub(super) struct Tracer<'a, A: Accel> {
     /// Primary rays of a tile in packets of this many (see
     /// [`RenderSettings::packet_width`]); 0 = one by one.
     packet_width: u32,
-}
-
-/// A 32-bit integer hash (Wellons' lowbias32) for per-pixel sample offsets.
-#[inline]
-fn hash(mut x: u32) -> u32 {
-    x ^= x >> 16;
-    x = x.wrapping_mul(0x7feb_352d);
-    x ^= x >> 15;
-    x = x.wrapping_mul(0x846c_a68b);
-    x ^= x >> 16;
-    x
-}
-
-#[inline]
-fn unit(x: u32) -> f32 {
-    (x >> 8) as f32 * (1.0 / (1u32 << 24) as f32)
 }
 
 /// Van der Corput radical inverse in base 2.
@@ -268,7 +254,7 @@ impl<'a, A: Accel> Tracer<'a, A> {
             if depth == 1 {
                 counts.eye_hit += 1;
             }
-            let gi = self.gi.and_then(|g| g.radiosity_at(&hit, d));
+            let gi = self.gi.and_then(|g| g.radiosity_at(&hit, surf.point.p, d));
             return self.shade(&surf, d, entering, depth, media, weight, gi, counts);
         }
     }
