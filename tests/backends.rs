@@ -116,3 +116,75 @@ proptest! {
         prop_assert!(hits > 200, "rays should hit often ({})", hits);
     }
 }
+
+/// Rays neither backend can trace (non-finite, or beyond Embree's accepted magnitude):
+/// each `(origin, direction, tmin, tmax)`.
+fn untraceable_rays() -> Vec<Ray> {
+    let nan = f32::NAN;
+    let inf = f32::INFINITY;
+    let far = 2.226e26;
+    let ok = Vec3::new(0.0, 0.0, 40.0);
+    let down = Vec3::new(0.0, 0.0, -1.0);
+    let mut rays = vec![
+        Ray::new(Vec3::new(nan, 0.0, 40.0), down),
+        Ray::new(ok, Vec3::new(0.0, nan, -1.0)),
+        Ray::new(ok, Vec3::splat(nan)),
+        Ray::new(Vec3::new(-1.0, -far, 0.5), Vec3::new(0.0, 1.0, 0.0)),
+        Ray::new(ok, Vec3::new(0.0, 0.0, -far)),
+        Ray::new(Vec3::new(inf, 0.0, 0.0), down),
+        Ray::new(ok, Vec3::new(0.0, 0.0, -inf)),
+    ];
+    let mut nan_interval = Ray::new(ok, down);
+    nan_interval.tmax = nan;
+    rays.push(nan_interval);
+    let mut nan_start = Ray::new(ok, down);
+    nan_start.tmin = nan;
+    rays.push(nan_start);
+    rays
+}
+
+/// Every query of both backends, on a scene with triangles, spheres, cones, a plane
+/// (tested outside the hierarchy) and an instance: a ray that cannot be traced hits
+/// nothing and occludes nothing, alone and inside a packet of good rays, which keep
+/// their hits.
+#[test]
+fn untraceable_rays_hit_nothing_on_both_backends() {
+    use emray::geometry::{Plane, Shape};
+    use emray::math::Xform;
+    use emray::scene::Instance;
+    let mut s = scene(7);
+    s.geometry
+        .add_shape(Shape::Plane(Plane::new(Vec3::Z, -30.0).unwrap()), 0);
+    let mut object = emray::scene::Geometry::default();
+    object.add_shape(Shape::Sphere(Sphere::new(Vec3::ZERO, 1.0)), 0);
+    s.objects.push(object);
+    s.instances.push(Instance {
+        object: 0,
+        xform: Xform::new(glam::Affine3A::from_translation(Vec3::new(0.0, 0.0, 25.0))).unwrap(),
+        material: 0,
+    });
+    let good = Ray::new(Vec3::new(0.0, 0.0, 40.0), Vec3::new(0.0, 0.0, -1.0));
+    let bvh = Bvh::build(&s);
+    let emb = EmbreeAccel::build(&s).unwrap();
+    let backends: [(&str, &dyn Accel); 2] = [("bvh", &bvh), ("embree", &emb)];
+    for (name, accel) in backends {
+        let expected = accel.intersect(&good);
+        assert!(expected.is_some(), "{name}: the good ray hits the instance");
+        assert!(accel.occluded(&good), "{name}");
+        for ray in untraceable_rays() {
+            assert!(!ray.is_traceable(), "{ray:?}");
+            assert_eq!(accel.intersect(&ray), None, "{name}: {ray:?}");
+            assert!(!accel.occluded(&ray), "{name}: {ray:?}");
+            for width in [0, 4, 8, 16] {
+                let rays = vec![good, ray, good, ray, good];
+                let mut hits = vec![None; rays.len()];
+                accel.intersect_coherent(&rays, &mut hits, width);
+                assert_eq!(hits[0], expected, "{name} width {width}");
+                assert_eq!(hits[2], expected, "{name} width {width}");
+                assert_eq!(hits[4], expected, "{name} width {width}");
+                assert_eq!(hits[1], None, "{name} width {width}: {ray:?}");
+                assert_eq!(hits[3], None, "{name} width {width}: {ray:?}");
+            }
+        }
+    }
+}

@@ -41,7 +41,26 @@ impl Ray {
     pub fn at(&self, t: f32) -> Vec3 {
         self.org + self.dir * t
     }
+
+    /// Whether both backends can trace this ray: origin and direction finite and
+    /// within [`MAX_RAY_COMPONENT`] in every component, and an interval that is not
+    /// NaN. Every ray query checks it first and treats any other ray as hitting
+    /// nothing, so that no value reaches a traversal or Embree that they do not accept.
+    #[inline]
+    pub fn is_traceable(&self) -> bool {
+        let limit = Vec3::splat(MAX_RAY_COMPONENT);
+        self.org.abs().cmple(limit).all()
+            && self.dir.abs().cmple(limit).all()
+            && !self.tmin.is_nan()
+            && !self.tmax.is_nan()
+    }
 }
+
+/// Largest magnitude of a ray's origin or direction component that the ray queries
+/// accept: Embree's own bound (`FLT_LARGE`, about 1.8·10¹⁸), above which its traversal
+/// is undefined. Scenes are kept far inside it (see `scene::MAX_COORDINATE`). NaN
+/// fails every comparison with it, so the test also rejects non-finite values.
+pub const MAX_RAY_COMPONENT: f32 = 1.844e18;
 
 /// The same ray in double precision, for reference computations.
 #[derive(Clone, Copy, Debug, PartialEq)]

@@ -225,7 +225,11 @@ impl Bvh {
         }
     }
 
+    /// The nearest hit; none for a ray that is not [traceable](Ray::is_traceable).
     fn nearest(&self, ray: &Ray) -> Option<Hit> {
+        if !ray.is_traceable() {
+            return None;
+        }
         let mut best: Option<Hit> = None;
         let mut wt = WatertightRay::new(ray);
         let mut tmax = ray.tmax;
@@ -248,7 +252,12 @@ impl Bvh {
         best
     }
 
+    /// Whether anything is hit; nothing is for a ray that is not
+    /// [traceable](Ray::is_traceable).
     fn any(&self, ray: &Ray) -> bool {
+        if !ray.is_traceable() {
+            return false;
+        }
         let wt = WatertightRay::new(ray);
         if self.unbounded.iter().any(|&i| self.occludes(i, ray, &wt)) {
             return true;

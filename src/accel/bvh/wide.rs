@@ -30,12 +30,17 @@ pub(super) struct Node4 {
     /// Interior child: its node index. Leaf: [`LEAF`] | index into the leaf table.
     /// Unused: `u32::MAX`.
     pub child: [u32; 4],
+    /// Bit `i` set when slot `i` holds a child. The slab test's hit mask is limited to
+    /// it, so an unused slot is never followed whatever the ray (a NaN in the slab
+    /// test keeps the interval, which would otherwise reach the empty boxes too).
+    pub used: u32,
 }
 
 impl Node4 {
     const UNUSED: Node4 = Node4 {
         bounds: [[[f32::INFINITY; 4]; 3], [[f32::NEG_INFINITY; 4]; 3]],
         child: [EMPTY; 4],
+        used: 0,
     };
 
     /// Box of slot `i` (empty for an unused slot).
@@ -54,6 +59,7 @@ impl Node4 {
             self.bounds[1][a][i] = bounds.max[a];
         }
         self.child[i] = child;
+        self.used |= 1 << i;
     }
 }
 
@@ -175,7 +181,7 @@ pub(super) fn traverse<const ORDERED: bool, const DEPTH: usize>(
                 tn = ((lo - org[a]) * inv[a]).max(tn);
                 tf = ((hi - org[a]) * inv[a] * far_scale).min(tf);
             }
-            let mut mask = tn.cmple(tf).bitmask();
+            let mut mask = tn.cmple(tf).bitmask() & node.used;
             if mask != 0 {
                 let mut hits = [(0u32, 0f32); 4];
                 let mut k = 0;

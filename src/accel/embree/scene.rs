@@ -316,6 +316,9 @@ impl CommittedScene {
     /// `tnear >= 0`).
     #[inline]
     pub(super) fn intersect(&self, ray: &Ray) -> Option<Hit> {
+        if !ray.is_traceable() {
+            return None;
+        }
         if self.unbounded.is_empty() {
             return self.intersect_embree(ray);
         }
@@ -335,6 +338,9 @@ impl CommittedScene {
     /// Whether anything lies in the ray's interval (any hit).
     #[inline]
     pub(super) fn occluded(&self, ray: &Ray) -> bool {
+        if !ray.is_traceable() {
+            return false;
+        }
         if !self.unbounded.is_empty() {
             let tnear = ray.tmin.max(0.0);
             if self.any_unbounded(&Ray {
@@ -351,10 +357,7 @@ impl CommittedScene {
     /// `tnear >= 0`).
     #[inline]
     fn intersect_embree(&self, ray: &Ray) -> Option<Hit> {
-        let tnear = ray.tmin.max(0.0);
-        if ray.tmax.is_nan() || ray.tmax < tnear {
-            return None;
-        }
+        let tnear = embree_tnear(ray)?;
         let mut rayhit = sys::RTCRayHit {
             ray: rtc_ray(ray, tnear),
             hit: empty_hit(),
@@ -380,10 +383,9 @@ impl CommittedScene {
 
     #[inline]
     fn occluded_embree(&self, ray: &Ray) -> bool {
-        let tnear = ray.tmin.max(0.0);
-        if ray.tmax.is_nan() || ray.tmax < tnear {
+        let Some(tnear) = embree_tnear(ray) else {
             return false;
-        }
+        };
         let mut r = rtc_ray(ray, tnear);
         query::occluded(self.top.raw, &mut r);
         r.tfar == f32::NEG_INFINITY
@@ -412,19 +414,29 @@ impl CommittedScene {
     }
 }
 
+/// The `tnear` Embree is given for `ray`, `max(tmin, 0)` (Embree requires `tnear >= 0`),
+/// or `None` for a ray that must not reach Embree: one that is not
+/// [traceable](Ray::is_traceable) (Embree's traversal asserts its origin and direction
+/// are finite and below `FLT_LARGE`) or whose interval is empty. Such a ray hits
+/// nothing. Every ray handed to Embree passes through here.
+#[inline(always)]
+fn embree_tnear(ray: &Ray) -> Option<f32> {
+    let tnear = ray.tmin.max(0.0);
+    (ray.is_traceable() && ray.tmax >= tnear).then_some(tnear)
+}
+
 /// `packetN(scene, rays, hits)`: up to N rays through one `rtcIntersectN` call, with the
-/// same conventions as the single-ray query (`tnear = max(tmin, 0)`; a ray with a NaN or
-/// empty interval is left out of the packet and misses).
+/// same conventions as the single-ray query (see [`embree_tnear`]; a ray it refuses is
+/// left out of the packet and misses).
 macro_rules! packet_query {
     ($name:ident, $n:literal, $ty:ident, $query:ident) => {
         fn $name(scene: sys::RTCScene, rays: &[Ray], hits: &mut [Option<Hit>]) {
             let mut p = sys::$ty::default();
             let mut valid = [0i32; $n];
             for (i, ray) in rays.iter().enumerate().take($n) {
-                let tnear = ray.tmin.max(0.0);
-                if ray.tmax.is_nan() || ray.tmax < tnear {
+                let Some(tnear) = embree_tnear(ray) else {
                     continue;
-                }
+                };
                 valid[i] = -1;
                 let r = &mut p.ray;
                 (r.org_x[i], r.org_y[i], r.org_z[i]) = (ray.org.x, ray.org.y, ray.org.z);
