@@ -17,7 +17,7 @@ use super::LoadError;
 use crate::geometry::polygon::Triangulator;
 use crate::geometry::{Cone, Sphere, Triangle};
 use crate::math::Vec3;
-use crate::scene::{default_light_intensity, Camera, Light, Material, Scene};
+use crate::scene::{default_light_intensity, range, Camera, Light, Material, Scene};
 use std::path::Path;
 
 /// Largest accepted image side.
@@ -312,6 +312,11 @@ impl<'a> Parser<'a, '_> {
         }
     }
 
+    /// A range check's verdict as an error at `tok`.
+    fn in_range(&self, tok: &Tok<'a>, verdict: Result<(), String>) -> Result<(), LoadError> {
+        verdict.map_err(|message| self.err(tok, message))
+    }
+
     fn keyword(&mut self, kw: &str) -> Result<Tok<'a>, LoadError> {
         let t = self.token(&|| format!("'{kw}' of the viewpoint"))?;
         if t.text == kw {
@@ -364,9 +369,11 @@ impl<'a> Parser<'a, '_> {
             );
         }
         self.keyword("from")?;
-        let (from, _) = self.vec3("the viewpoint 'from'", XYZ)?;
+        let (from, from_tok) = self.vec3("the viewpoint 'from'", XYZ)?;
+        self.in_range(&from_tok, range::check_point("the viewpoint 'from'", from))?;
         self.keyword("at")?;
         let (at, at_tok) = self.vec3("the viewpoint 'at'", XYZ)?;
+        self.in_range(&at_tok, range::check_point("the viewpoint 'at'", at))?;
         self.keyword("up")?;
         let (up, up_tok) = self.vec3("the viewpoint 'up'", XYZ)?;
         self.keyword("angle")?;
@@ -441,7 +448,8 @@ impl<'a> Parser<'a, '_> {
     }
 
     fn light(&mut self) -> Result<(), LoadError> {
-        let (pos, _) = self.vec3("the light position", XYZ)?;
+        let (pos, pos_tok) = self.vec3("the light position", XYZ)?;
+        self.in_range(&pos_tok, range::check_point("the light position", pos))?;
         let has_color = self.lex.peek().is_some_and(|t| looks_numeric(t.text));
         let color = if has_color {
             self.vec3("the light colour", RGB)?.0
@@ -457,9 +465,17 @@ impl<'a> Parser<'a, '_> {
         let (color, _) = self.vec3("the fill colour", RGB)?;
         let (kd, _) = self.num("the diffuse weight Kd")?;
         let (ks, _) = self.num("the specular weight Ks")?;
-        let (shine, _) = self.num("the Phong exponent Shine")?;
+        let (shine, shine_tok) = self.num("the Phong exponent Shine")?;
+        if shine < 0.0 {
+            // (R·V)^Shine is infinite where R·V = 0.
+            return Err(self.err(
+                &shine_tok,
+                format!("the Phong exponent Shine must not be negative, found {shine}"),
+            ));
+        }
         let (t, _) = self.num("the transmittance T")?;
-        let (ior, _) = self.num("the index of refraction")?;
+        let (ior, ior_tok) = self.num("the index of refraction")?;
+        self.in_range(&ior_tok, range::check_ior(t, ior))?;
         self.materials.push(Material {
             color,
             ka: kd,
@@ -496,8 +512,10 @@ impl<'a> Parser<'a, '_> {
         if r == 0.0 {
             return Err(self.err(&r_tok, "sphere radius must not be zero".into()));
         }
+        let sphere = Sphere::new(center, r);
+        self.in_range(&r_tok, range::check_bounds("the sphere", &sphere.bounds()))?;
         let m = self.material_index();
-        self.scene.spheres.push(Sphere::new(center, r), m);
+        self.scene.spheres.push(sphere, m);
         Ok(())
     }
 
@@ -522,8 +540,10 @@ impl<'a> Parser<'a, '_> {
         if base == apex {
             return Err(self.err(&apex_tok, "cone apex equals its base".into()));
         }
+        let cone = Cone::new(base, rb, apex, ra);
+        self.in_range(&ra_tok, range::check_bounds("the cone", &cone.bounds()))?;
         let m = self.material_index();
-        self.scene.cones.push(Cone::new(base, rb, apex, ra), m);
+        self.scene.cones.push(cone, m);
         Ok(())
     }
 
@@ -560,7 +580,8 @@ impl<'a> Parser<'a, '_> {
         self.pts.clear();
         self.nrm.clear();
         for _ in 0..n {
-            let (p, _) = self.vec3("the polygon vertex", XYZ)?;
+            let (p, p_tok) = self.vec3("the polygon vertex", XYZ)?;
+            self.in_range(&p_tok, range::check_point("the polygon vertex", p))?;
             self.pts.push(p);
             if with_normals {
                 let (nv, n_tok) = self.vec3("the vertex normal", XYZ)?;

@@ -99,8 +99,9 @@
 //! - ks = mean(`Ks`) (0 without `Ks`), shine = `Ns` (1 without `Ns`).
 //! - t = 1 − `d` (`d` from `d`, else 1 − `Tr`, else 1): a material with `d` < 1
 //!   transmits, whatever its illumination model.
-//! - ior = `Ni`, or 1 when absent, not positive (many exporters write `Ni 0`) or not
-//!   finite; a transmissive material with such an `Ni` gets a warning.
+//! - ior = `Ni`, or 1 when absent or outside 0.001–1000 (many exporters write `Ni 0`;
+//!   the range is [`range::IOR_RANGE`]); a transmissive material with such an `Ni` gets
+//!   a warning.
 //! - priority = 0.
 //!
 //! The illumination model (`illum`) then switches terms off or the mirror on:
@@ -141,7 +142,9 @@ use crate::geometry::polygon::Triangulator;
 use crate::geometry::{QuadUv, Triangle};
 use crate::math::{Aabb, DVec3, Vec3};
 use crate::scene::texture::{Image, Wrap};
-use crate::scene::{Camera, Environment, Geometry, Light, LoadStats, Material, Scene, Texture};
+use crate::scene::{
+    range, Camera, Environment, Geometry, Light, LoadStats, Material, Scene, Texture,
+};
 use glam::Vec2;
 use std::cell::RefCell;
 use std::collections::HashMap;
@@ -324,12 +327,16 @@ pub fn load_geometry(path: &Path) -> Result<ObjData, LoadError> {
     let mtl = mtl.unwrap_or_default();
 
     for m in &models {
-        let finite = m.mesh.positions.iter().all(|v| v.is_finite())
+        let usable = m
+            .mesh
+            .positions
+            .iter()
+            .all(|v| v.abs() <= range::MAX_COORDINATE)
             && m.mesh.normals.iter().all(|v| v.is_finite());
-        if !finite {
+        if !usable {
             return Err(match find_bad_number(&text, usize::MAX) {
                 Some(l) => l.at(path),
-                None => whole_file(path, "non-finite vertex coordinates".into()),
+                None => whole_file(path, "vertex coordinates out of range".into()),
             });
         }
         if !mesh_is_consistent(&m.mesh) {
@@ -832,6 +839,12 @@ fn find_bad_number(text: &str, limit: usize) -> Option<Located> {
                 );
             };
             match tok.parse::<f32>() {
+                Ok(v) if what == "vertex" && v.is_finite() => {
+                    if let Err(e) = range::check_coordinate(&format!("vertex {name}"), v) {
+                        return err(Some(tok), e);
+                    }
+                    xyz[k] = v
+                }
                 Ok(v) if v.is_finite() || !finite => xyz[k] = v,
                 Ok(_) => {
                     return err(
@@ -869,6 +882,12 @@ fn find_bad_number(text: &str, limit: usize) -> Option<Located> {
                             show(w_tok)
                         ),
                     );
+                }
+                for (c, name) in xyz.iter().zip(XYZ) {
+                    let what = format!("vertex {name} / w =");
+                    if let Err(e) = range::check_coordinate(&what, c / w) {
+                        return err(Some(w_tok), e);
+                    }
                 }
             }
             Ok(_) => {
@@ -1374,7 +1393,7 @@ fn convert_material(m: &tobj::Material) -> (Material, Option<String>) {
         _ => {}
     }
     let t = 1.0 - d;
-    let ni = m.optical_density.filter(|n| n.is_finite() && *n > 0.0);
+    let ni = m.optical_density.filter(|n| range::IOR_RANGE.contains(n));
     let warning = (t > 0.0 && ni.is_none()).then(|| {
         let found = m
             .optical_density
@@ -2075,7 +2094,7 @@ f -3/-1/-1 -2/1/1 -1//1
     #[test]
     fn bad_numbers() {
         let find = |src: &str| find_bad_number(src, usize::MAX).unwrap();
-        let e = find("v 1e30 0 0 1e-30\n");
+        let e = find("v 1e8 0 0 1e-31\n");
         assert!(e.message.contains("divided by the weight"), "{}", e.message);
         let e = find("v 1 2 3 w\n");
         assert_eq!((e.line, e.col), (1, 9));

@@ -9,6 +9,7 @@ use crate::math::{Aabb, Ray, Vec3, Xform};
 use crate::Hit;
 use glam::Vec2;
 
+pub mod range;
 pub mod texture;
 
 pub use texture::{Environment, Maps, Texture, NO_TEXTURE};
@@ -230,6 +231,10 @@ pub struct Geometry {
     pub shapes: Prims<Shape>,
 }
 
+/// The primitive counts of a [`Geometry`] at one moment ([`Geometry::mark`]).
+#[derive(Clone, Copy, Debug, Default, PartialEq, Eq)]
+pub struct GeometryMark([usize; 4]);
+
 /// Material index meaning "the material of the instance that places this object".
 pub const INHERIT: u32 = u32::MAX;
 
@@ -380,6 +385,27 @@ impl Geometry {
             .zip(&self.shapes.items)
             .map(|(i, s)| (s.kind(), i, s.clone()));
         spheres.chain(cones).chain(others)
+    }
+
+    /// How many primitives of each list there are now, to find later the ones added
+    /// since ([`Geometry::bounds_since`]).
+    pub fn mark(&self) -> GeometryMark {
+        GeometryMark([
+            self.triangles.len(),
+            self.spheres.len(),
+            self.cones.len(),
+            self.shapes.len(),
+        ])
+    }
+
+    /// The bounds of each primitive added since `mark`.
+    pub fn bounds_since(&self, mark: GeometryMark) -> impl Iterator<Item = Aabb> + '_ {
+        let [t, s, c, o] = mark.0;
+        let tris = self.triangles.items[t..].iter().map(Triangle::bounds);
+        let spheres = self.spheres.items[s..].iter().map(Sphere::bounds);
+        let cones = self.cones.items[c..].iter().map(Cone::bounds);
+        let others = self.shapes.items[o..].iter().map(|s| s.bounds());
+        tris.chain(spheres).chain(cones).chain(others)
     }
 
     /// Bounds of everything (infinite when an unbounded primitive is present).

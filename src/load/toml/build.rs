@@ -30,8 +30,8 @@ use crate::load::{nff, obj, LoadError};
 use crate::math::{Aabb, Vec3, Xform};
 use crate::scene::texture::{Image, Wrap};
 use crate::scene::{
-    Camera, Environment, Geometry, Instance, Light, LoadStats, Maps, Material, Scene, Spot,
-    Texture, INHERIT,
+    range, Camera, Environment, Geometry, GeometryMark, Instance, Light, LoadStats, Maps, Material,
+    Scene, Spot, Texture, INHERIT,
 };
 use glam::{Affine3A, DAffine3, DMat3, DMat4, DQuat, DVec3, Quat};
 use std::collections::HashMap;
@@ -666,6 +666,13 @@ impl<'a, 's> Builder<'a, 's> {
                 "the camera's up vector is zero or parallel to the viewing direction",
             ));
         }
+        let (from_span, at_span) = match (&c.matrix, &c.from, &c.at) {
+            (Some(m), _, _) => (m.span(), m.span()),
+            (None, Some(f), Some(a)) => (f.span(), a.span()),
+            _ => (cam.span(), cam.span()),
+        };
+        range::check_point("the camera `from`", f32v(from)).map_err(|e| self.err(from_span, e))?;
+        range::check_point("the camera `at`", f32v(at)).map_err(|e| self.err(at_span, e))?;
         Ok(Camera {
             from: f32v(from),
             at: f32v(at),
@@ -830,6 +837,11 @@ impl<'a, 's> Builder<'a, 's> {
             Some(v) => self.positive(v, "`ior`")? as f32,
             None => 1.0,
         };
+        let t = weight(&d.transmittance, "transmittance", 0.0)?;
+        if let Err(e) = range::check_ior(t, ior) {
+            let at = d.ior.as_ref().map_or(def.span(), |v| v.span());
+            return Err(self.err(at, e));
+        }
         Ok(Material {
             color,
             ka: weight(&d.ambient, "ambient", kd as f64)?,
@@ -837,7 +849,7 @@ impl<'a, 's> Builder<'a, 's> {
             ks: weight(&d.specular, "specular", 0.0)?,
             shine: weight(&d.shininess, "shininess", DEFAULT_SHININESS)?,
             kr: weight(&d.reflectance, "reflectance", 0.0)?,
-            t: weight(&d.transmittance, "transmittance", 0.0)?,
+            t,
             ior,
             filter: match &d.filter {
                 Some(f) => self.non_negative3(f, "`filter`")?,
@@ -886,6 +898,8 @@ impl<'a, 's> Builder<'a, 's> {
             }
         }
         let pos = v3(l.position.get_ref());
+        range::check_point("the light `position`", f32v(pos))
+            .map_err(|e| self.err(l.position.span(), e))?;
         let color = match &l.color {
             Some(c) => self.non_negative3(c, "light `color`")?,
             None => Vec3::ONE,
@@ -1167,6 +1181,55 @@ impl<'a, 's> Builder<'a, 's> {
             material: inherited,
             depth: ctx.depth + 1,
         };
+        let (mark, first_instance) = (self.geometry.mark(), self.instances.len());
+        self.place(node, ty, x, explicit, inherited, inner, sink)?;
+        // A group's children were checked one by one; inside a define, coordinates are
+        // the object's own, checked where an instance places it.
+        if ty != Ty::Group && !sink.in_define() {
+            self.check_placed(mark, first_instance, ty, node.get_ref().ty.span())?;
+        }
+        Ok(())
+    }
+
+    /// Refuse what [`Builder::walk`] just placed at the top level (primitives added since
+    /// `mark`, instances from `first_instance` on) when it reaches outside the range
+    /// emray traces ([`range::MAX_COORDINATE`]).
+    fn check_placed(
+        &self,
+        mark: GeometryMark,
+        first_instance: usize,
+        ty: Ty,
+        span: Range<usize>,
+    ) -> R<()> {
+        let what = format!("this {}", ty.name());
+        let check = |b: &Aabb| range::check_bounds(&what, b).map_err(|e| self.err(span.clone(), e));
+        for b in self.geometry.bounds_since(mark) {
+            check(&b)?;
+        }
+        for inst in &self.instances[first_instance..] {
+            let object = &self.objects[inst.object as usize];
+            let bounded = object
+                .bounds_since(GeometryMark::default())
+                .filter(Aabb::is_finite)
+                .fold(Aabb::EMPTY, |a, b| a.union(&b));
+            check(&inst.xform.bounds_to_world(&bounded))?;
+        }
+        Ok(())
+    }
+
+    /// The body of [`Builder::walk`]: place node `node` of type `ty` under `x`.
+    #[allow(clippy::too_many_arguments)]
+    fn place(
+        &mut self,
+        node: &'a Spanned<ObjectDef>,
+        ty: Ty,
+        x: DAffine3,
+        explicit: Option<u32>,
+        inherited: Option<u32>,
+        inner: Ctx,
+        sink: &mut Sink,
+    ) -> R<()> {
+        let o = node.get_ref();
         match ty {
             Ty::Group => {
                 let children = self.need(&o.children, "children", node, ty)?;
