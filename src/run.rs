@@ -110,6 +110,7 @@ impl Report {
                 ("bailed", r.bailed),
                 ("skipped_shadow", r.skipped_shadow),
                 ("skipped_reflection", r.skipped_reflection),
+                ("saturated", r.saturated),
                 ("total", r.total()),
             ]),
             mrays_per_s: stats.mrays_per_s(),

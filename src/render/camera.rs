@@ -18,8 +18,8 @@ impl RayGen {
     /// Rays for a grid of `width × height` sample positions whose outer rows of sample
     /// centres span the camera's full `angle` vertically; pixels are square.
     pub fn new(cam: &Camera, width: u32, height: u32) -> Self {
-        let forward = (cam.at - cam.from).normalize();
-        let right = forward.cross(cam.up).normalize();
+        let forward = unit(cam.at - cam.from);
+        let right = unit(forward.cross(cam.up));
         let up = right.cross(forward);
         let half_angle = (cam.angle_deg.to_radians() * 0.5).tan();
         let scale = half_angle / ((height.max(2) - 1) as f32 * 0.5);
@@ -43,6 +43,20 @@ impl RayGen {
         let dir = (self.forward + self.right * x + self.up * y).normalize();
         Ray::new(self.from, dir)
     }
+}
+
+/// `v` normalised, also when its squared length overflows or underflows f32 (a huge or
+/// tiny `up`, `at` a hair from `from`): such a vector is first scaled by its largest
+/// component. Zero stays zero (the loaders refuse the cameras that would give it).
+fn unit(v: Vec3) -> Vec3 {
+    v.try_normalize().unwrap_or_else(|| {
+        let m = v.abs().max_element();
+        if m > 0.0 && m.is_finite() {
+            (v / m).normalize()
+        } else {
+            Vec3::ZERO
+        }
+    })
 }
 
 #[cfg(test)]
@@ -89,5 +103,21 @@ mod tests {
         let dx = g.ray(101.0, 50.0).dir.angle_between(d);
         let dy = g.ray(100.0, 51.0).dir.angle_between(d);
         assert!((dx - dy).abs() < 1e-6);
+    }
+
+    /// An `up` whose square overflows f32, or underflows to zero, still gives the
+    /// camera frame it points to.
+    #[test]
+    fn huge_and_tiny_up_vectors_give_the_same_frame() {
+        let reference = RayGen::new(&cam(16, 16, 40.0), 16, 16).ray(3.5, 9.5).dir;
+        for scale in [1e30f32, 1e-30, 3e38] {
+            let mut c = cam(16, 16, 40.0);
+            c.up = Vec3::new(0.0, 3.0, 0.5) * (scale / 3.0);
+            let d = RayGen::new(&c, 16, 16).ray(3.5, 9.5).dir;
+            assert!(
+                (d - reference).length() < 1e-6,
+                "{scale}: {d} vs {reference}"
+            );
+        }
     }
 }

@@ -169,6 +169,22 @@ pub struct RenderStats {
 }
 
 impl RenderStats {
+    /// The statistics of a render that cast `rays` and started at `start`; warns when
+    /// radiance overflowed.
+    fn finish(rays: RayCounts, start: std::time::Instant) -> Self {
+        if rays.saturated > 0 {
+            log::warn!(
+                "the radiance of {} ray(s) overflowed single precision and was clamped: the \
+                 scene's colours, light intensities or weights are too large",
+                rays.saturated
+            );
+        }
+        RenderStats {
+            rays,
+            render_ms: start.elapsed().as_secs_f64() * 1e3,
+        }
+    }
+
     /// Millions of rays (of every type) per second of render time.
     pub fn mrays_per_s(&self) -> f64 {
         if self.render_ms <= 0.0 {
@@ -233,8 +249,7 @@ pub fn render_with_gi<A: Accel>(
         });
         let (film, more) = sample_grid(r.x0, r.y0, rw, rh, settings.tile, progress, refine);
         rays += more;
-        let render_ms = start.elapsed().as_secs_f64() * 1e3;
-        return (film, RenderStats { rays, render_ms });
+        return (film, RenderStats::finish(rays, start));
     }
     // In SPD mode the sample grid is the pixel corners: one more row and column.
     let (gw, gh) = if settings.spd { (w + 1, h + 1) } else { (w, h) };
@@ -249,11 +264,7 @@ pub fn render_with_gi<A: Accel>(
     } else {
         grid
     };
-    let stats = RenderStats {
-        rays,
-        render_ms: start.elapsed().as_secs_f64() * 1e3,
-    };
-    (film, stats)
+    (film, RenderStats::finish(rays, start))
 }
 
 /// A per-position function `f(i, j, counts)` as a tile function for [`sample_grid`]:

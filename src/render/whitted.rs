@@ -31,6 +31,9 @@ pub struct RayCounts {
     /// Reflection rays not cast at hits on non-reflective (`Ks = 0`) surfaces below
     /// the depth limit.
     pub skipped_reflection: u64,
+    /// Rays whose radiance overflowed f32 and was saturated (see [`saturate`]): the
+    /// scene's colours, intensities or weights are too large. 0 for sane scenes.
+    pub saturated: u64,
 }
 
 impl RayCounts {
@@ -51,6 +54,7 @@ impl std::ops::AddAssign for RayCounts {
         self.bailed += o.bailed;
         self.skipped_shadow += o.skipped_shadow;
         self.skipped_reflection += o.skipped_reflection;
+        self.saturated += o.saturated;
     }
 }
 
@@ -81,6 +85,28 @@ fn radical_inverse(i: u32) -> f32 {
     unit(i.reverse_bits())
 }
 
+/// A ray's radiance as f32 can hold it. Finite inputs can still overflow (a light of
+/// 10³⁸ on a white surface, weights above 1 multiplied down a deep ray tree), and an
+/// infinite channel times a zero weight further up the tree would be NaN. So an
+/// infinite channel saturates at ±`f32::MAX` and a NaN one (∞ − ∞, only possible with
+/// negative NFF colours) counts as 0; either is counted in [`RayCounts::saturated`].
+/// Finite radiance passes unchanged.
+#[inline]
+fn saturate(c: Vec3, counts: &mut RayCounts) -> Vec3 {
+    if c.is_finite() {
+        return c;
+    }
+    counts.saturated += 1;
+    let f = |x: f32| {
+        if x.is_nan() {
+            0.0
+        } else {
+            x.clamp(-f32::MAX, f32::MAX)
+        }
+    };
+    Vec3::new(f(c.x), f(c.y), f(c.z))
+}
+
 /// Mirror `d` about the unit normal `n`.
 #[inline]
 fn reflect(d: Vec3, n: Vec3) -> Vec3 {
@@ -89,14 +115,22 @@ fn reflect(d: Vec3, n: Vec3) -> Vec3 {
 
 /// Snell's law: the refracted direction of unit `d` through a surface with unit normal
 /// `n` facing the incoming ray, for `eta = n₁/n₂`; `None` on total internal reflection.
+///
+/// For any `eta` between 10⁻⁶ and 10⁶ (the ratio of two indices of
+/// [`range::IOR_RANGE`](crate::scene::range::IOR_RANGE), which every transmitting
+/// material's index lies in) the result is a finite unit vector: `eta²` stays far inside
+/// f32 and the refracted direction has length `eta`-ish before it is normalised. Inputs
+/// that are not finite give `None`, never a NaN direction.
 #[inline]
 fn refract(d: Vec3, n: Vec3, eta: f32) -> Option<Vec3> {
     let cos_i = (-d).dot(n).min(1.0);
     let k = 1.0 - eta * eta * (1.0 - cos_i * cos_i);
-    if k < 0.0 {
+    // A NaN `k` (from non-finite inputs) is no refraction either.
+    if k < 0.0 || k.is_nan() {
         return None;
     }
-    Some((d * eta + n * (eta * cos_i - k.sqrt())).normalize())
+    let t = (d * eta + n * (eta * cos_i - k.sqrt())).normalize();
+    t.is_finite().then_some(t)
 }
 
 impl<'a, A: Accel> Tracer<'a, A> {
@@ -255,7 +289,8 @@ impl<'a, A: Accel> Tracer<'a, A> {
                 counts.eye_hit += 1;
             }
             let gi = self.gi.and_then(|g| g.radiosity_at(&hit, surf.point.p, d));
-            return self.shade(&surf, d, entering, depth, media, weight, gi, counts);
+            let radiance = self.shade(&surf, d, entering, depth, media, weight, gi, counts);
+            return saturate(radiance, counts);
         }
     }
 
@@ -519,6 +554,40 @@ mod tests {
     fn reflect_mirrors_about_the_normal() {
         let r = reflect(Vec3::new(1.0, -1.0, 0.0), Vec3::Y);
         assert_eq!(r, Vec3::new(1.0, 1.0, 0.0));
+    }
+
+    /// Any pair of indices a material may have, at any angle: a finite unit direction
+    /// or total internal reflection, never NaN; and garbage in gives `None`.
+    #[test]
+    fn refraction_is_finite_over_the_whole_index_range() {
+        let (lo, hi) = (
+            *crate::scene::range::IOR_RANGE.start(),
+            *crate::scene::range::IOR_RANGE.end(),
+        );
+        let iors = [lo, 0.01, 0.5, 1.0, 1.5, 2.4, 100.0, hi];
+        let mut refracted = 0;
+        for k in 0..=200 {
+            let th = (k as f32 / 200.0) * std::f32::consts::FRAC_PI_2;
+            let d = Vec3::new(th.sin(), 0.3 * th.cos(), -th.cos()).normalize();
+            for n1 in iors {
+                for n2 in iors {
+                    if let Some(t) = refract(d, Vec3::Z, n1 / n2) {
+                        assert!(t.is_finite(), "{n1}/{n2} at {th}: {t}");
+                        assert!((t.length() - 1.0).abs() < 1e-5, "{n1}/{n2}: {t}");
+                        assert!(t.z <= 0.0, "goes through: {t}");
+                        refracted += 1;
+                    }
+                }
+            }
+        }
+        assert!(refracted > 1000, "{refracted}");
+        for eta in [f32::NAN, f32::INFINITY, 1e30] {
+            assert_eq!(
+                refract(Vec3::NEG_Z * 0.99 + Vec3::X * 0.14, Vec3::Z, eta),
+                None
+            );
+        }
+        assert_eq!(refract(Vec3::splat(f32::NAN), Vec3::Z, 1.5), None);
     }
 
     #[test]
