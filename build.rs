@@ -294,7 +294,9 @@ mod embree {
         let builder = bindgen::Builder::default()
             .header(header.to_string_lossy())
             .clang_arg(format!("-I{}", found.include_dir.display()))
-            .rust_target(bindgen::RustTarget::stable(80, 0).expect("1.80 is a stable Rust"))
+            .rust_target(bindgen::RustTarget::stable(85, 0).expect("1.85 is a stable Rust"))
+            // Edition 2024: `unsafe extern "C"` blocks.
+            .rust_edition(bindgen::RustEdition::Edition2024)
             .allowlist_function("rtc.*")
             .allowlist_type("RTC.*")
             .allowlist_var("RTC.*")

@@ -2,9 +2,9 @@
 //! same scene of 10 000 primitives of one kind, on the BVH and (with the `embree`
 //! feature) on Embree. Run with `cargo bench --bench intersect`.
 
-use criterion::{criterion_group, criterion_main, Criterion, Throughput};
-use emray::accel::bvh::Bvh;
+use criterion::{Criterion, Throughput, criterion_group, criterion_main};
 use emray::accel::Accel;
+use emray::accel::bvh::Bvh;
 use emray::geometry::{
     AaBox, CappedCone, Cone, Csg, CsgOp, CsgTree, Kind, OBox, Plane, Polyhedron, Quadric, Shape,
     Sphere, Torus, Triangle,

@@ -4,13 +4,13 @@
 //! intersection per primitive kind is in `benches/intersect.rs`. Run with
 //! `cargo bench --bench suite`; `emray bench` is the suite-level measurement.
 
-use criterion::{criterion_group, criterion_main, Criterion, Throughput};
+use criterion::{Criterion, Throughput, criterion_group, criterion_main};
+use emray::Scene;
 use emray::accel::bvh::Bvh;
 use emray::accel::{Accel, Hit};
 use emray::bench::load_scene;
 use emray::math::Ray;
 use emray::render::{RayGen, RenderSettings};
-use emray::Scene;
 use std::hint::black_box;
 
 const SCENES: [&str; 6] = [
@@ -41,10 +41,10 @@ fn build(c: &mut Criterion) {
 
 /// The eye rays of a `n × n` image of `scene` and the hits they make.
 fn eye_hits<A: Accel>(scene: &Scene, accel: &A, n: u32) -> Vec<(Ray, Hit)> {
-    let gen = RayGen::new(&scene.camera, n, n);
+    let raygen = RayGen::new(&scene.camera, n, n);
     (0..n * n)
         .filter_map(|k| {
-            let ray = gen.ray((k % n) as f32 + 0.5, (k / n) as f32 + 0.5);
+            let ray = raygen.ray((k % n) as f32 + 0.5, (k / n) as f32 + 0.5);
             accel.intersect(&ray).map(|h| (ray, h))
         })
         .collect()

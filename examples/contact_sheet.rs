@@ -2,9 +2,9 @@
 //! sheet): `cargo run --release --example contact_sheet -- docs/spd.png [TILE]`.
 
 use emray::accel::Backend;
-use emray::gen::Database;
-use emray::output::{to_rgb8, Encoding};
+use emray::output::{Encoding, to_rgb8};
 use emray::render::RenderSettings;
+use emray::spd::Database;
 use std::path::Path;
 
 fn main() {

@@ -10,7 +10,6 @@
 pub mod accel;
 pub mod batch;
 pub mod bench;
-pub mod gen;
 pub mod geometry;
 pub mod load;
 pub mod math;
@@ -20,6 +19,7 @@ pub mod radiosity;
 pub mod render;
 pub mod run;
 pub mod scene;
+pub mod spd;
 pub mod stress;
 pub mod study;
 

@@ -3,14 +3,14 @@
 mod cli;
 mod quality_cmd;
 
-use anyhow::{bail, Context, Result};
+use anyhow::{Context, Result, bail};
 use clap::Parser;
 use cli::{Cli, Command, RenderArgs};
+use emray::Scene;
 use emray::accel::Backend;
-use emray::gen::Database;
 use emray::load;
 use emray::scene::Environment;
-use emray::Scene;
+use emray::spd::Database;
 use std::io::{IsTerminal, Write};
 use std::path::{Path, PathBuf};
 use std::process::ExitCode;
@@ -23,7 +23,7 @@ fn main() -> ExitCode {
     let cli = Cli::parse();
     let args = match cli.command {
         Some(Command::Render(a)) => a,
-        Some(Command::Gen(g)) => return gen(&g),
+        Some(Command::Gen(g)) => return generate(&g),
         Some(Command::Batch(b)) => return batch(&b),
         Some(Command::Merge(m)) => return merge(&m),
         Some(Command::Bench(b)) => return bench(&b),
@@ -81,7 +81,7 @@ fn batch(b: &cli::BatchArgs) -> ExitCode {
             }
         },
         None if b.scenes.is_empty() => {
-            return usage("give scene files, globs or --manifest FILE".into())
+            return usage("give scene files, globs or --manifest FILE".into());
         }
         None => {
             let settings = batch::JobSettings {
@@ -161,7 +161,7 @@ fn merge(m: &cli::MergeArgs) -> ExitCode {
 }
 
 /// `emray gen`: exit 2 on a bad database or size, 1 when the file cannot be written.
-fn gen(g: &cli::GenArgs) -> ExitCode {
+fn generate(g: &cli::GenArgs) -> ExitCode {
     let Some(db) = Database::from_name(&g.database) else {
         let names: Vec<&str> = Database::ALL.iter().map(|d| d.name()).collect();
         eprintln!(

@@ -110,9 +110,9 @@ pub struct StressArgs {
 /// Run every stress case at full counts and print what was measured; exit 1 if a
 /// bound of `tests/stability.rs` is broken.
 pub fn stress(a: &StressArgs) -> ExitCode {
+    use emray::Backend;
     use emray::accel::bvh::Bvh;
     use emray::stress::*;
-    use emray::Backend;
     let mut ok = true;
     let mut check = |cond: bool, what: String| {
         println!("{} {what}", if cond { "ok  " } else { "FAIL" });
@@ -239,7 +239,7 @@ pub struct StudyArgs {
 /// Exit status: 0 done, 1 a scene or render error, 2 a usage error.
 pub fn study(a: &StudyArgs) -> ExitCode {
     let name = a.scene.display().to_string();
-    let scene = match emray::gen::Database::parse_spec(&name) {
+    let scene = match emray::spd::Database::parse_spec(&name) {
         Err(e) => {
             eprintln!("emray: error: {e}");
             return ExitCode::from(2);

@@ -128,7 +128,7 @@ impl Report {
         let prims: Vec<String> = self
             .prims
             .iter()
-            .filter(|(_, &n)| n > 0)
+            .filter(|&(_, &n)| n > 0)
             .map(|(k, n)| format!("{n} {k}"))
             .collect();
         let t = &self.time_ms;

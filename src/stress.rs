@@ -4,7 +4,7 @@
 use crate::accel::Accel;
 use crate::geometry::reference as r64;
 use crate::load::nff::parse_str;
-use crate::math::{next_float_down, offset_ray_origin, DRay, DVec3, Ray, Vec3};
+use crate::math::{DRay, DVec3, Ray, Vec3, next_float_down, offset_ray_origin};
 use crate::render::{Film, RayGen, RenderSettings};
 use crate::run::render_scene;
 use crate::{Backend, Scene};
@@ -66,11 +66,11 @@ pub fn render(scene: &Scene, backend: Backend) -> Film {
 /// spawned as the renderer spawns it, blocked. Returns `(lit points, acne)`.
 pub fn acne<A: Accel>(scene: &Scene, accel: &A) -> (u64, u64) {
     let cam = &scene.camera;
-    let gen = RayGen::new(cam, cam.width, cam.height);
+    let raygen = RayGen::new(cam, cam.width, cam.height);
     let (mut lit, mut acne) = (0, 0);
     for j in 0..cam.height {
         for i in 0..cam.width {
-            let ray = gen.ray(i as f32 + 0.5, j as f32 + 0.5);
+            let ray = raygen.ray(i as f32 + 0.5, j as f32 + 0.5);
             let Some(hit) = accel.intersect(&ray) else {
                 continue;
             };
@@ -423,14 +423,14 @@ pub type RootCase = (&'static str, fn(u32) -> RootStats);
 fn roots<S: crate::geometry::Intersect>(
     n: u32,
     shape: &S,
-    mut gen: impl FnMut(&mut Rng) -> (Ray, bool),
+    mut raygen: impl FnMut(&mut Rng) -> (Ray, bool),
     exact: impl Fn(&DRay) -> Option<f64>,
     dist: impl Fn(DVec3) -> f64,
 ) -> RootStats {
     let mut rng = Rng::new(n ^ 0x5eed);
     let mut st = RootStats::default();
     for _ in 0..n {
-        let (ray, band) = gen(&mut rng);
+        let (ray, band) = raygen(&mut rng);
         let dray = DRay::from(&ray);
         st.rays += 1;
         let want = exact(&dray);
@@ -499,9 +499,9 @@ pub fn quadric_root_cases() -> Vec<RootCase> {
                 &q,
                 |g| {
                     let a = g.range(0.0, std::f64::consts::TAU);
-                    let gen = DVec3::new(0.5 * a.cos(), 0.5 * a.sin(), 1.0).normalize();
+                    let raygen = DVec3::new(0.5 * a.cos(), 0.5 * a.sin(), 1.0).normalize();
                     let o = DVec3::new(g.range(-1.0, 1.0), g.range(-1.0, 1.0), -2.0);
-                    let d = (gen + g.perpendicular(gen) * g.tiny(1.0, 8.0)).normalize();
+                    let d = (raygen + g.perpendicular(raygen) * g.tiny(1.0, 8.0)).normalize();
                     (ray32(o, d), false)
                 },
                 |r| r64::quadric::quadric(r, &c, None, 0.0),
@@ -516,9 +516,9 @@ pub fn quadric_root_cases() -> Vec<RootCase> {
                 &cone,
                 |g| {
                     let a = g.range(0.0, std::f64::consts::TAU);
-                    let gen = DVec3::new(-0.5 * a.cos(), -0.5 * a.sin(), 1.0).normalize();
+                    let raygen = DVec3::new(-0.5 * a.cos(), -0.5 * a.sin(), 1.0).normalize();
                     let o = DVec3::new(g.range(-0.5, 0.5), g.range(-0.5, 0.5), -1.0);
-                    let d = (gen + g.perpendicular(gen) * g.tiny(1.0, 8.0)).normalize();
+                    let d = (raygen + g.perpendicular(raygen) * g.tiny(1.0, 8.0)).normalize();
                     (ray32(o, d), false)
                 },
                 |r| r64::cone(r, DVec3::ZERO, 1.0, 2.0 * DVec3::Z, 0.0, false, 0.0),

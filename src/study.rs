@@ -3,11 +3,11 @@
 //! each run's wall time, rays and error metrics to CSV, and error against time on
 //! log-log axes to SVG and PNG (plotters), one curve per knob.
 
+use crate::Scene;
 use crate::accel::{AccelError, Backend};
-use crate::metrics::{compare, Metrics};
+use crate::metrics::{Metrics, compare};
 use crate::render::{Aa, RenderSettings};
 use crate::run::{render_reference, render_scene};
-use crate::Scene;
 use std::fmt::Write as _;
 use std::path::Path;
 

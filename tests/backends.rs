@@ -4,9 +4,9 @@
 //! a stated relative bound for triangles (Embree's own test against the watertight one).
 #![cfg(feature = "embree")]
 
+use emray::accel::Accel;
 use emray::accel::bvh::Bvh;
 use emray::accel::embree::EmbreeAccel;
-use emray::accel::Accel;
 use emray::geometry::{Cone, Kind, Sphere, Triangle};
 use emray::math::{Ray, Vec3};
 use emray::scene::{Camera, Material, Scene};

@@ -1,7 +1,7 @@
 //! `emray bench`: a tiny suite end to end (child processes, markdown, CSV, JSON,
 //! baseline), raw casting against the render's own ray counts, and bad input.
 
-use emray::bench::{self, raw, Mode, RunSpec};
+use emray::bench::{self, Mode, RunSpec, raw};
 use emray::render::RenderSettings;
 use std::path::Path;
 use std::process::{Command, Output};

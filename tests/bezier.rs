@@ -1,8 +1,8 @@
 //! Bézier curves and patches against their definitions, and the tessellation of the
 //! Utah teapot against its error bound and for cracks.
 
-use emray::geometry::bezier::{teapot_patches, tessellate, BezierCurve, BezierPatch, TriMesh};
 use emray::geometry::WatertightRay;
+use emray::geometry::bezier::{BezierCurve, BezierPatch, TriMesh, teapot_patches, tessellate};
 use emray::math::{DVec3, Ray, Vec3};
 use std::collections::HashMap;
 use std::sync::OnceLock;

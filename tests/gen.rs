@@ -3,8 +3,8 @@
 //! counts per the SPD's formulas at small sizes.
 
 use emray::accel::Backend;
-use emray::gen::Database;
 use emray::render::RenderSettings;
+use emray::spd::Database;
 use std::path::Path;
 
 /// (database, size, triangles, spheres, cones) expected after loading: polygons are

@@ -3,6 +3,7 @@
 //! classify points like the set expression, and the set identities hold on rendered
 //! hit masks.
 
+use emray::Scene;
 use emray::accel::Backend;
 use emray::geometry::{Csg, CsgOp, CsgTree, Shape, Solid, Sphere, Triangle};
 use emray::math::{Ray, Vec3, Xform};
@@ -10,7 +11,6 @@ use emray::output::differing_pixels;
 use emray::render::{Film, RenderSettings};
 use emray::run::render_scene;
 use emray::scene::{Camera, Geometry, Instance, Light, Material};
-use emray::Scene;
 use glam::{Affine3A, Quat};
 use std::sync::Arc;
 

@@ -2,8 +2,8 @@
 //! grazing, from inside, tiny and huge sizes, far from the origin. Plus the robustness
 //! of spawned rays: a ray leaving a surface never re-hits it.
 
-use emray::geometry::{reference, Cone, Sphere, Triangle};
-use emray::math::{offset_ray_origin, DRay, DVec3, Ray, Vec3};
+use emray::geometry::{Cone, Sphere, Triangle, reference};
+use emray::math::{DRay, DVec3, Ray, Vec3, offset_ray_origin};
 use proptest::prelude::*;
 
 fn v3() -> impl Strategy<Value = Vec3> {
@@ -252,13 +252,15 @@ fn cylinder_and_cone_analytic() {
     let r = Ray::new(Vec3::new(5.0, 0.0, 1.0), -Vec3::X);
     assert!((c.intersect(&r).unwrap().t - 4.0).abs() < 1e-6);
     // Above the top: open, no cap.
-    assert!(c
-        .intersect(&Ray::new(Vec3::new(5.0, 0.0, 2.5), -Vec3::X))
-        .is_none());
+    assert!(
+        c.intersect(&Ray::new(Vec3::new(5.0, 0.0, 2.5), -Vec3::X))
+            .is_none()
+    );
     // Straight down the axis: no caps, so no hit.
-    assert!(c
-        .intersect(&Ray::new(Vec3::new(0.0, 0.0, 5.0), -Vec3::Z))
-        .is_none());
+    assert!(
+        c.intersect(&Ray::new(Vec3::new(0.0, 0.0, 5.0), -Vec3::Z))
+            .is_none()
+    );
     // Cone radius 1 at z=0 to 0 at z=1: at height 0.5 the radius is 0.5.
     let k = Cone::new(Vec3::ZERO, 1.0, Vec3::Z, 0.0);
     let h = k

@@ -164,11 +164,13 @@ fn every_malformed_file_fails_cleanly() {
     for (job, (name, _)) in r["jobs"].as_array().unwrap().iter().zip(&cases) {
         assert!(job["error"].as_str().unwrap().starts_with(name), "{job}");
     }
-    assert!(!std::fs::read_dir(d).unwrap().any(|e| e
-        .unwrap()
-        .file_name()
-        .to_string_lossy()
-        .ends_with(".png")));
+    assert!(
+        !std::fs::read_dir(d).unwrap().any(|e| e
+            .unwrap()
+            .file_name()
+            .to_string_lossy()
+            .ends_with(".png"))
+    );
 }
 
 #[test]

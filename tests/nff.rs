@@ -1,11 +1,11 @@
 //! NFF loader tests through the public API. Every scene is written inline; the ignored
 //! test at the end checks the SPD files in `../shared/spd` when they are present.
 
-use emray::geometry::polygon::newell_normal;
 use emray::geometry::Kind;
-use emray::load::{load_path, nff::parse_str, LoadError};
+use emray::geometry::polygon::newell_normal;
+use emray::load::{LoadError, load_path, nff::parse_str};
 use emray::math::Vec3;
-use emray::scene::{default_light_intensity, Material, Scene};
+use emray::scene::{Material, Scene, default_light_intensity};
 use std::path::Path;
 
 /// A viewpoint block, as the SPD programs write it.
@@ -424,7 +424,9 @@ fn numbers_in_all_notations() {
     assert_eq!(sp.center, Vec3::new(1.0, -2.0, 5.0));
     assert_eq!(sp.radius, 0.1);
     // Integral numbers are accepted for the resolution and vertex counts.
-    let s = ok("v from 0 0 1 at 0 0 0 up 0 1 0 angle 45 hither 1 resolution 32.0 16\np 3.0 0 0 0 1 0 0 0 1 0");
+    let s = ok(
+        "v from 0 0 1 at 0 0 0 up 0 1 0 angle 45 hither 1 resolution 32.0 16\np 3.0 0 0 0 1 0 0 0 1 0",
+    );
     assert_eq!(s.camera.width, 32);
     assert_eq!(s.triangles.len(), 1);
 }

@@ -1,14 +1,14 @@
 //! OBJ/MTL loader tests through the public API. Every file is written by the test into
 //! a temporary directory.
 
+use emray::Hit;
 use emray::geometry::{Kind, Triangle};
 use emray::load::obj::{
-    frame, load, load_geometry, ObjData, AUTO_FOV_DEG, AUTO_RESOLUTION, DEFAULT_MATERIAL,
+    AUTO_FOV_DEG, AUTO_RESOLUTION, DEFAULT_MATERIAL, ObjData, frame, load, load_geometry,
 };
-use emray::load::{load_path, LoadError};
+use emray::load::{LoadError, load_path};
 use emray::math::{Aabb, Ray, Vec3};
 use emray::scene::Material;
-use emray::Hit;
 use std::collections::HashMap;
 use std::path::{Path, PathBuf};
 use tempfile::TempDir;
@@ -108,11 +108,12 @@ fn cube_of_quads_is_twelve_outward_triangles_with_its_materials() {
         "{path:?}"
     );
     // Flat: no vn in the file.
-    assert!(data
-        .geometry
-        .triangle_normals
-        .iter()
-        .all(|&n| n == u32::MAX));
+    assert!(
+        data.geometry
+            .triangle_normals
+            .iter()
+            .all(|&n| n == u32::MAX)
+    );
     assert!(data.geometry.vertex_normals.is_empty());
 
     // Outward: every triangle faces away from the centre, and the area is the cube's.
@@ -417,10 +418,11 @@ illum 0
     // Tr = 1 − d; Ni 0 is unusable for a transparent material: ior 1 and a warning.
     assert!((m[1].t - 0.4).abs() < 1e-6);
     assert_eq!(m[1].ior, 1.0);
-    assert!(data
-        .warnings
-        .iter()
-        .any(|w| w.contains("'tr'") && w.contains("Ni 0")));
+    assert!(
+        data.warnings
+            .iter()
+            .any(|w| w.contains("'tr'") && w.contains("Ni 0"))
+    );
     // `Kd 0.7` is grey 0.7; `Kd 0.1 0.2` is malformed and ignored with its line; the
     // texture file is missing (a warning); illum 0 turns the ambient term off.
     assert_eq!(m[2].color, Vec3::splat(0.7));

@@ -19,7 +19,7 @@
 
 use emray::geometry::reference::{quadric as rq, torus as rt};
 use emray::geometry::{Intersect, Plane, Quadric, ShapeHit, Solid, Spans, Sphere, Torus};
-use emray::math::{offset_ray_origin, Aabb, DRay, DVec3, Ray, Vec3};
+use emray::math::{Aabb, DRay, DVec3, Ray, Vec3, offset_ray_origin};
 use proptest::prelude::*;
 
 const T_ULPS: f64 = 1.0;
@@ -229,11 +229,7 @@ fn q_cos(qc: &QCase, ray: &DRay, t: f64) -> f64 {
     }
     let g = rq::quadric_gradient(&qc.coeffs, p);
     let c = g.normalize_or_zero().dot(ray.dir.normalize()).abs();
-    if c.is_finite() {
-        c
-    } else {
-        0.0
-    }
+    if c.is_finite() { c } else { 0.0 }
 }
 
 /// The finite ends of spans.
@@ -485,11 +481,7 @@ fn compare_spans(
 ) -> Result<f64, TestCaseError> {
     let ends = |a: f64, b: f64| {
         if a.is_infinite() || b.is_infinite() {
-            if a == b {
-                0.0
-            } else {
-                f64::INFINITY
-            }
+            if a == b { 0.0 } else { f64::INFINITY }
         } else {
             (a - b).abs() / tol(b)
         }
@@ -1016,9 +1008,10 @@ fn tangent_rays() {
     assert!(q.intersect(&outside).is_none());
     // The torus's outer equator, grazed from outside and a hair inside.
     let t = Torus::new(Vec3::ZERO, Vec3::Z, 2.0, 0.5).unwrap();
-    assert!(t
-        .intersect(&Ray::new(Vec3::new(-5.0, 2.5 + 1e-5, 0.0), Vec3::X))
-        .is_none());
+    assert!(
+        t.intersect(&Ray::new(Vec3::new(-5.0, 2.5 + 1e-5, 0.0), Vec3::X))
+            .is_none()
+    );
     spans.clear();
     t.spans(
         &Ray::new(Vec3::new(-5.0, 2.5 - 1e-5, 0.0), Vec3::X),

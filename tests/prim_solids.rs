@@ -11,7 +11,7 @@
 
 use emray::geometry::reference::solids::{self as refs, Crossing};
 use emray::geometry::{AaBox, CappedCone, Intersect, OBox, Polyhedron, ShapeHit, Solid, Spans};
-use emray::math::{offset_ray_origin, DRay, DVec3, Ray, Vec3};
+use emray::math::{DRay, DVec3, Ray, Vec3, offset_ray_origin};
 use glam::Quat;
 use proptest::prelude::*;
 use proptest::strategy::ValueTree;
@@ -1092,9 +1092,10 @@ fn tangent_rays_to_the_side() {
     let half = (1.0f64 - 0.999 * 0.999).sqrt();
     assert!(approx(t0, 5.0 - half, 1e-5) && approx(t1, 5.0 + half, 1e-5));
     assert!(n0.y < 0.0 && n1.y > 0.0);
-    assert!(c
-        .intersect(&Ray::new(Vec3::new(1.001, -5.0, 1.0), Vec3::Y))
-        .is_none());
+    assert!(
+        c.intersect(&Ray::new(Vec3::new(1.001, -5.0, 1.0), Vec3::Y))
+            .is_none()
+    );
     // A cone's side, tangent along a generator (a = 0: the linear case).
     let k = CappedCone::new(Vec3::ZERO, Vec3::Z, 1.0, 1.0, 0.0).unwrap();
     let along = Ray::new(Vec3::new(1.5, 0.0, -0.5), Vec3::new(-1.0, 0.0, 1.0));
@@ -1465,9 +1466,10 @@ fn rays_parallel_to_faces_and_origins_on_face_planes() {
         let h = s.intersect(&r).map(|h| h.t);
         assert!(h.is_none() || (h.unwrap() - 1.0).abs() < 1e-6, "{h:?}");
         // Parallel, just outside: nothing.
-        assert!(s
-            .intersect(&Ray::new(Vec3::new(-1e-6, 0.5, -1.0), Vec3::Z))
-            .is_none());
+        assert!(
+            s.intersect(&Ray::new(Vec3::new(-1e-6, 0.5, -1.0), Vec3::Z))
+                .is_none()
+        );
         // Parallel, inside: enters through z = 0 at t = 1, leaves through z = 1.
         let r = Ray::new(Vec3::new(0.5, 0.5, -1.0), Vec3::Z * 2.0);
         let h = s.intersect(&r).unwrap();
@@ -1476,9 +1478,10 @@ fn rays_parallel_to_faces_and_origins_on_face_planes() {
         let r = Ray::new(Vec3::new(0.5, 0.5, 0.0), Vec3::Z);
         let h = s.intersect(&r).unwrap();
         assert!((h.t - 1.0).abs() < 1e-6 && h.ng.z > 0.0);
-        assert!(s
-            .intersect(&Ray::new(Vec3::new(0.5, 0.5, 0.0), -Vec3::Z))
-            .is_none());
+        assert!(
+            s.intersect(&Ray::new(Vec3::new(0.5, 0.5, 0.0), -Vec3::Z))
+                .is_none()
+        );
         // Along an edge (in two face planes): a hit or none, never NaN.
         let r = Ray::new(Vec3::new(0.0, 0.0, -1.0), Vec3::Z);
         if let Some(h) = s.intersect(&r) {

@@ -2,6 +2,7 @@
 //! the two backends agree on the image, and the infinite plane (kept outside both
 //! hierarchies) shadows and reflects like any other primitive.
 
+use emray::Scene;
 use emray::accel::Backend;
 use emray::geometry::{
     AaBox, CappedCone, Cone, Csg, CsgOp, CsgTree, Kind, OBox, Plane, Polyhedron, Quadric, Shape,
@@ -12,7 +13,6 @@ use emray::output::differing_pixels;
 use emray::render::{Film, RenderSettings};
 use emray::run::render_scene;
 use emray::scene::{Camera, Light, Material};
-use emray::Scene;
 use glam::Quat;
 use std::sync::Arc;
 

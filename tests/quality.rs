@@ -1,12 +1,12 @@
 //! Error metrics and the speed/accuracy knobs: `emray compare` and its exit status,
 //! adaptive antialiasing, `--bailout`, skipping work that cannot change the image.
 
+use emray::Scene;
 use emray::accel::Backend;
 use emray::load::nff::parse_str;
 use emray::metrics::compare;
 use emray::render::{Aa, Film, RenderSettings};
-use emray::run::{render_scene, Report};
-use emray::Scene;
+use emray::run::{Report, render_scene};
 use std::path::Path;
 use std::process::Command;
 
@@ -109,7 +109,7 @@ fn skipping_changes_no_pixel_and_saves_rays() {
 /// their counts), and `--stats` says which.
 #[test]
 fn backends_hold_only_the_kinds_present() {
-    use emray::accel::{bvh::Bvh, Accel};
+    use emray::accel::{Accel, bvh::Bvh};
     use emray::geometry::Kind;
     let head = "v\nfrom 0 -6 0\nat 0 0 0\nup 0 0 1\nangle 40\nhither 0\nresolution 8 8\n\
         l 2 -3 4\nf 0.8 0.8 0.8 0.9 0.2 10 0 1\n";

@@ -6,12 +6,12 @@ use emray::accel::bvh::Bvh;
 use emray::geometry::Triangle;
 use emray::math::Vec3;
 use emray::radiosity::formfactor::{
-    element_form_factor, parallel_rectangles, perpendicular_rectangles, point_to_disk,
-    point_to_polygon, Sampling,
+    Sampling, element_form_factor, parallel_rectangles, perpendicular_rectangles, point_to_disk,
+    point_to_polygon,
 };
 use emray::radiosity::hemicube::Hemicube;
-use emray::radiosity::mesh::{longest_edge, Mesh};
-use emray::radiosity::{self, solver, FormFactorMethod, RadiositySettings, SolverKind};
+use emray::radiosity::mesh::{Mesh, longest_edge};
+use emray::radiosity::{self, FormFactorMethod, RadiositySettings, SolverKind, solver};
 use emray::scene::{Camera, Material, Scene};
 
 fn camera() -> Camera {

@@ -4,8 +4,8 @@
 //! no panic, no abort and no NaN pixel. New crashing inputs from a fuzzing run go into
 //! the same folders (and seed the fuzzers).
 
-use emray::accel::Backend;
 use emray::Scene;
+use emray::accel::Backend;
 use std::path::{Path, PathBuf};
 
 fn inputs(format: &str) -> Vec<PathBuf> {

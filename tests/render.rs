@@ -1,11 +1,11 @@
 //! End-to-end renders checked against analytic answers, across thread counts and
 //! (with the `embree` feature) across backends.
 
+use emray::Scene;
 use emray::accel::Backend;
 use emray::load::nff::parse_str;
 use emray::render::{Film, RenderSettings};
-use emray::run::{render_scene, Report};
-use emray::Scene;
+use emray::run::{Report, render_scene};
 use std::path::Path;
 
 fn scene(src: &str) -> Scene {

@@ -4,10 +4,10 @@
 //! line. Errors are checked against a `# HERE` marker on the line they must name.
 
 use emray::geometry::{Intersect, Kind, Shape};
-use emray::load::toml::{self as scene_toml, format::SceneFile, SceneSettings};
 use emray::load::LoadError;
+use emray::load::toml::{self as scene_toml, SceneSettings, format::SceneFile};
 use emray::math::Vec3;
-use emray::scene::{Scene, INHERIT};
+use emray::scene::{INHERIT, Scene};
 use std::path::{Path, PathBuf};
 
 const CAMERA: &str = "[camera]\nfrom = [0, 0, 10]\nat = [0, 0, 0]\n";
@@ -392,7 +392,9 @@ radius = 2
         );
     }
     // Ka defaults to Kd.
-    let s = build("[materials.m]\ndiffuse = 0.3\n[[objects]]\ntype = \"sphere\"\ncenter = [0, 0, 0]\nradius = 1\nmaterial = \"m\"\n");
+    let s = build(
+        "[materials.m]\ndiffuse = 0.3\n[[objects]]\ntype = \"sphere\"\ncenter = [0, 0, 0]\nradius = 1\nmaterial = \"m\"\n",
+    );
     assert_eq!(s.materials[0].ka, 0.3);
 }
 
@@ -551,7 +553,9 @@ fn check_inside(s: &Scene, inside: &[[f32; 3]], outside: &[[f32; 3]]) {
 
 #[test]
 fn closed_solids() {
-    let s = build("[[objects]]\ntype = \"cylinder\"\nbase = [1, 0, 0]\naxis = [0, 2, 0]\nheight = 3\nradius = 0.5\n");
+    let s = build(
+        "[[objects]]\ntype = \"cylinder\"\nbase = [1, 0, 0]\naxis = [0, 2, 0]\nheight = 3\nradius = 0.5\n",
+    );
     assert_eq!(s.count(Kind::CappedCone), 1);
     let Shape::CappedCone(c) = &s.shapes.items[0] else {
         panic!()
@@ -572,7 +576,9 @@ fn closed_solids() {
         &[[1.0, 3.1, 0.0], [1.6, 1.0, 0.0], [1.0, -0.1, 0.0]],
     );
 
-    let s = build("[[objects]]\ntype = \"capped_cone\"\nbase = [0, 0, 0]\naxis = [0, 0, 1]\nheight = 2\nbase_radius = 1\ntop_radius = 0\n");
+    let s = build(
+        "[[objects]]\ntype = \"capped_cone\"\nbase = [0, 0, 0]\naxis = [0, 0, 1]\nheight = 2\nbase_radius = 1\ntop_radius = 0\n",
+    );
     let Shape::CappedCone(c) = &s.shapes.items[0] else {
         panic!()
     };
@@ -598,7 +604,9 @@ fn closed_solids() {
 
     // An oriented box three ways: size + rotation steps, half_size + axes, and the
     // same with a default (identity) orientation.
-    let s = build("[[objects]]\ntype = \"obox\"\ncenter = [0, 0, 0]\nsize = [4, 2, 2]\nrotation = [{ rotate = [0, 0, 1], angle = 90 }]\n");
+    let s = build(
+        "[[objects]]\ntype = \"obox\"\ncenter = [0, 0, 0]\nsize = [4, 2, 2]\nrotation = [{ rotate = [0, 0, 1], angle = 90 }]\n",
+    );
     assert_eq!(s.count(Kind::OBox), 1);
     let Shape::OBox(b) = &s.shapes.items[0] else {
         panic!()
@@ -609,16 +617,22 @@ fn closed_solids() {
         &[[0.0, 1.9, 0.0], [0.9, 0.0, 0.0]],
         &[[1.1, 0.0, 0.0], [0.0, 2.1, 0.0]],
     );
-    let s = build("[[objects]]\ntype = \"obox\"\ncenter = [0, 0, 0]\nhalf_size = [2, 1, 1]\naxes = [[0, 1, 0], [-1, 0, 0], [0, 0, 1]]\n");
+    let s = build(
+        "[[objects]]\ntype = \"obox\"\ncenter = [0, 0, 0]\nhalf_size = [2, 1, 1]\naxes = [[0, 1, 0], [-1, 0, 0], [0, 0, 1]]\n",
+    );
     check_inside(&s, &[[0.0, 1.9, 0.0]], &[[1.1, 0.0, 0.0]]);
     let s = build("[[objects]]\ntype = \"obox\"\ncenter = [5, 0, 0]\nhalf_size = [2, 1, 1]\n");
     check_inside(&s, &[[6.9, 0.0, 0.0]], &[[5.0, 1.1, 0.0]]);
 
     // Polyhedra: planes, a preset, a prism.
-    let s = build("[[objects]]\ntype = \"polyhedron\"\nplanes = [[1, 0, 0, 1], [-1, 0, 0, 1], [0, 1, 0, 2], [0, -1, 0, 2], [0, 0, 1, 1], [0, 0, -1, 1]]\n");
+    let s = build(
+        "[[objects]]\ntype = \"polyhedron\"\nplanes = [[1, 0, 0, 1], [-1, 0, 0, 1], [0, 1, 0, 2], [0, -1, 0, 2], [0, 0, 1, 1], [0, 0, -1, 1]]\n",
+    );
     assert_eq!(s.count(Kind::Polyhedron), 1);
     check_inside(&s, &[[0.9, 1.9, -0.9]], &[[1.1, 0.0, 0.0], [0.0, 2.1, 0.0]]);
-    let s = build("[[objects]]\ntype = \"polyhedron\"\npreset = \"octahedron\"\ncenter = [0, 1, 0]\nradius = 2\n");
+    let s = build(
+        "[[objects]]\ntype = \"polyhedron\"\npreset = \"octahedron\"\ncenter = [0, 1, 0]\nradius = 2\n",
+    );
     let Shape::Polyhedron(p) = &s.shapes.items[0] else {
         panic!()
     };
@@ -643,7 +657,9 @@ fn closed_solids() {
 #[test]
 fn quadrics_planes_and_tori() {
     // The unit sphere as a quadric, clipped to z ≥ 0.
-    let s = build("[[objects]]\ntype = \"quadric\"\ncoefficients = [1, 1, 1, 0, 0, 0, 0, 0, 0, -1]\nclip = { min = [-2, -2, 0], max = [2, 2, 2] }\n");
+    let s = build(
+        "[[objects]]\ntype = \"quadric\"\ncoefficients = [1, 1, 1, 0, 0, 0, 0, 0, 0, -1]\nclip = { min = [-2, -2, 0], max = [2, 2, 2] }\n",
+    );
     assert_eq!(s.count(Kind::Quadric), 1);
     check_inside(
         &s,
@@ -664,7 +680,9 @@ fn quadrics_planes_and_tori() {
     assert_eq!((p.normal(), p.offset()), (Vec3::Y, -1.0));
     check_inside(&s, &[[100.0, -1.1, 7.0]], &[[0.0, -0.9, 0.0]]);
 
-    let s = build("[[objects]]\ntype = \"torus\"\ncenter = [0, 0, 0]\naxis = [0, 1, 0]\nmajor_radius = 2\nminor_radius = 0.5\n");
+    let s = build(
+        "[[objects]]\ntype = \"torus\"\ncenter = [0, 0, 0]\naxis = [0, 1, 0]\nmajor_radius = 2\nminor_radius = 0.5\n",
+    );
     assert_eq!(s.count(Kind::Torus), 1);
     let Shape::Torus(t) = &s.shapes.items[0] else {
         panic!()
@@ -687,30 +705,70 @@ fn transformed_primitives_are_baked_when_exact() {
     type Case<'a> = (&'a str, bool, &'a [[f32; 3]], &'a [[f32; 3]]);
     let cases: &[Case] = &[
         // A box under translation and per-axis scale stays a box.
-        ("type = \"box\"\nmin = [0, 0, 0]\nmax = [1, 1, 1]\ntransform = [{ scale = [2, -3, 1] }, { translate = [0, 0, 5] }]",
-         true, &[[1.9, -2.9, 5.9]], &[[0.5, 0.5, 5.5], [2.1, -1.0, 5.5]]),
+        (
+            "type = \"box\"\nmin = [0, 0, 0]\nmax = [1, 1, 1]\ntransform = [{ scale = [2, -3, 1] }, { translate = [0, 0, 5] }]",
+            true,
+            &[[1.9, -2.9, 5.9]],
+            &[[0.5, 0.5, 5.5], [2.1, -1.0, 5.5]],
+        ),
         // Rotated, it is an instance.
-        ("type = \"box\"\nmin = [0, 0, 0]\nmax = [2, 1, 1]\ntransform = [{ rotate = [0, 0, 1], angle = 90 }]",
-         false, &[[-0.5, 1.9, 0.5]], &[[1.5, 0.5, 0.5]]),
-        ("type = \"obox\"\ncenter = [0, 0, 0]\nhalf_size = [2, 1, 1]\ntransform = [{ rotate = [0, 0, 1], angle = 90 }, { scale = 2 }, { translate = [10, 0, 0] }]",
-         true, &[[10.0, 3.9, 0.0]], &[[12.1, 0.0, 0.0]]),
-        ("type = \"cylinder\"\nbase = [0, 0, 0]\naxis = [0, 1, 0]\nheight = 1\nradius = 1\ntransform = [{ rotate = [1, 0, 0], angle = 90 }, { scale = 3 }]",
-         true, &[[0.0, 0.0, 2.9], [2.9, 0.0, 0.1]], &[[0.0, 0.0, 3.1], [0.0, 0.0, -0.1]]),
+        (
+            "type = \"box\"\nmin = [0, 0, 0]\nmax = [2, 1, 1]\ntransform = [{ rotate = [0, 0, 1], angle = 90 }]",
+            false,
+            &[[-0.5, 1.9, 0.5]],
+            &[[1.5, 0.5, 0.5]],
+        ),
+        (
+            "type = \"obox\"\ncenter = [0, 0, 0]\nhalf_size = [2, 1, 1]\ntransform = [{ rotate = [0, 0, 1], angle = 90 }, { scale = 2 }, { translate = [10, 0, 0] }]",
+            true,
+            &[[10.0, 3.9, 0.0]],
+            &[[12.1, 0.0, 0.0]],
+        ),
+        (
+            "type = \"cylinder\"\nbase = [0, 0, 0]\naxis = [0, 1, 0]\nheight = 1\nradius = 1\ntransform = [{ rotate = [1, 0, 0], angle = 90 }, { scale = 3 }]",
+            true,
+            &[[0.0, 0.0, 2.9], [2.9, 0.0, 0.1]],
+            &[[0.0, 0.0, 3.1], [0.0, 0.0, -0.1]],
+        ),
         // A stretched cylinder is an elliptic one: an instance.
-        ("type = \"cylinder\"\nbase = [0, 0, 0]\naxis = [0, 1, 0]\nheight = 1\nradius = 1\ntransform = [{ scale = [3, 1, 1] }]",
-         false, &[[2.9, 0.5, 0.0]], &[[0.0, 0.5, 1.1]]),
-        ("type = \"torus\"\ncenter = [0, 0, 0]\naxis = [0, 1, 0]\nmajor_radius = 2\nminor_radius = 0.5\ntransform = [{ rotate = [1, 0, 0], angle = 90 }, { translate = [0, 0, 1] }]",
-         true, &[[2.0, 0.0, 1.4]], &[[2.0, 0.0, 0.0]]),
+        (
+            "type = \"cylinder\"\nbase = [0, 0, 0]\naxis = [0, 1, 0]\nheight = 1\nradius = 1\ntransform = [{ scale = [3, 1, 1] }]",
+            false,
+            &[[2.9, 0.5, 0.0]],
+            &[[0.0, 0.5, 1.1]],
+        ),
+        (
+            "type = \"torus\"\ncenter = [0, 0, 0]\naxis = [0, 1, 0]\nmajor_radius = 2\nminor_radius = 0.5\ntransform = [{ rotate = [1, 0, 0], angle = 90 }, { translate = [0, 0, 1] }]",
+            true,
+            &[[2.0, 0.0, 1.4]],
+            &[[2.0, 0.0, 0.0]],
+        ),
         // Polyhedra, planes and unclipped quadrics bake under any affine map.
-        ("type = \"polyhedron\"\npreset = \"cube\"\nradius = 1.7320508\ntransform = [{ matrix = [[1, 1, 0, 0], [0, 1, 0, 0], [0, 0, 1, 0], [0, 0, 0, 1]] }]",
-         true, &[[1.9, 0.95, 0.0]], &[[-1.9, 0.95, 0.0], [0.0, 1.1, 0.0]]),
-        ("type = \"plane\"\npoint = [0, 0, 0]\nnormal = [1, 1, 0]\ntransform = [{ scale = [2, 1, 1] }, { translate = [1, 0, 0] }]",
-         true, &[[0.0, 0.0, 0.0], [1.0, -0.1, 0.0]], &[[1.2, 0.0, 0.0], [0.0, 0.6, 0.0]]),
-        ("type = \"quadric\"\ncoefficients = [1, 1, 1, 0, 0, 0, 0, 0, 0, -1]\ntransform = [{ scale = [3, 1, 1] }, { translate = [0, 100, 0] }]",
-         true, &[[2.9, 100.0, 0.0]], &[[0.0, 101.1, 0.0], [0.0, 0.0, 0.0]]),
+        (
+            "type = \"polyhedron\"\npreset = \"cube\"\nradius = 1.7320508\ntransform = [{ matrix = [[1, 1, 0, 0], [0, 1, 0, 0], [0, 0, 1, 0], [0, 0, 0, 1]] }]",
+            true,
+            &[[1.9, 0.95, 0.0]],
+            &[[-1.9, 0.95, 0.0], [0.0, 1.1, 0.0]],
+        ),
+        (
+            "type = \"plane\"\npoint = [0, 0, 0]\nnormal = [1, 1, 0]\ntransform = [{ scale = [2, 1, 1] }, { translate = [1, 0, 0] }]",
+            true,
+            &[[0.0, 0.0, 0.0], [1.0, -0.1, 0.0]],
+            &[[1.2, 0.0, 0.0], [0.0, 0.6, 0.0]],
+        ),
+        (
+            "type = \"quadric\"\ncoefficients = [1, 1, 1, 0, 0, 0, 0, 0, 0, -1]\ntransform = [{ scale = [3, 1, 1] }, { translate = [0, 100, 0] }]",
+            true,
+            &[[2.9, 100.0, 0.0]],
+            &[[0.0, 101.1, 0.0], [0.0, 0.0, 0.0]],
+        ),
         // A clipped quadric keeps its box: an instance.
-        ("type = \"quadric\"\ncoefficients = [1, 1, 1, 0, 0, 0, 0, 0, 0, -1]\nclip = { min = [-2, -2, -2], max = [2, 2, 0] }\ntransform = [{ scale = [3, 1, 1] }]",
-         false, &[[2.9, 0.0, -0.1]], &[[2.9, 0.0, 0.1]]),
+        (
+            "type = \"quadric\"\ncoefficients = [1, 1, 1, 0, 0, 0, 0, 0, 0, -1]\nclip = { min = [-2, -2, -2], max = [2, 2, 0] }\ntransform = [{ scale = [3, 1, 1] }]",
+            false,
+            &[[2.9, 0.0, -0.1]],
+            &[[2.9, 0.0, 0.1]],
+        ),
     ];
     for (obj, baked, inside, outside) in cases {
         let s = build(&format!("[[objects]]\n{obj}\n"));
@@ -766,7 +824,10 @@ fn errors_of_the_new_primitives() {
         "[[objects]]\ntype = \"obox\"\ncenter = [0, 0, 0]\nsize = [1, 1, 0] # HERE\n",
         &["positive components"],
     );
-    error_at("[[objects]]\ntype = \"obox\"\ncenter = [0, 0, 0]\nsize = [1, 1, 1]\nhalf_size = [1, 1, 1] # HERE\n", &["not both"]);
+    error_at(
+        "[[objects]]\ntype = \"obox\"\ncenter = [0, 0, 0]\nsize = [1, 1, 1]\nhalf_size = [1, 1, 1] # HERE\n",
+        &["not both"],
+    );
     error_at(
         "[[objects]]\ntype = \"obox\"\ncenter = [0, 0, 0]\nsize = [1, 1, 1]\nrotation = [{ scale = 2 }] # HERE\n",
         &["rotations only"],
@@ -775,8 +836,14 @@ fn errors_of_the_new_primitives() {
         "[[objects]]\ntype = \"obox\"\ncenter = [0, 0, 0]\nsize = [1, 1, 1]\naxes = [[1, 0, 0], [1, 0, 0], [0, 0, 1]] # HERE\n",
         &["not orthonormal"],
     );
-    error_at("[[objects]]\ntype = \"cylinder\"\nbase = [0, 0, 0]\naxis = [0, 0, 0] # HERE\nheight = 1\nradius = 1\n", &["must not be zero"]);
-    error_at("[[objects]]\ntype = \"cylinder\"\nbase = [0, 0, 0]\naxis = [0, 1, 0]\nheight = 1\nradius = 0 # HERE\n", &["must be positive"]);
+    error_at(
+        "[[objects]]\ntype = \"cylinder\"\nbase = [0, 0, 0]\naxis = [0, 0, 0] # HERE\nheight = 1\nradius = 1\n",
+        &["must not be zero"],
+    );
+    error_at(
+        "[[objects]]\ntype = \"cylinder\"\nbase = [0, 0, 0]\naxis = [0, 1, 0]\nheight = 1\nradius = 0 # HERE\n",
+        &["must be positive"],
+    );
     error_at(
         "[[objects]]\ntype = \"capped_cone\"\nbase = [0, 0, 0]\naxis = [0, 1, 0]\nheight = 1\nbase_radius = 0\ntop_radius = 0 # HERE\n",
         &["both be zero"],

@@ -73,7 +73,7 @@ fn spd_scenes_render_on_the_bvh() {
 #[test]
 #[ignore = "needs the SPD scene files (EMRAY_SPD_DIR)"]
 fn generated_files_match_the_spd_programs() {
-    use emray::gen::{compare_nff, Database};
+    use emray::spd::{Database, compare_nff};
     let only: Option<Vec<String>> = std::env::var("EMRAY_SPD_ONLY")
         .ok()
         .map(|s| s.split(',').map(str::to_string).collect());

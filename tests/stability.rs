@@ -1,12 +1,12 @@
 //! Numerical stress cases, each asserting a bound (small counts for the debug build;
 //! `emray stress` runs the full counts and prints the numbers).
 
-use emray::accel::bvh::Bvh;
+use emray::Backend;
 use emray::accel::Accel;
+use emray::accel::bvh::Bvh;
 use emray::load::nff::parse_str;
 use emray::math::{Ray, Vec3};
 use emray::stress::{self, acne, convex_scene, differing_share, floor_scene, render};
-use emray::Backend;
 use std::path::Path;
 
 fn backends() -> Vec<Backend> {

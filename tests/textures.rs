@@ -3,15 +3,15 @@
 //! bump normal against the analytic tilt, a mirror sphere against the environment
 //! texel behind the camera, OBJ `vt`/MTL maps as documented, and backend agreement.
 
+use emray::Hit;
 use emray::accel::{Accel, Backend};
-use emray::geometry::{inverse_bilinear, Kind, Sphere, Triangle};
-use emray::load::obj::{load_geometry, MISSING_TEXTURE};
+use emray::geometry::{Kind, Sphere, Triangle, inverse_bilinear};
+use emray::load::obj::{MISSING_TEXTURE, load_geometry};
 use emray::math::{Ray, Vec3};
 use emray::render::RenderSettings;
-use emray::run::{render_scene, with_accel, WithAccel};
-use emray::scene::texture::{bump_normal, srgb_to_linear, Image, Wrap, NO_TEXTURE};
+use emray::run::{WithAccel, render_scene, with_accel};
+use emray::scene::texture::{Image, NO_TEXTURE, Wrap, bump_normal, srgb_to_linear};
 use emray::scene::{Camera, Environment, Light, Maps, Material, Scene, Texture};
-use emray::Hit;
 use glam::Vec2;
 use std::path::Path;
 use std::sync::Arc;
@@ -666,18 +666,10 @@ fn obj_vt_and_map_kd_decode_srgb_and_negative_indices() {
     .unwrap();
     // Left half sRGB 128 (linear 0.2158), right half 255.
     write_png(&dir.path().join("t.png"), 2, 1, |x, _| {
-        if x == 0 {
-            [128; 3]
-        } else {
-            [255; 3]
-        }
+        if x == 0 { [128; 3] } else { [255; 3] }
     });
     write_png(&dir.path().join("h.png"), 2, 1, |x, _| {
-        if x == 0 {
-            [128; 3]
-        } else {
-            [255; 3]
-        }
+        if x == 0 { [128; 3] } else { [255; 3] }
     });
     let data = load_geometry(&dir.path().join("q.obj")).unwrap();
     assert!(data.warnings.is_empty(), "{:?}", data.warnings);
@@ -736,10 +728,11 @@ fn obj_without_vt_has_no_texture_coordinates_and_missing_texture_is_visible() {
         "{}",
         w[0]
     );
-    assert!(data
-        .warnings
-        .iter()
-        .any(|w| w.contains("gone.png") && w.contains("left out")));
+    assert!(
+        data.warnings
+            .iter()
+            .any(|w| w.contains("gone.png") && w.contains("left out"))
+    );
     let m = &data.materials[0];
     assert_eq!(data.textures[m.maps.color as usize], MISSING_TEXTURE);
     assert_eq!(m.maps.bump, emray::scene::NO_TEXTURE);

@@ -21,7 +21,7 @@
 //! (`srgb`/`linear`). A job's own key wins over the default; settings given on the
 //! command line win over both.
 
-use super::{expand_template, Job, JobSettings};
+use super::{Job, JobSettings, expand_template};
 use crate::accel::Backend;
 use crate::load::LoadError;
 use crate::output::Encoding;
@@ -243,10 +243,12 @@ mod tests {
             spp: Some(2),
             ..Overrides::default()
         };
-        assert!(load(&p, &cli)
-            .unwrap()
-            .iter()
-            .all(|j| j.settings.spp == Some(2)));
+        assert!(
+            load(&p, &cli)
+                .unwrap()
+                .iter()
+                .all(|j| j.settings.spp == Some(2))
+        );
     }
 
     #[test]
@@ -261,9 +263,11 @@ mod tests {
         assert!(e.contains("jobs.toml:"), "{e}");
         assert!(e.contains("speed"), "{e}");
         let p = write(dir.path(), "output = \"x.png\"\n");
-        assert!(load(&p, &Overrides::default())
-            .unwrap_err()
-            .to_string()
-            .contains("no [[job]]"));
+        assert!(
+            load(&p, &Overrides::default())
+                .unwrap_err()
+                .to_string()
+                .contains("no [[job]]")
+        );
     }
 }

@@ -11,14 +11,14 @@ pub mod manifest;
 pub mod merge;
 mod runner;
 
-pub use runner::{run, BatchOptions, BatchReport, JobRecord, JobStatus};
+pub use runner::{BatchOptions, BatchReport, JobRecord, JobStatus, run};
 
+use crate::Scene;
 use crate::accel::Backend;
-use crate::gen::Database;
 use crate::load;
 use crate::output::Encoding;
 use crate::render::{Region, RenderSettings};
-use crate::Scene;
+use crate::spd::Database;
 use std::path::{Path, PathBuf};
 
 /// How one job renders; `None` leaves the scene's or the renderer's default.
@@ -139,7 +139,7 @@ pub fn expand_template(
                         .map(|k| format!("{{{k}}}"))
                         .collect::<Vec<_>>()
                         .join(", ")
-                ))
+                ));
             }
         }
         rest = &after[close + 1..];
@@ -293,9 +293,11 @@ mod tests {
             expand_template("{stem}.png", Path::new("spd:gears?size=2"), &s, 0).unwrap(),
             "gears_s2.png"
         );
-        assert!(expand_template("{colour}.png", p, &s, 0)
-            .unwrap_err()
-            .contains("unknown placeholder"));
+        assert!(
+            expand_template("{colour}.png", p, &s, 0)
+                .unwrap_err()
+                .contains("unknown placeholder")
+        );
         assert!(expand_template("{stem.png", p, &s, 0).is_err());
     }
 

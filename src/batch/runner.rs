@@ -1,12 +1,12 @@
 //! Running a batch: workers, progress, the JSON report, Ctrl-C.
 
-use super::{load_scene, Job};
+use super::{Job, load_scene};
 use crate::run::Report;
 use serde::Serialize;
 use std::io::IsTerminal;
 use std::path::{Path, PathBuf};
 use std::sync::atomic::{AtomicBool, AtomicUsize, Ordering};
-use std::sync::{mpsc, Arc, Once, RwLock};
+use std::sync::{Arc, Once, RwLock, mpsc};
 use std::time::{Duration, Instant};
 
 /// How to run a batch.

@@ -8,10 +8,10 @@ pub mod raw;
 pub mod report;
 
 use crate::accel::Backend;
-use crate::gen::Database;
 use crate::render::RenderSettings;
-use crate::run::{with_accel, WithAccel};
+use crate::run::{WithAccel, with_accel};
 use crate::scene::Scene;
+use crate::spd::Database;
 use serde::{Deserialize, Serialize};
 use std::path::Path;
 use std::process::Command;
@@ -579,10 +579,12 @@ mod tests {
         })
         .unwrap();
         assert_eq!(raw.rays, r.rays, "the raw run casts the render's rays");
-        assert!(run_child(&RunSpec {
-            backend: "nope".into(),
-            ..spec
-        })
-        .is_err());
+        assert!(
+            run_child(&RunSpec {
+                backend: "nope".into(),
+                ..spec
+            })
+            .is_err()
+        );
     }
 }

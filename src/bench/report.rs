@@ -4,7 +4,7 @@
 
 use super::peer::PeerRow;
 use super::{Machine, Mode, Rays, Sample};
-use crate::gen::Database;
+use crate::spd::Database;
 use serde::{Deserialize, Serialize};
 use std::collections::BTreeMap;
 use std::fmt::Write;
@@ -299,7 +299,10 @@ pub fn markdown(
         machine.cpu, machine.cpus, machine.isa, machine.load_before, machine.load_after
     );
     let reps = rows.iter().map(|r| r.reps).max().unwrap_or(0);
-    let _ = writeln!(o, "- {reps} repetitions per row, interleaved; times are medians, spread = (max − min) / median\n");
+    let _ = writeln!(
+        o,
+        "- {reps} repetitions per row, interleaved; times are medians, spread = (max − min) / median\n"
+    );
     let _ = writeln!(
         o,
         "| scene | prims | backend | thr | load ms | build ms | render ms | spread | raw ms | render/raw | rays | Mrays/s | peak MiB | ÷ embree |"
@@ -344,10 +347,16 @@ pub fn markdown(
     }
     let _ = writeln!(o, "\n## Targets\n");
     for (t, g) in &sum.bvh_vs_embree {
-        let _ = writeln!(o, "- BVH ÷ Embree render time, geometric mean over the default-size SPD scenes, {t} thread(s): {g:.2} (target ≤ 1.5)");
+        let _ = writeln!(
+            o,
+            "- BVH ÷ Embree render time, geometric mean over the default-size SPD scenes, {t} thread(s): {g:.2} (target ≤ 1.5)"
+        );
     }
     for (b, g) in &sum.overhead {
-        let _ = writeln!(o, "- render ÷ raw casting on {b}, geometric mean (most threads): {g:.2} (target ≤ 1.25 on embree)");
+        let _ = writeln!(
+            o,
+            "- render ÷ raw casting on {b}, geometric mean (most threads): {g:.2} (target ≤ 1.25 on embree)"
+        );
     }
     for (b, (k, scene)) in &sum.scaling_min {
         let _ = writeln!(
@@ -365,7 +374,10 @@ pub fn markdown(
     if peers.is_empty() {
         let _ = writeln!(o, "{peer_note}");
     } else {
-        let _ = writeln!(o, "| scene | thr | tachyon ms | emray embree ms | tachyon ÷ emray | note |\n|---|---:|---:|---:|---:|---|");
+        let _ = writeln!(
+            o,
+            "| scene | thr | tachyon ms | emray embree ms | tachyon ÷ emray | note |\n|---|---:|---:|---:|---:|---|"
+        );
         for p in peers {
             let _ = writeln!(
                 o,

@@ -11,7 +11,7 @@
 //! and runs the same test against `[−h, h]`.
 
 use super::{Intersect, ShapeHit, Solid, Span, Spans, SurfacePoint};
-use crate::math::{gamma, Aabb, Ray, Vec3};
+use crate::math::{Aabb, Ray, Vec3, gamma};
 use glam::{DMat3, DQuat, Mat3, Quat};
 
 /// One end of a line's stretch through a box: its parameter, the axis whose slab decided

@@ -17,9 +17,9 @@
 //! linear or constant equation instead of dividing by zero.
 
 use super::{
-    diff_of_products, quadratic_roots, Intersect, ShapeHit, Solid, Span, Spans, SurfacePoint,
+    Intersect, ShapeHit, Solid, Span, Spans, SurfacePoint, diff_of_products, quadratic_roots,
 };
-use crate::math::{gamma, Aabb, DVec3, Frame, Ray, Vec3};
+use crate::math::{Aabb, DVec3, Frame, Ray, Vec3, gamma};
 use std::f32::consts::TAU;
 
 /// Which part of the surface an end of the line's stretch lies on.

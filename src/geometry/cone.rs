@@ -1,5 +1,5 @@
-use super::{diff_of_products, quadratic_roots, ShapeHit, SurfacePoint};
-use crate::math::{gamma, Aabb, Ray, Vec3};
+use super::{ShapeHit, SurfacePoint, diff_of_products, quadratic_roots};
+use crate::math::{Aabb, Ray, Vec3, gamma};
 
 /// NFF's open cone or cylinder: the lateral surface between a base disk and an apex
 /// disk, with no end caps. With `inside_only` (NFF's negative radii) only hits where the

@@ -25,7 +25,7 @@ pub use boxes::{AaBox, OBox};
 pub use capped::CappedCone;
 pub use cone::Cone;
 pub use csg::{Csg, CsgOp, CsgTree};
-pub use param::{inverse_bilinear, Param, QuadUv};
+pub use param::{Param, QuadUv, inverse_bilinear};
 pub use plane::Plane;
 pub use polyhedron::Polyhedron;
 pub use quadric::Quadric;

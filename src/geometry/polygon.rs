@@ -99,7 +99,7 @@ impl Triangulator {
         out.clear();
         self.idx.clear();
         for (i, p) in points.iter().enumerate() {
-            if self.idx.last().map_or(true, |&l| points[l] != *p) {
+            if self.idx.last().is_none_or(|&l| points[l] != *p) {
                 self.idx.push(i);
             }
         }
@@ -224,7 +224,7 @@ impl Triangulator {
                 let mut j = i;
                 for _ in 0..remaining {
                     let t = self.corner(sign, self.prev[j], j, self.next[j]);
-                    if t > 0.0 && best.map_or(true, |(_, bt)| t > bt) {
+                    if t > 0.0 && best.is_none_or(|(_, bt)| t > bt) {
                         best = Some((j, t));
                     }
                     j = self.next[j];

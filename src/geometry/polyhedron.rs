@@ -12,7 +12,7 @@
 //! without cancellation.
 
 use super::{Intersect, ShapeHit, Solid, Span, Spans, SurfacePoint};
-use crate::math::{gamma, next_float_down, next_float_up, Aabb, DVec3, Ray, Vec3};
+use crate::math::{Aabb, DVec3, Ray, Vec3, gamma, next_float_down, next_float_up};
 
 /// The most planes a polyhedron may have (validation enumerates plane triples).
 pub const MAX_PLANES: usize = 256;
@@ -241,7 +241,7 @@ impl Polyhedron {
                 return Err(format!(
                     "unknown polyhedron {name:?} (known: {})",
                     Self::PRESETS.join(", ")
-                ))
+                ));
             }
         }
         let planes = normals
@@ -529,7 +529,7 @@ impl Intersect for Polyhedron {
                 }
                 let dj = dj - margin(dj);
                 let viol = nj.dot(y) - dj;
-                if viol > 0.0 && worst.map_or(true, |w| viol > w.0) {
+                if viol > 0.0 && worst.is_none_or(|w| viol > w.0) {
                     worst = Some((viol, nj, dj));
                 }
             }

@@ -33,7 +33,7 @@
 //! Only the results (`t`, normals, points) are rounded to f32.
 
 use super::{Intersect, ShapeHit, Solid, Span, Spans, SurfacePoint};
-use crate::math::{next_float_down, next_float_up, Aabb, DVec3, Ray, Vec3};
+use crate::math::{Aabb, DVec3, Ray, Vec3, next_float_down, next_float_up};
 use glam::DMat3;
 
 /// `n·u / (1 − n·u)` with `u = 2⁻⁵³`: the relative error bound of `n` f64 operations.
@@ -71,21 +71,13 @@ pub(super) fn outward_or_dir(g: DVec3, dir: DVec3, exit: bool) -> Vec3 {
 /// The largest f32 not above `x` (round towards −∞).
 pub(super) fn f32_down(x: f64) -> f32 {
     let y = x as f32;
-    if y as f64 > x {
-        next_float_down(y)
-    } else {
-        y
-    }
+    if y as f64 > x { next_float_down(y) } else { y }
 }
 
 /// The smallest f32 not below `x` (round towards +∞).
 pub(super) fn f32_up(x: f64) -> f32 {
     let y = x as f32;
-    if (y as f64) < x {
-        next_float_up(y)
-    } else {
-        y
-    }
+    if (y as f64) < x { next_float_up(y) } else { y }
 }
 
 /// The f32 box containing `[lo, hi]` (rounded outwards).
@@ -1020,13 +1012,17 @@ mod tests {
         let nan = [f64::NAN, 1.0, 1.0, 0.0, 0.0, 0.0, 0.0, 0.0, 0.0, -1.0];
         assert!(Quadric::new(nan, None).unwrap_err().contains("not finite"));
         let empty = [1.0, 1.0, 1.0, 0.0, 0.0, 0.0, 0.0, 0.0, 0.0, 1.0];
-        assert!(Quadric::new(empty, None)
-            .unwrap_err()
-            .contains("no real points"));
+        assert!(
+            Quadric::new(empty, None)
+                .unwrap_err()
+                .contains("no real points")
+        );
         let point = [1.0, 1.0, 1.0, 0.0, 0.0, 0.0, 0.0, 0.0, 0.0, 0.0];
-        assert!(Quadric::new(point, None)
-            .unwrap_err()
-            .contains("degenerate"));
+        assert!(
+            Quadric::new(point, None)
+                .unwrap_err()
+                .contains("degenerate")
+        );
         let all = [-1.0, -1.0, -1.0, 0.0, 0.0, 0.0, 0.0, 0.0, 0.0, -1.0];
         assert!(Quadric::new(all, None).unwrap_err().contains("all space"));
         let constant = [0.0, 0.0, 0.0, 0.0, 0.0, 0.0, 0.0, 0.0, 0.0, -1.0];
@@ -1043,9 +1039,11 @@ mod tests {
             min: Vec3::ZERO,
             max: Vec3::new(1.0, 0.0, 1.0),
         };
-        assert!(Quadric::new(cyl, Some(flat))
-            .unwrap_err()
-            .contains("clip box"));
+        assert!(
+            Quadric::new(cyl, Some(flat))
+                .unwrap_err()
+                .contains("clip box")
+        );
         assert!(Quadric::sphere(Vec3::ZERO, 0.0).is_err());
         assert!(Quadric::sphere(Vec3::ZERO, -1.0).is_err());
         assert!(Quadric::sphere(Vec3::splat(f32::INFINITY), 1.0).is_err());
@@ -1054,10 +1052,12 @@ mod tests {
             min: Vec3::splat(5.0),
             max: Vec3::splat(6.0),
         };
-        assert!(Quadric::sphere(Vec3::ZERO, 1.0)
-            .unwrap()
-            .with_clip(far)
-            .is_err());
+        assert!(
+            Quadric::sphere(Vec3::ZERO, 1.0)
+                .unwrap()
+                .with_clip(far)
+                .is_err()
+        );
     }
 
     #[test]

@@ -1,5 +1,5 @@
-use super::{diff_of_products, quadratic_roots, ShapeHit, SurfacePoint};
-use crate::math::{gamma, Aabb, Ray, Vec3};
+use super::{ShapeHit, SurfacePoint, diff_of_products, quadratic_roots};
+use crate::math::{Aabb, Ray, Vec3, gamma};
 
 /// A sphere. With `inside_only` (NFF's negative radius) only hits where the ray leaves
 /// the sphere count, so the inside is visible and the outside is not.

@@ -420,11 +420,7 @@ fn wrap01(x: f64) -> f32 {
     let x = if x < 0.0 { x + 1.0 } else { x };
     // Rounding of x + 1 for tiny negative x can give exactly 1.
     let x = x as f32;
-    if x >= 1.0 {
-        0.0
-    } else {
-        x
-    }
+    if x >= 1.0 { 0.0 } else { x }
 }
 
 /// The root of a function monotone on `[lo, hi]` whose values `f_lo`, `f_hi` at the two

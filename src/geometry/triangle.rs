@@ -1,5 +1,5 @@
 use super::{ShapeHit, SurfacePoint};
-use crate::math::{gamma, Aabb, Ray, Vec3};
+use crate::math::{Aabb, Ray, Vec3, gamma};
 
 /// A triangle. Its front side is the one from which the vertices appear
 /// counterclockwise; the geometric normal `(p1 − p0) × (p2 − p0)` points to it.

@@ -17,7 +17,7 @@ use super::LoadError;
 use crate::geometry::polygon::Triangulator;
 use crate::geometry::{Cone, Sphere, Triangle};
 use crate::math::Vec3;
-use crate::scene::{default_light_intensity, range, Camera, Light, Material, Scene};
+use crate::scene::{Camera, Light, Material, Scene, default_light_intensity, range};
 use std::path::Path;
 
 /// Largest accepted image side.
@@ -350,7 +350,7 @@ impl<'a> Parser<'a, '_> {
                              (too many numbers for the entity before it?)",
                             show(s)
                         ),
-                    ))
+                    ));
                 }
                 s => return Err(self.err(&t, format!("unknown entity {}", show(s)))),
             }

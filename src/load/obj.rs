@@ -143,7 +143,7 @@ use crate::geometry::{QuadUv, Triangle};
 use crate::math::{Aabb, DVec3, Vec3};
 use crate::scene::texture::{Image, Wrap};
 use crate::scene::{
-    range, Camera, Environment, Geometry, Light, LoadStats, Material, Scene, Texture,
+    Camera, Environment, Geometry, Light, LoadStats, Material, Scene, Texture, range,
 };
 use glam::Vec2;
 use std::cell::RefCell;
@@ -711,7 +711,7 @@ fn scan(text: &str) -> Result<Scan, Located> {
                             }
                         } else if x as usize > counts[k] {
                             let refs = &mut forward[k];
-                            if refs.last().map_or(true, |r| r.index < x as usize) {
+                            if refs.last().is_none_or(|r| r.index < x as usize) {
                                 refs.push(ForwardRef {
                                     index: x as usize,
                                     at: err(Some(tok), String::new()),
@@ -786,7 +786,7 @@ fn scan(text: &str) -> Result<Scan, Located> {
             };
             if worst
                 .as_ref()
-                .map_or(true, |w| (at.line, at.col) < (w.line, w.col))
+                .is_none_or(|w| (at.line, at.col) < (w.line, w.col))
             {
                 worst = Some(at);
             }
@@ -850,7 +850,7 @@ fn find_bad_number(text: &str, limit: usize) -> Option<Located> {
                     return err(
                         Some(tok),
                         format!("{what} {name} {} is not a finite number", show(tok)),
-                    )
+                    );
                 }
                 Err(_) => {
                     return err(
@@ -860,7 +860,7 @@ fn find_bad_number(text: &str, limit: usize) -> Option<Located> {
                             show(tok),
                             comment_hint(tok)
                         ),
-                    )
+                    );
                 }
             }
         }
@@ -894,7 +894,7 @@ fn find_bad_number(text: &str, limit: usize) -> Option<Located> {
                 return err(
                     Some(w_tok),
                     format!("vertex weight w {} is not a finite number", show(w_tok)),
-                )
+                );
             }
             Err(_) => {
                 return err(
@@ -904,7 +904,7 @@ fn find_bad_number(text: &str, limit: usize) -> Option<Located> {
                         show(w_tok),
                         comment_hint(w_tok)
                     ),
-                )
+                );
             }
         }
     }

@@ -116,11 +116,7 @@ impl Aabb {
         let far = t0.max(t1) * (1.0 + 2.0 * super::gamma(3));
         let tn = near.max_element().max(tmin);
         let tf = far.min_element().min(tmax);
-        if tn <= tf {
-            Some(tn)
-        } else {
-            None
-        }
+        if tn <= tf { Some(tn) } else { None }
     }
 
     /// Convenience form of [`Aabb::hit`] for a whole ray.

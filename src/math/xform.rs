@@ -1,7 +1,7 @@
 //! Affine transforms of rays, points and normals, with the rounding-error bounds that
 //! robust ray spawning needs (pbrt, 3rd ed., §3.9).
 
-use super::{gamma, Aabb, Ray, Vec3};
+use super::{Aabb, Ray, Vec3, gamma};
 use crate::geometry::SurfacePoint;
 use glam::{Affine3A, Mat3};
 

@@ -3,7 +3,7 @@
 //! FLIP (NVIDIA's perceptual difference, on the 8-bit sRGB images: LDR only), plus a
 //! heat-map picture of where they differ. Used by `emray compare` and `emray study`.
 
-use crate::output::{to_rgb8, Encoding};
+use crate::output::{Encoding, to_rgb8};
 use crate::render::Film;
 use glam::Vec3;
 use serde::Serialize;
@@ -136,11 +136,7 @@ pub fn check_sizes(a: &Film, pa: &Path, b: &Film, pb: &Path) -> Result<(), Metri
 #[inline]
 fn diff(v: f32, r: f32) -> f64 {
     let d = (v as f64 - r as f64).abs();
-    if d.is_nan() {
-        f64::INFINITY
-    } else {
-        d
-    }
+    if d.is_nan() { f64::INFINITY } else { d }
 }
 
 /// Every metric of `test` against `reference` (same size; panics otherwise: check with

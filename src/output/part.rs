@@ -3,11 +3,11 @@
 //! settings it was rendered from, so that `emray merge` can check the parts belong
 //! together.
 
-use super::{write_atomic, OutputError};
+use super::{OutputError, write_atomic};
 use crate::render::{Film, Region};
 use exr::prelude::{
-    read, AttributeValue, Image, ImageAttributes, IntegerBounds, Layer, LayerAttributes,
-    ReadChannels, ReadLayers, SpecificChannels, Text, Vec2, WritableImage,
+    AttributeValue, Image, ImageAttributes, IntegerBounds, Layer, LayerAttributes, ReadChannels,
+    ReadLayers, SpecificChannels, Text, Vec2, WritableImage, read,
 };
 use glam::Vec3;
 use std::io::BufWriter;

@@ -7,8 +7,8 @@
 //! `ρ` shows `ρ ×` it, the same units as the radiosity solution's `B`.
 
 use crate::accel::Accel;
-use crate::math::{gamma, hash, hash_unit as unit, next_float_down, offset_ray_origin, Ray, Vec3};
-use crate::scene::{Scene, INHERIT};
+use crate::math::{Ray, Vec3, gamma, hash, hash_unit as unit, next_float_down, offset_ray_origin};
+use crate::scene::{INHERIT, Scene};
 use std::f32::consts::FRAC_1_PI;
 
 /// One emitting triangle in world space.

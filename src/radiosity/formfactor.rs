@@ -8,9 +8,9 @@
 //! distributes exactly the energy that leaves `i` in a closed enclosure (the
 //! point-to-polygon form factors of a closed polyhedron sum to one at every point).
 
-use super::mesh::{centroid_pattern, Element, Mesh};
+use super::mesh::{Element, Mesh, centroid_pattern};
 use crate::accel::Accel;
-use crate::math::{next_float_down, offset_ray_origin, Ray, Vec3};
+use crate::math::{Ray, Vec3, next_float_down, offset_ray_origin};
 
 /// The exact form factor from a differential area at `x` with unit normal `n` to the
 /// planar polygon `poly` (either winding), ignoring occlusion; the part of the

@@ -20,8 +20,8 @@
 //! its distance to the receiver; both errors fall with the resolution and the patch
 //! size respectively.
 
-use super::mesh::Mesh;
 use super::RadiosityError;
+use super::mesh::Mesh;
 use crate::math::{Frame, Vec3};
 use rayon::prelude::*;
 

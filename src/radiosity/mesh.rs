@@ -8,12 +8,12 @@
 //! leave T-junctions: [`Mesh::hanging_vertices`] lists the vertices that lie inside
 //! another element's edge, so that the display can interpolate them along that edge.
 
-use super::tessellate::{self, Lookup, Tessellation};
 use super::RadiosityError;
+use super::tessellate::{self, Lookup, Tessellation};
 use crate::accel::NO_INSTANCE;
 use crate::geometry::{Kind, Shape};
-use crate::math::{gamma, Vec3};
-use crate::scene::{Geometry, Material, Scene, INHERIT};
+use crate::math::{Vec3, gamma};
+use crate::scene::{Geometry, INHERIT, Material, Scene};
 use std::collections::HashMap;
 
 /// Deepest subdivision of one source triangle (4^12 elements).

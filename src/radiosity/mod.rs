@@ -403,7 +403,7 @@ pub fn render_view<A: Accel>(
     height: u32,
     spp: u32,
 ) -> Film {
-    let gen = RayGen::new(&scene.camera, width, height);
+    let raygen = RayGen::new(&scene.camera, width, height);
     let n = spp.max(1);
     let rows: Vec<Vec<Vec3>> = (0..height)
         .into_par_iter()
@@ -413,7 +413,7 @@ pub fn render_view<A: Accel>(
                     let mut sum = Vec3::ZERO;
                     for sy in 0..n {
                         for sx in 0..n {
-                            let ray = gen.ray(
+                            let ray = raygen.ray(
                                 i as f32 + (sx as f32 + 0.5) / n as f32,
                                 j as f32 + (sy as f32 + 0.5) / n as f32,
                             );

@@ -6,9 +6,9 @@
 //!   is the unshot power over the emitted power.
 //! - Gauss–Seidel on the full matrix for small meshes, as a cross-check.
 
-use super::formfactor::{element_form_factor, Sampling};
-use super::mesh::Mesh;
 use super::RadiosityError;
+use super::formfactor::{Sampling, element_form_factor};
+use super::mesh::Mesh;
 use crate::accel::Accel;
 use crate::math::Vec3;
 use rayon::prelude::*;

@@ -104,11 +104,7 @@ impl Lookup {
 
 /// `x` in `[0, 1)`, for an angle in turns from `atan2`.
 fn wrap(x: f32) -> f32 {
-    if x < 0.0 {
-        x + 1.0
-    } else {
-        x
-    }
+    if x < 0.0 { x + 1.0 } else { x }
 }
 
 /// The cell of `x ∈ [0, 1]` among `n`.

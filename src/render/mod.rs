@@ -224,7 +224,7 @@ pub fn render_with_gi<A: Accel>(
     let r = settings.region.unwrap_or(Region::full(w, h));
     if let (Aa::Adaptive { threshold, depth }, false) = (settings.aa, settings.spd) {
         // The rays through every pixel corner, then each pixel refined from its four.
-        let gen = RayGen::new(&scene.camera, w, h);
+        let raygen = RayGen::new(&scene.camera, w, h);
         let (cw, ch) = (r.width() + 1, r.height() + 1);
         let (corners, mut rays) = sample_grid(
             r.x0,
@@ -233,7 +233,7 @@ pub fn render_with_gi<A: Accel>(
             ch,
             settings.tile,
             None,
-            per_position(|i, j, c| tracer.sample(&gen, i as f32, j as f32, c)),
+            per_position(|i, j, c| tracer.sample(&raygen, i as f32, j as f32, c)),
         );
         let (rw, rh) = (r.width(), r.height());
         let refine = per_position(|i, j, c| {
@@ -244,7 +244,7 @@ pub fn render_with_gi<A: Accel>(
                 corners.get(ci, cj + 1),
                 corners.get(ci + 1, cj + 1),
             ];
-            let s = |x: f32, y: f32, c: &mut RayCounts| tracer.sample(&gen, x, y, c);
+            let s = |x: f32, y: f32, c: &mut RayCounts| tracer.sample(&raygen, x, y, c);
             adaptive(&s, i as f32, j as f32, 1.0, k, threshold, depth, c)
         });
         let (film, more) = sample_grid(r.x0, r.y0, rw, rh, settings.tile, progress, refine);
@@ -253,11 +253,11 @@ pub fn render_with_gi<A: Accel>(
     }
     // In SPD mode the sample grid is the pixel corners: one more row and column.
     let (gw, gh) = if settings.spd { (w + 1, h + 1) } else { (w, h) };
-    let gen = RayGen::new(&scene.camera, gw, gh);
+    let raygen = RayGen::new(&scene.camera, gw, gh);
     let extra = u32::from(settings.spd);
     let (rw, rh) = (r.width() + extra, r.height() + extra);
     let (grid, rays) = sample_grid(r.x0, r.y0, rw, rh, settings.tile, progress, |t, px, c| {
-        tracer.tile(&gen, t, px, c);
+        tracer.tile(&raygen, t, px, c);
     });
     let film = if settings.spd {
         grid.average_corners()

@@ -3,9 +3,9 @@
 use super::{RayGen, Region, RenderSettings};
 use crate::accel::{Accel, Hit};
 use crate::math::{
-    hash, hash_unit as unit, next_float_down, offset_ray_origin, Ray, RayOrigins, Vec3,
+    Ray, RayOrigins, Vec3, hash, hash_unit as unit, next_float_down, offset_ray_origin,
 };
-use crate::radiosity::{area, Solution};
+use crate::radiosity::{Solution, area};
 use crate::scene::{Light, Material, Scene, Surface};
 
 /// Rays cast, by type.
@@ -162,9 +162,9 @@ impl<'a, A: Accel> Tracer<'a, A> {
     /// The value of sample-grid position `(i, j)`: its centre with one sample, else the
     /// mean of `spp` stratified samples (a Hammersley set rotated per pixel by a hash
     /// of its coordinates, so the result does not depend on the thread schedule).
-    pub(super) fn pixel(&self, gen: &RayGen, i: u32, j: u32, counts: &mut RayCounts) -> Vec3 {
+    pub(super) fn pixel(&self, raygen: &RayGen, i: u32, j: u32, counts: &mut RayCounts) -> Vec3 {
         if self.spp == 1 {
-            return self.eye(gen.ray(i as f32 + 0.5, j as f32 + 0.5), counts);
+            return self.eye(raygen.ray(i as f32 + 0.5, j as f32 + 0.5), counts);
         }
         let seed = hash(i.wrapping_mul(0x9e37_79b9) ^ hash(j));
         let (ox, oy) = (unit(hash(seed)), unit(hash(seed ^ 0x5bd1_e995)));
@@ -173,7 +173,7 @@ impl<'a, A: Accel> Tracer<'a, A> {
         for s in 0..n {
             let sx = ((s as f32 + ox) / n as f32).fract();
             let sy = (radical_inverse(s) + oy).fract();
-            sum += self.eye(gen.ray(i as f32 + sx, j as f32 + sy), counts);
+            sum += self.eye(raygen.ray(i as f32 + sx, j as f32 + sy), counts);
         }
         sum / n as f32
     }
@@ -182,17 +182,23 @@ impl<'a, A: Accel> Tracer<'a, A> {
     /// [`Tracer::pixel`] gives them, but with one sample per pixel the tile's eye rays
     /// are cast together first (packets on backends that have them; see
     /// [`RenderSettings::packet_width`]), then each is shaded from its hit.
-    pub(super) fn tile(&self, gen: &RayGen, t: Region, px: &mut Vec<Vec3>, counts: &mut RayCounts) {
+    pub(super) fn tile(
+        &self,
+        raygen: &RayGen,
+        t: Region,
+        px: &mut Vec<Vec3>,
+        counts: &mut RayCounts,
+    ) {
         if self.spp != 1 || self.packet_width == 0 {
             for j in t.y0..t.y1 {
                 for i in t.x0..t.x1 {
-                    px.push(self.pixel(gen, i, j, counts));
+                    px.push(self.pixel(raygen, i, j, counts));
                 }
             }
             return;
         }
         let rays: Vec<Ray> = (t.y0..t.y1)
-            .flat_map(|j| (t.x0..t.x1).map(move |i| gen.ray(i as f32 + 0.5, j as f32 + 0.5)))
+            .flat_map(|j| (t.x0..t.x1).map(move |i| raygen.ray(i as f32 + 0.5, j as f32 + 0.5)))
             .collect();
         let mut hits = vec![None; rays.len()];
         self.accel
@@ -204,8 +210,8 @@ impl<'a, A: Accel> Tracer<'a, A> {
     }
 
     /// The value of the eye ray through continuous film position `(px, py)`.
-    pub(super) fn sample(&self, gen: &RayGen, px: f32, py: f32, counts: &mut RayCounts) -> Vec3 {
-        self.eye(gen.ray(px, py), counts)
+    pub(super) fn sample(&self, raygen: &RayGen, px: f32, py: f32, counts: &mut RayCounts) -> Vec3 {
+        self.eye(raygen.ray(px, py), counts)
     }
 
     fn eye(&self, ray: Ray, counts: &mut RayCounts) -> Vec3 {

@@ -1,18 +1,18 @@
 //! The backend-free scene: camera, lights, materials and primitives. No I/O here; the
 //! loaders in [`crate::load`] build it and the backends in [`crate::accel`] read it.
 
+use crate::Hit;
 use crate::accel::NO_INSTANCE;
 use crate::geometry::{
     Cone, Csg, Intersect, Kind, Param, QuadUv, Shape, ShapeHit, Sphere, SurfacePoint, Triangle,
 };
 use crate::math::{Aabb, Ray, Vec3, Xform};
-use crate::Hit;
 use glam::Vec2;
 
 pub mod range;
 pub mod texture;
 
-pub use texture::{Environment, Maps, Texture, NO_TEXTURE};
+pub use texture::{Environment, Maps, NO_TEXTURE, Texture};
 
 /// The NFF viewpoint (`v`): see DESIGN.md §3 for the exact ray construction.
 #[derive(Clone, Copy, Debug, PartialEq)]

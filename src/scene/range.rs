@@ -121,9 +121,11 @@ mod tests {
         let b = Aabb::from_points(Vec3::splat(-1.0), Vec3::splat(1.0));
         assert!(check_bounds("a sphere", &b).is_ok());
         let far = Aabb::from_points(Vec3::splat(-1.0), Vec3::new(1.0, 2e9, 1.0));
-        assert!(check_bounds("a sphere", &far)
-            .unwrap_err()
-            .contains("a sphere reaches"));
+        assert!(
+            check_bounds("a sphere", &far)
+                .unwrap_err()
+                .contains("a sphere reaches")
+        );
         let plane = Aabb {
             min: Vec3::splat(f32::NEG_INFINITY),
             max: Vec3::splat(f32::INFINITY),

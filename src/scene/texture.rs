@@ -263,11 +263,7 @@ impl Texture {
             Texture::Image(img) => img.bilinear(uv),
             Texture::Checker { a, b, scale } => {
                 let i = (uv.x * scale).floor() as i64 + (uv.y * scale).floor() as i64;
-                if i.rem_euclid(2) == 0 {
-                    *a
-                } else {
-                    *b
-                }
+                if i.rem_euclid(2) == 0 { *a } else { *b }
             }
             Texture::Marble { a, b, scale } => {
                 let q = p * *scale;

@@ -106,9 +106,10 @@ mod tests {
         assert!(s.contains("RTC_ERROR_OUT_OF_MEMORY (error code 4)"), "{s}");
         assert!(s.contains("not enough memory"), "{s}");
         let e = EmbreeError::embree("rtcNewDevice", 2, "unknown config option");
-        assert!(e
-            .to_string()
-            .ends_with("RTC_ERROR_INVALID_ARGUMENT (error code 2): unknown config option"));
+        assert!(
+            e.to_string()
+                .ends_with("RTC_ERROR_INVALID_ARGUMENT (error code 2): unknown config option")
+        );
         assert_eq!(e.code(), Some(2));
         assert_eq!(e.message(), "unknown config option");
     }

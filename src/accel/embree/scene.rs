@@ -5,7 +5,7 @@ use super::device::Device;
 use super::error::EmbreeError;
 use super::sys;
 use super::user::{self, UserPrims, UserShape};
-use crate::accel::{add_kind, Hit, NO_INSTANCE};
+use crate::accel::{Hit, NO_INSTANCE, add_kind};
 use crate::geometry::{Cone, Intersect, Kind, Shape, Sphere, Triangle};
 use crate::math::{Ray, Vec3, Xform};
 use crate::scene::Geometry as SceneGeometry;

@@ -612,7 +612,7 @@ fn packets_with_an_unbounded_plane_fall_back_to_single_rays() {
 /// byte for byte, on a scene of analytic shapes.
 #[test]
 fn packet_width_does_not_change_a_render_of_spheres() {
-    let nff = crate::gen::Database::Balls.generate(1);
+    let nff = crate::spd::Database::Balls.generate(1);
     let s = crate::load::nff::parse_str(&nff, std::path::Path::new("balls.nff")).expect("balls");
     let accel = build(&s);
     let mut settings = crate::render::RenderSettings::for_scene(&s);
@@ -627,9 +627,10 @@ fn packet_width_does_not_change_a_render_of_spheres() {
         })
         .collect();
     for img in &images[1..] {
-        assert!(img
-            .iter()
-            .zip(&images[0])
-            .all(|(a, b)| a.to_bits() == b.to_bits()));
+        assert!(
+            img.iter()
+                .zip(&images[0])
+                .all(|(a, b)| a.to_bits() == b.to_bits())
+        );
     }
 }

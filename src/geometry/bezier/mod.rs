@@ -63,9 +63,9 @@ mod tessellate;
 
 pub use curve::BezierCurve;
 pub use patch::BezierPatch;
-pub use tessellate::{tessellate, TriMesh, MAX_LEVEL};
+pub use tessellate::{MAX_LEVEL, TriMesh, tessellate};
 
-/// Newell's teapot (the data of the `teapot` database in [`crate::gen`]) as 32
+/// Newell's teapot (the data of the `teapot` database in [`crate::spd`]) as 32
 /// bicubic patches: rim 0–3, body 4–11, handle 12–15, spout 16–19, lid 20–27, bottom
 /// 28–31.
 ///

@@ -117,11 +117,7 @@ fn golden_min(g: &impl Fn(f64) -> f64, mut a: f64, mut b: f64) -> f64 {
             break;
         }
     }
-    if gc < gd {
-        c
-    } else {
-        d
-    }
+    if gc < gd { c } else { d }
 }
 
 /// The nearest crossing `t > tmin`.

@@ -19,19 +19,19 @@ use super::format::{
     LightDef, MaterialDef, ObjectDef, Real, Scale, SceneFile, Spanned, TextureDef, TransformList,
     TransformStep, V3,
 };
-use super::{suggest, SceneSettings, Source, MAX_SIDE};
-use crate::geometry::bezier::{teapot_patches, tessellate, BezierPatch};
+use super::{MAX_SIDE, SceneSettings, Source, suggest};
+use crate::geometry::bezier::{BezierPatch, teapot_patches, tessellate};
 use crate::geometry::polygon::Triangulator;
 use crate::geometry::{
     AaBox, CappedCone, Cone, Csg, CsgOp, CsgTree, OBox, Plane, Polyhedron, QuadUv, Quadric, Shape,
     Sphere, Torus, Triangle,
 };
-use crate::load::{nff, obj, LoadError};
+use crate::load::{LoadError, nff, obj};
 use crate::math::{Aabb, Vec3, Xform};
 use crate::scene::texture::{Image, Wrap};
 use crate::scene::{
-    range, Camera, Environment, Geometry, GeometryMark, Instance, Light, LoadStats, Maps, Material,
-    Scene, Spot, Texture, INHERIT,
+    Camera, Environment, Geometry, GeometryMark, INHERIT, Instance, Light, LoadStats, Maps,
+    Material, Scene, Spot, Texture, range,
 };
 use glam::{Affine3A, DAffine3, DMat3, DMat4, DQuat, DVec3, Quat};
 use std::collections::HashMap;
@@ -782,7 +782,7 @@ impl<'a, 's> Builder<'a, 's> {
                         return Err(self.err(
                             span,
                             format!("unknown wrap mode `{w}` (expected `repeat` or `clamp`)"),
-                        ))
+                        ));
                     }
                 };
                 Ok(Texture::Image(Arc::new(img)))
@@ -878,7 +878,7 @@ impl<'a, 's> Builder<'a, 's> {
                             "unknown light type `{other}`{}; light types: point, spot",
                             did_you_mean(other, ["point", "spot"])
                         ),
-                    ))
+                    ));
                 }
             },
         };
@@ -932,10 +932,10 @@ impl<'a, 's> Builder<'a, 's> {
                     return Err(self.err(
                         t.span(),
                         "a spot light takes `direction` or `target`, not both",
-                    ))
+                    ));
                 }
                 (None, None) => {
-                    return Err(self.err(def.span(), "a spot light needs `direction` or `target`"))
+                    return Err(self.err(def.span(), "a spot light needs `direction` or `target`"));
                 }
             };
             let cutoff = match &l.cutoff {
@@ -1329,13 +1329,13 @@ impl<'a, 's> Builder<'a, 's> {
                     (Some(_), Some(h)) => {
                         return Err(
                             self.err(h.span(), "an obox takes `size` or `half_size`, not both")
-                        )
+                        );
                     }
                     (None, None) => {
                         return Err(self.err(
                             node.span(),
                             "missing key `size` (or `half_size`) for an obox",
-                        ))
+                        ));
                     }
                 };
                 let b = match (&o.rotation, &o.axes) {
@@ -1365,7 +1365,7 @@ impl<'a, 's> Builder<'a, 's> {
                     (Some(_), Some(a)) => {
                         return Err(
                             self.err(a.span(), "an obox takes `rotation` or `axes`, not both")
-                        )
+                        );
                     }
                 };
                 Ok(Shape::OBox(Arc::new(b)))
@@ -1460,7 +1460,7 @@ impl<'a, 's> Builder<'a, 's> {
                         return Err(self.err(
                             node.span(),
                             "missing key `planes`, `preset` or `sides` for a polyhedron",
-                        ))
+                        ));
                     }
                     _ => {
                         let second = [
@@ -1994,17 +1994,17 @@ impl<'a, 's> Builder<'a, 's> {
                             "unknown built-in patch set `{other}`{}; built-ins: teapot",
                             did_you_mean(other, ["teapot"])
                         ),
-                    ))
+                    ));
                 }
             },
             (Some(_), Some(b)) => {
-                return Err(self.err(b.span(), "a bezier takes `patches` or `builtin`, not both"))
+                return Err(self.err(b.span(), "a bezier takes `patches` or `builtin`, not both"));
             }
             (None, None) => {
                 return Err(self.err(
                     node.span(),
                     "missing key `patches` (or `builtin`) for a bezier",
-                ))
+                ));
             }
         };
         let mirror = x.matrix3.determinant() < 0.0;

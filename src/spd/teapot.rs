@@ -18,7 +18,7 @@
 //! so that the printed rounding noise (e.g. normals `1.4538e-15 -1.67359e-15 1`)
 //! comes out the same.
 
-use super::{phong_power, NffWriter};
+use super::{NffWriter, phong_power};
 use glam::DVec3;
 
 /// The SPD program's default size factor.

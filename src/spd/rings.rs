@@ -12,7 +12,7 @@
 //! 5·n(n+1)(2n+1) of each (30, 150, 420, …, 4200 at 7), plus the wall polygon.
 
 use super::tx::{rotate, transform_point};
-use super::{phong_power, NffWriter};
+use super::{NffWriter, phong_power};
 use glam::DVec3;
 use std::f64::consts::PI;
 

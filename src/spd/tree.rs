@@ -12,8 +12,8 @@
 //! from depth `size` down to 0, so size factor `n` gives `2ⁿ⁺¹ − 1` cones and as many
 //! spheres (4095 of each at the default 11), plus the one field polygon.
 
-use super::tx::{multiply, rotate, transform_point, Matrix, IDENTITY};
 use super::NffWriter;
+use super::tx::{IDENTITY, Matrix, multiply, rotate, transform_point};
 use glam::DVec3;
 use std::f64::consts::PI;
 
@@ -138,7 +138,7 @@ mod tests {
     use super::*;
     use std::path::Path;
 
-    fn gen(size: u32) -> String {
+    fn nff(size: u32) -> String {
         let mut w = NffWriter::new();
         generate(size, &mut w);
         w.finish()
@@ -147,7 +147,7 @@ mod tests {
     #[test]
     fn counts_follow_two_to_the_size_plus_one_minus_one() {
         for size in 0..=6 {
-            let text = gen(size);
+            let text = nff(size);
             let n = (1usize << (size + 1)) - 1;
             assert_eq!(text.lines().filter(|l| l.starts_with("c ")).count(), n);
             assert_eq!(text.lines().filter(|l| l.starts_with("s ")).count(), n);
@@ -206,7 +206,7 @@ mod tests {
 
     #[test]
     fn spheres_cap_every_joint() {
-        let text = gen(3);
+        let text = nff(3);
         let lines: Vec<&str> = text.lines().collect();
         let mut cones = 0;
         for (i, l) in lines.iter().enumerate() {
@@ -223,7 +223,7 @@ mod tests {
 
     #[test]
     fn output_parses_with_the_expected_counts() {
-        let text = gen(3);
+        let text = nff(3);
         let scene = crate::load::nff::parse_str(&text, Path::new("x")).unwrap();
         assert_eq!(scene.cones.len(), 15);
         assert_eq!(scene.spheres.len(), 15);

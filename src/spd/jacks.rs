@@ -11,8 +11,8 @@
 //! A jack is 3 cylinders and 6 spheres; size factor `n` nests `n` levels deep, so there
 //! are (8ⁿ − 1)/7 jacks: 9·(8ⁿ − 1)/7 primitives (9, 81, 657, 5265, 42129, …).
 
-use super::tx::{multiply, Matrix, IDENTITY};
-use super::{phong_power, NffWriter};
+use super::tx::{IDENTITY, Matrix, multiply};
+use super::{NffWriter, phong_power};
 use glam::DVec3;
 use std::f64::consts::PI;
 
@@ -276,9 +276,11 @@ mod tests {
         for (i, a) in dirs.iter().enumerate() {
             for b in &dirs[i + 1..] {
                 let d = (*a - *b).length();
-                assert!([1.0, 2f64.sqrt(), 3f64.sqrt()]
-                    .iter()
-                    .any(|e| (d - e).abs() < 1e-5));
+                assert!(
+                    [1.0, 2f64.sqrt(), 3f64.sqrt()]
+                        .iter()
+                        .any(|e| (d - e).abs() < 1e-5)
+                );
             }
         }
     }

@@ -16,8 +16,8 @@
 //! the order the SPD's vector library does, row-vector matrices included, so the
 //! printed numbers are the SPD's to the last digit.
 
-use super::tx::{rotate, rotate_axis, transform_coord_w0, IDENTITY};
-use super::{phong_power, NffWriter};
+use super::tx::{IDENTITY, rotate, rotate_axis, transform_coord_w0};
+use super::{NffWriter, phong_power};
 use glam::DVec3;
 use std::f64::consts::PI;
 
@@ -272,6 +272,6 @@ mod tests {
             let half = (ang * PI / 180.0f64).cos().powf(p);
             assert!((half - 0.5).abs() < 1e-12, "{ang}: {p}");
         }
-        assert_eq!(crate::gen::fmt_g(phong_power(37.0)), "3.0827");
+        assert_eq!(crate::spd::fmt_g(phong_power(37.0)), "3.0827");
     }
 }

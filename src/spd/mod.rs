@@ -457,21 +457,31 @@ mod tests {
             Database::parse_spec("spd:tetra?size=3"),
             Ok(Some((Database::Tetra, 3)))
         );
-        assert!(Database::parse_spec("spd:nope")
-            .unwrap_err()
-            .contains("unknown database"));
-        assert!(Database::parse_spec("spd:balls?size=x")
-            .unwrap_err()
-            .contains("whole number"));
-        assert!(Database::parse_spec("spd:balls?size=0")
-            .unwrap_err()
-            .contains("out of range"));
-        assert!(Database::parse_spec("spd:balls?size=99")
-            .unwrap_err()
-            .contains("out of range"));
-        assert!(Database::parse_spec("spd:balls?depth=2")
-            .unwrap_err()
-            .contains("?size=N"));
+        assert!(
+            Database::parse_spec("spd:nope")
+                .unwrap_err()
+                .contains("unknown database")
+        );
+        assert!(
+            Database::parse_spec("spd:balls?size=x")
+                .unwrap_err()
+                .contains("whole number")
+        );
+        assert!(
+            Database::parse_spec("spd:balls?size=0")
+                .unwrap_err()
+                .contains("out of range")
+        );
+        assert!(
+            Database::parse_spec("spd:balls?size=99")
+                .unwrap_err()
+                .contains("out of range")
+        );
+        assert!(
+            Database::parse_spec("spd:balls?depth=2")
+                .unwrap_err()
+                .contains("?size=N")
+        );
     }
 
     #[test]

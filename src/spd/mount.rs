@@ -15,7 +15,7 @@
 //! 3.x made the fix optional).
 
 use super::tx::{rotate, rotate_axis, transform_vector};
-use super::{phong_power, NffWriter};
+use super::{NffWriter, phong_power};
 use glam::DVec3;
 use std::f64::consts::PI;
 
@@ -216,7 +216,7 @@ mod tests {
     use std::collections::HashMap;
     use std::path::Path;
 
-    fn gen(size: u32) -> String {
+    fn nff(size: u32) -> String {
         let mut w = NffWriter::new();
         generate(size, &mut w);
         w.finish()
@@ -236,7 +236,7 @@ mod tests {
     #[test]
     fn counts_follow_two_times_four_to_the_size() {
         for size in 0..=4 {
-            let text = gen(size);
+            let text = nff(size);
             let tris = text.lines().filter(|l| *l == "p 3").count();
             assert_eq!(tris, 2 * 4usize.pow(size), "size {size}");
             assert_eq!(text.lines().filter(|l| l.starts_with("s ")).count(), 4);
@@ -297,7 +297,7 @@ mod tests {
             // Interior edges are shared by exactly two triangles; the 4n border edges
             // belong to one.
             assert!(edges.values().all(|&c| c == 1 || c == 2));
-            let border: Vec<_> = edges.iter().filter(|(_, &c)| c == 1).collect();
+            let border: Vec<_> = edges.iter().filter(|&(_, &c)| c == 1).collect();
             assert_eq!(border.len(), 4 * n, "size {size}");
             for ((a, b), _) in border {
                 let on_border = |p: &[u64; 3]| {
@@ -317,7 +317,7 @@ mod tests {
 
     #[test]
     fn output_parses_with_the_expected_counts() {
-        let text = gen(2);
+        let text = nff(2);
         let scene = crate::load::nff::parse_str(&text, Path::new("x")).unwrap();
         assert_eq!(scene.spheres.len(), 4);
         assert_eq!(scene.triangles.len(), 32);

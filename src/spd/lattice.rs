@@ -6,7 +6,7 @@
 //! radius 1/(16n), each starting and ending just inside the spheres it joins.
 //! Everything gets its own `f` line before it, as the SPD program writes them.
 
-use super::{phong_power, NffWriter};
+use super::{NffWriter, phong_power};
 use glam::DVec3;
 
 /// The SPD program's default size factor: `lattice.c` starts with

@@ -11,7 +11,7 @@
 //! Size factor `n`: n³ gears, each 2 + 144 polygons, plus the ground square:
 //! 146·n³ + 1 polygons (147, 1169, 3943, 9345, …).
 
-use super::{phong_power, NffWriter};
+use super::{NffWriter, phong_power};
 use glam::DVec3;
 use std::f64::consts::PI;
 
@@ -206,11 +206,7 @@ fn fraction(a: f64) -> f64 {
 
 /// C's `MAX(a, b)`: `a > b ? a : b`.
 fn c_max(a: f64, b: f64) -> f64 {
-    if a > b {
-        a
-    } else {
-        b
-    }
+    if a > b { a } else { b }
 }
 
 #[cfg(test)]
