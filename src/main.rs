@@ -468,9 +468,6 @@ fn render_one(args: &RenderArgs, scene_path: Option<&Path>, out: &Path) -> Resul
         settings.spp = 1;
         settings.max_depth = 5;
     }
-    settings.embree_quality = args.embree_quality.into();
-    settings.embree_robust = args.embree_robust;
-    settings.packet_width = args.packet_width;
     settings.bailout = args.bailout.unwrap_or(if args.spd {
         0.0
     } else {
@@ -484,6 +481,12 @@ fn render_one(args: &RenderArgs, scene_path: Option<&Path>, out: &Path) -> Resul
     }
     settings.skip = !args.no_skip;
     let backend = job.backend();
+    let options = emray::accel::BackendOptions {
+        backend,
+        embree_quality: args.embree_quality.into(),
+        embree_robust: args.embree_robust,
+        packet_width: args.packet_width,
+    };
     let (w, h) = (settings.width, settings.height);
     settings.region = match (args.tile, args.crop) {
         (Some((i, n)), _) => Some(emray::Region::band(i, n, w, h)),
@@ -534,14 +537,14 @@ fn render_one(args: &RenderArgs, scene_path: Option<&Path>, out: &Path) -> Resul
         emray::run::render_two_pass(
             &name,
             &scene,
-            backend,
+            options,
             &settings,
             &rad,
             load_ms,
             Some(&progress),
         )?
     } else {
-        emray::run::render_scene(&name, &scene, backend, &settings, load_ms, Some(&progress))?
+        emray::run::render_scene(&name, &scene, options, &settings, load_ms, Some(&progress))?
     };
     if let Some(b) = &bar {
         b.finish_and_clear();

@@ -1,7 +1,7 @@
 //! One render from start to end, with the phases timed separately (the SPD rule:
 //! preprocessing apart from ray tracing): load, build the backend, render.
 
-use crate::accel::{Accel, AccelError, AccelStats, Backend};
+use crate::accel::{self, Accel, AccelError, AccelStats, BackendOptions, WithAccel};
 use crate::geometry::Kind;
 use crate::radiosity::{RadiosityError, RadiositySettings};
 use crate::render::{self, Film, Progress, RenderSettings, RenderStats};
@@ -189,52 +189,6 @@ impl Report {
     }
 }
 
-/// Work to do with a built backend, generic over it: [`with_accel`] builds the backend
-/// and hands it over, so that everything below is monomorphised per backend.
-pub trait WithAccel {
-    /// What the work returns.
-    type Output;
-    /// Do the work with `accel`, built in `build_ms` milliseconds.
-    fn run<A: Accel>(self, accel: &A, build_ms: f64) -> Self::Output;
-}
-
-/// Build `backend` over `scene` (timed, with the build options of `settings`) and run
-/// `work` with it on the current rayon pool. This is the one place the backend is chosen.
-pub fn with_accel<W: WithAccel>(
-    scene: &Scene,
-    backend: Backend,
-    settings: &RenderSettings,
-    work: W,
-) -> Result<W::Output, AccelError> {
-    let t0 = Instant::now();
-    let ms = |t: Instant| t.elapsed().as_secs_f64() * 1e3;
-    match backend {
-        Backend::Bvh => {
-            let accel = crate::accel::bvh::Bvh::build(scene);
-            let build = ms(t0);
-            Ok(work.run(&accel, build))
-        }
-        #[cfg(feature = "embree")]
-        Backend::Embree => {
-            // Embree builds with as many threads as the pool renders with.
-            let config = format!("threads={}", rayon::current_num_threads());
-            let accel = crate::accel::embree::EmbreeAccel::build_with(
-                scene,
-                &config,
-                settings.embree_quality,
-                settings.embree_robust,
-            )?;
-            let build = ms(t0);
-            Ok(work.run(&accel, build))
-        }
-        #[cfg(not(feature = "embree"))]
-        Backend::Embree => {
-            let _ = settings;
-            Err(AccelError::Unavailable("embree"))
-        }
-    }
-}
-
 /// A full render with its report.
 struct RenderWork<'a> {
     name: &'a str,
@@ -265,19 +219,19 @@ impl WithAccel for RenderWork<'_> {
     }
 }
 
-/// Build `backend` over `scene` and render it on the current rayon pool.
+/// Build the backend (a [`Backend`] with the default options, or [`BackendOptions`])
+/// over `scene` and render it on the current rayon pool.
 pub fn render_scene(
     name: &str,
     scene: &Scene,
-    backend: Backend,
+    backend: impl Into<BackendOptions>,
     settings: &RenderSettings,
     load_ms: f64,
     progress: Option<Progress<'_>>,
 ) -> Result<(Film, Report), AccelError> {
-    with_accel(
+    accel::build(
         scene,
-        backend,
-        settings,
+        &backend.into(),
         RenderWork {
             name,
             scene,
@@ -288,68 +242,70 @@ pub fn render_scene(
     )
 }
 
-#[allow(clippy::too_many_arguments)]
-fn two_pass<A: Accel>(
-    name: &str,
-    scene: &Scene,
-    accel: &A,
-    settings: &RenderSettings,
-    rad: &RadiositySettings,
+/// The two-pass render with its report.
+struct TwoPassWork<'a> {
+    name: &'a str,
+    scene: &'a Scene,
+    settings: &'a RenderSettings,
+    rad: &'a RadiositySettings,
     load_ms: f64,
-    build_ms: f64,
-    progress: Option<Progress<'_>>,
-) -> Result<(Film, Report), RadiosityError> {
-    let sol = crate::radiosity::solve(scene, accel, rad)?;
-    log::info!(
-        "radiosity: {} elements, {} shots, residual {:.2e}, form factors {:.0} ms, solve {:.0} ms",
-        sol.mesh.elements.len(),
-        sol.solve.iterations,
-        sol.solve.residuals.last().copied().unwrap_or(0.0),
-        sol.solve.form_factor_ms,
-        sol.solve.total_ms
-    );
-    let (film, stats) = render::render_with_gi(scene, accel, settings, Some(&sol), progress);
-    let t = Timings {
-        load: load_ms,
-        // The view-independent solve is preprocessing, like the build.
-        build: build_ms + sol.solve.total_ms,
-        render: stats.render_ms,
-    };
-    let report = Report::new(name, scene, settings, &accel.stats(), t, &stats);
-    Ok((film, report))
+    progress: Option<Progress<'a>>,
 }
 
-/// Two-pass rendering: build `backend` over `scene`, solve its radiosity with the
+impl WithAccel for TwoPassWork<'_> {
+    type Output = Result<(Film, Report), RadiosityError>;
+    fn run<A: Accel>(self, accel: &A, build_ms: f64) -> Self::Output {
+        let sol = crate::radiosity::solve(self.scene, accel, self.rad)?;
+        log::info!(
+            "radiosity: {} elements, {} shots, residual {:.2e}, form factors {:.0} ms, solve {:.0} ms",
+            sol.mesh.elements.len(),
+            sol.solve.iterations,
+            sol.solve.residuals.last().copied().unwrap_or(0.0),
+            sol.solve.form_factor_ms,
+            sol.solve.total_ms
+        );
+        let (film, stats) =
+            render::render_with_gi(self.scene, accel, self.settings, Some(&sol), self.progress);
+        let t = Timings {
+            load: self.load_ms,
+            // The view-independent solve is preprocessing, like the build.
+            build: build_ms + sol.solve.total_ms,
+            render: stats.render_ms,
+        };
+        let report = Report::new(
+            self.name,
+            self.scene,
+            self.settings,
+            &accel.stats(),
+            t,
+            &stats,
+        );
+        Ok((film, report))
+    }
+}
+
+/// Two-pass rendering: build the backend over `scene`, solve its radiosity with the
 /// backend's visibility, then render with the diffuse term of meshed surfaces from
 /// the solution and the specular paths from the Whitted recursion. The solve counts
 /// as build (preprocessing) time.
 pub fn render_two_pass(
     name: &str,
     scene: &Scene,
-    backend: Backend,
+    backend: impl Into<BackendOptions>,
     settings: &RenderSettings,
     rad: &RadiositySettings,
     load_ms: f64,
     progress: Option<Progress<'_>>,
 ) -> Result<(Film, Report), RadiosityError> {
-    let t0 = Instant::now();
-    let ms = |t: Instant| t.elapsed().as_secs_f64() * 1e3;
-    match backend {
-        Backend::Bvh => {
-            let accel = crate::accel::bvh::Bvh::build(scene);
-            let b = ms(t0);
-            two_pass(name, scene, &accel, settings, rad, load_ms, b, progress)
-        }
-        #[cfg(feature = "embree")]
-        Backend::Embree => {
-            let accel =
-                crate::accel::embree::EmbreeAccel::build(scene).map_err(AccelError::from)?;
-            let b = ms(t0);
-            two_pass(name, scene, &accel, settings, rad, load_ms, b, progress)
-        }
-        #[cfg(not(feature = "embree"))]
-        Backend::Embree => Err(AccelError::Unavailable("embree").into()),
-    }
+    let work = TwoPassWork {
+        name,
+        scene,
+        settings,
+        rad,
+        load_ms,
+        progress,
+    };
+    accel::build(scene, &backend.into(), work)?
 }
 
 /// Render `scene` with the f64 reference renderer ([`render::reference`]) using

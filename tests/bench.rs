@@ -127,7 +127,7 @@ fn raw_casting_replays_exactly_the_rays_of_the_render() {
     // The eye rays went in batches, one per tile, which raw casting replays as batches.
     let batches: Vec<raw::Batch> = queries.iter().filter_map(|q| q.batch).collect();
     assert_eq!(batches.len(), 1, "13x13 corner rays: one 16x16 tile");
-    assert_eq!(batches[0], raw::Batch { len: 169, width: 8 });
+    assert_eq!(batches[0], raw::Batch { len: 169 });
     let cast = pool.install(|| raw::cast(&accel, &queries));
     assert_eq!(cast.queries, counts.total());
     // Eye rays that hit, reflection rays that hit and occluded shadow rays, found again

@@ -4,12 +4,13 @@
 //! texel behind the camera, OBJ `vt`/MTL maps as documented, and backend agreement.
 
 use emray::Hit;
+use emray::accel::WithAccel;
 use emray::accel::{Accel, Backend};
 use emray::geometry::{Kind, Sphere, Triangle, inverse_bilinear};
 use emray::load::obj::{MISSING_TEXTURE, load_geometry};
 use emray::math::{Ray, Vec3};
 use emray::render::RenderSettings;
-use emray::run::{WithAccel, render_scene, with_accel};
+use emray::run::render_scene;
 use emray::scene::texture::{Image, NO_TEXTURE, Wrap, bump_normal, srgb_to_linear};
 use emray::scene::{Camera, Environment, Light, Maps, Material, Scene, Texture};
 use glam::Vec2;
@@ -626,9 +627,8 @@ fn quad_faces_take_the_inverse_bilinear_uv() {
             .map(|&(s, t)| Ray::new(bilinear_point(quad, s, t) + Vec3::Z * 5.0, -Vec3::Z))
             .collect();
         for backend in backends() {
-            let settings = RenderSettings::for_scene(scene);
             let work = UvAtHits { scene, rays: &rays };
-            let got = with_accel(scene, backend, &settings, work).unwrap();
+            let got = emray::accel::build(scene, &backend.into(), work).unwrap();
             let mut bend = 0.0f32;
             for (&(s, t), (uv, bary)) in samples.iter().zip(&got) {
                 let err = (*uv - Vec2::new(s, t)).abs().max_element();

@@ -7,38 +7,10 @@ pub mod bvh;
 pub mod embree;
 
 use crate::geometry::Kind;
-use crate::math::{Ray, Vec3};
+use crate::math::Ray;
+use crate::scene::Scene;
 
-/// The nearest hit along a ray.
-#[derive(Clone, Copy, Debug, PartialEq)]
-pub struct Hit {
-    /// Ray parameter.
-    pub t: f32,
-    /// Geometry id: a [`Kind`] discriminant.
-    pub geom_id: u32,
-    /// Index of the primitive within its kind.
-    pub prim_id: u32,
-    /// First surface parameter (triangles: barycentric weight of vertex 1).
-    pub u: f32,
-    /// Second surface parameter (triangles: barycentric weight of vertex 2).
-    pub v: f32,
-    /// Geometric normal, not normalised; for triangles `(p1 − p0) × (p2 − p0)`. In the
-    /// object space of the instance for instanced hits.
-    pub ng: Vec3,
-    /// Index of the instance hit ([`crate::scene::Scene::instances`]), or
-    /// [`NO_INSTANCE`] for top-level primitives.
-    pub inst_id: u32,
-}
-
-/// [`Hit::inst_id`] of a top-level primitive.
-pub const NO_INSTANCE: u32 = u32::MAX;
-
-impl Hit {
-    /// The primitive kind hit.
-    pub fn kind(&self) -> Kind {
-        Kind::from_id(self.geom_id).expect("invalid geometry id")
-    }
-}
+pub use crate::scene::{Hit, NO_INSTANCE};
 
 /// What a backend reports about itself.
 #[derive(Clone, Debug, Default, PartialEq)]
@@ -90,11 +62,10 @@ pub trait Accel: Sync {
     /// Whether anything lies in `(ray.tmin, ray.tmax)` (any-hit, for shadow rays).
     fn occluded(&self, ray: &Ray) -> bool;
     /// The nearest hits of a batch of coherent rays (`hits[i]` for `rays[i]`; the
-    /// slices have the same length), each as [`Accel::intersect`] would find it.
-    /// `width` asks for packets of that many rays (4, 8 or 16) where the backend has
-    /// them (Embree); the default, and width 0, cast the rays one at a time.
-    fn intersect_coherent(&self, rays: &[Ray], hits: &mut [Option<Hit>], width: usize) {
-        let _ = width;
+    /// slices have the same length), each as [`Accel::intersect`] would find it. A
+    /// backend with ray packets casts them in packets of the width it was built with
+    /// ([`BackendOptions::packet_width`]); the default casts them one at a time.
+    fn intersect_coherent(&self, rays: &[Ray], hits: &mut [Option<Hit>]) {
         for (ray, hit) in rays.iter().zip(hits.iter_mut()) {
             *hit = self.intersect(ray);
         }
@@ -128,6 +99,96 @@ impl Backend {
         } else {
             Backend::Bvh
         }
+    }
+}
+
+/// Which backend to build, and how: everything about the acceleration structure that a
+/// render does not need to know. The BVH ignores the Embree options.
+#[derive(Clone, Copy, Debug, PartialEq, Eq, Hash)]
+pub struct BackendOptions {
+    /// The backend.
+    pub backend: Backend,
+    /// Embree's build quality.
+    pub embree_quality: EmbreeQuality,
+    /// Embree's `RTC_SCENE_FLAG_ROBUST` on every scene it commits (the BVH is
+    /// watertight anyway).
+    pub embree_robust: bool,
+    /// Coherent rays (a tile's eye rays with one sample per pixel) are cast in packets
+    /// of this many (4, 8 or 16: Embree's `rtcIntersect4/8/16`); 0 casts them one by
+    /// one. Analytic shapes give the same hits either way; Embree's packet triangle
+    /// test may round a ray through a shared edge to the other triangle.
+    pub packet_width: u32,
+}
+
+/// Eye rays per Embree packet by default.
+pub const DEFAULT_PACKET_WIDTH: u32 = 8;
+
+impl BackendOptions {
+    /// `backend` with the default options: medium build quality, fast traversal,
+    /// packets of [`DEFAULT_PACKET_WIDTH`].
+    pub fn new(backend: Backend) -> Self {
+        BackendOptions {
+            backend,
+            embree_quality: EmbreeQuality::default(),
+            embree_robust: false,
+            packet_width: DEFAULT_PACKET_WIDTH,
+        }
+    }
+}
+
+impl Default for BackendOptions {
+    /// The default backend ([`Backend::default_available`]) with the default options.
+    fn default() -> Self {
+        BackendOptions::new(Backend::default_available())
+    }
+}
+
+impl From<Backend> for BackendOptions {
+    fn from(backend: Backend) -> Self {
+        BackendOptions::new(backend)
+    }
+}
+
+/// Work to do with a built backend, generic over it: [`build`] builds the backend and
+/// hands it over, so that everything below is monomorphised per backend.
+pub trait WithAccel {
+    /// What the work returns.
+    type Output;
+    /// Do the work with `accel`, built in `build_ms` milliseconds.
+    fn run<A: Accel>(self, accel: &A, build_ms: f64) -> Self::Output;
+}
+
+/// Build the backend `options` names over `scene` (timed) and run `work` with it. This
+/// is the one place a backend is chosen and built. Embree builds with as many threads
+/// as the current rayon pool has.
+pub fn build<W: WithAccel>(
+    scene: &Scene,
+    options: &BackendOptions,
+    work: W,
+) -> Result<W::Output, AccelError> {
+    let t0 = std::time::Instant::now();
+    let ms = |t: std::time::Instant| t.elapsed().as_secs_f64() * 1e3;
+    match options.backend {
+        Backend::Bvh => {
+            let accel = bvh::Bvh::build(scene);
+            let build_ms = ms(t0);
+            Ok(work.run(&accel, build_ms))
+        }
+        #[cfg(feature = "embree")]
+        Backend::Embree => {
+            let config = format!("threads={}", rayon::current_num_threads());
+            let accel = embree::EmbreeAccel::build_with(
+                scene,
+                &config,
+                options.embree_quality,
+                options.embree_robust,
+            )?
+            .with_packet_width(options.packet_width);
+            let build_ms = ms(t0);
+            Ok(work.run(&accel, build_ms))
+        }
+        #[cfg(not(feature = "embree"))]
+        Backend::Embree => Err(AccelError::Unavailable("embree")),
     }
 }
 

@@ -8,8 +8,8 @@ pub mod raw;
 pub mod report;
 
 use crate::accel::Backend;
+use crate::accel::{BackendOptions, WithAccel};
 use crate::render::RenderSettings;
-use crate::run::{WithAccel, with_accel};
 use crate::scene::Scene;
 use crate::spd::Database;
 use serde::{Deserialize, Serialize};
@@ -154,12 +154,16 @@ pub fn run_child(spec: &RunSpec) -> Result<RunResult, String> {
         settings.spp = 1;
         settings.max_depth = 5;
     }
-    settings.embree_quality = spec.embree_quality;
-    settings.packet_width = spec.packet_width;
+    let options = BackendOptions {
+        backend,
+        embree_quality: spec.embree_quality,
+        embree_robust: false,
+        packet_width: spec.packet_width,
+    };
     let (build_ms, ms, rays, accel) = pool.install(|| match spec.mode {
         Mode::Render => {
             let (_, rep) =
-                crate::run::render_scene(&spec.scene, &scene, backend, &settings, load_ms, None)
+                crate::run::render_scene(&spec.scene, &scene, options, &settings, load_ms, None)
                     .map_err(|e| e.to_string())?;
             let r = |k: &str| rep.rays.get(k).copied().unwrap_or(0);
             let rays = Rays {
@@ -177,7 +181,7 @@ pub fn run_child(spec: &RunSpec) -> Result<RunResult, String> {
                 settings: &settings,
             };
             let (build_ms, cast, counts, detail) =
-                with_accel(&scene, backend, &settings, work).map_err(|e| e.to_string())?;
+                crate::accel::build(&scene, &options, work).map_err(|e| e.to_string())?;
             Ok((build_ms, cast.ms, Rays::from(counts), detail))
         }
     })?;

@@ -17,8 +17,8 @@ pub struct Query {
     /// `true` for [`Accel::occluded`], `false` for [`Accel::intersect`].
     pub occluded: bool,
     /// Set on the first query of a batch of `len` nearest-hit queries the renderer cast
-    /// together through [`Accel::intersect_coherent`] with this packet `width` (the
-    /// batch's other queries follow it); `None` for everything else.
+    /// together through [`Accel::intersect_coherent`] (the batch's other queries follow
+    /// it; the backend casts them in its own packet width); `None` for everything else.
     pub batch: Option<Batch>,
 }
 
@@ -27,8 +27,6 @@ pub struct Query {
 pub struct Batch {
     /// Queries in the batch, this one included.
     pub len: u32,
-    /// The packet width asked for.
-    pub width: u32,
 }
 
 /// A backend that records every query passed through it, per worker thread (one
@@ -85,17 +83,16 @@ impl<A: Accel> Accel for Recorder<'_, A> {
         self.inner.occluded(ray)
     }
 
-    fn intersect_coherent(&self, rays: &[Ray], hits: &mut [Option<Hit>], width: usize) {
+    fn intersect_coherent(&self, rays: &[Ray], hits: &mut [Option<Hit>]) {
         let batch = Batch {
             len: u32::try_from(rays.len()).unwrap_or(u32::MAX),
-            width: u32::try_from(width).unwrap_or(0),
         };
         self.push(rays.iter().enumerate().map(|(i, ray)| Query {
             ray: *ray,
             occluded: false,
             batch: (i == 0).then_some(batch),
         }));
-        self.inner.intersect_coherent(rays, hits, width);
+        self.inner.intersect_coherent(rays, hits);
     }
 
     fn stats(&self) -> AccelStats {
@@ -147,7 +144,7 @@ pub fn cast<A: Accel>(accel: &A, queries: &[Query]) -> RawCast {
                     rays.extend(chunk[k..k + len].iter().map(|q| q.ray));
                     found.clear();
                     found.resize(len, None);
-                    accel.intersect_coherent(&rays, &mut found, b.width as usize);
+                    accel.intersect_coherent(&rays, &mut found);
                     n += found.iter().filter(|h| h.is_some()).count() as u64;
                     k += len;
                     continue;

@@ -21,7 +21,7 @@ pub mod mesh;
 pub mod solver;
 pub mod tessellate;
 
-use crate::accel::{Accel, AccelError, Backend, Hit};
+use crate::accel::{Accel, AccelError, BackendOptions, Hit, WithAccel};
 use crate::geometry::Kind;
 use crate::math::Vec3;
 use crate::render::{Film, RayGen};
@@ -559,28 +559,32 @@ fn solve_and_view<A: Accel>(
     Ok((sol, film, report))
 }
 
-/// Build `backend` over `scene`, solve, and render one `width × height` view with
+/// Solve and view with a built backend.
+struct SolveAndView<'a> {
+    scene: &'a Scene,
+    settings: &'a RadiositySettings,
+    view: (u32, u32, u32),
+}
+
+impl WithAccel for SolveAndView<'_> {
+    type Output = Result<(Solution, Film, RadiosityReport), RadiosityError>;
+    fn run<A: Accel>(self, accel: &A, build_ms: f64) -> Self::Output {
+        solve_and_view(self.scene, accel, self.settings, self.view, build_ms)
+    }
+}
+
+/// Build the backend over `scene`, solve, and render one `width × height` view with
 /// `spp²` samples per pixel.
 pub fn run(
     scene: &Scene,
-    backend: Backend,
+    backend: impl Into<BackendOptions>,
     settings: &RadiositySettings,
     view: (u32, u32, u32),
 ) -> Result<(Solution, Film, RadiosityReport), RadiosityError> {
-    let t0 = Instant::now();
-    let ms = |t: Instant| t.elapsed().as_secs_f64() * 1e3;
-    match backend {
-        Backend::Bvh => {
-            let accel = crate::accel::bvh::Bvh::build(scene);
-            solve_and_view(scene, &accel, settings, view, ms(t0))
-        }
-        #[cfg(feature = "embree")]
-        Backend::Embree => {
-            let accel =
-                crate::accel::embree::EmbreeAccel::build(scene).map_err(AccelError::from)?;
-            solve_and_view(scene, &accel, settings, view, ms(t0))
-        }
-        #[cfg(not(feature = "embree"))]
-        Backend::Embree => Err(AccelError::Unavailable("embree").into()),
-    }
+    let work = SolveAndView {
+        scene,
+        settings,
+        view,
+    };
+    crate::accel::build(scene, &backend.into(), work)?
 }

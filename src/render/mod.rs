@@ -34,11 +34,6 @@ pub struct RenderSettings {
     pub tile: u32,
     /// Shadow rays per emitting triangle (area light): `area_samples²`, stratified.
     pub area_samples: u32,
-    /// Embree build quality (the BVH backend ignores it).
-    pub embree_quality: crate::accel::EmbreeQuality,
-    /// Embree's `RTC_SCENE_FLAG_ROBUST` on every scene it commits (the BVH backend is
-    /// watertight anyway and ignores it).
-    pub embree_robust: bool,
     /// Antialiasing: uniform `spp` samples per pixel, or adaptive subdivision.
     pub aa: Aa,
     /// Hall & Greenberg's adaptive ray-tree depth: a reflected or refracted ray whose
@@ -52,11 +47,6 @@ pub struct RenderSettings {
     /// Render only this part of the image (`None`: all of it). The film then holds
     /// the region alone; every pixel comes out as in the full render.
     pub region: Option<Region>,
-    /// Primary rays of a tile are cast together, in packets of this many rays (4, 8 or
-    /// 16: Embree's `rtcIntersect4/8/16`; the BVH casts them one by one); 0 casts
-    /// each primary ray on its own. Only with one sample per pixel and uniform
-    /// sampling (SPD mode included); secondary rays are always single.
-    pub packet_width: u32,
 }
 
 /// A rectangle of pixels, `x0..x1` by `y0..y1` (half-open, from the top-left).
@@ -148,13 +138,10 @@ impl RenderSettings {
             spd: false,
             tile: 16,
             area_samples: 4,
-            embree_quality: crate::accel::EmbreeQuality::Medium,
-            embree_robust: false,
             aa: Aa::Uniform,
             bailout: 0.0,
             skip: true,
             region: None,
-            packet_width: 8,
         }
     }
 }

@@ -74,9 +74,6 @@ pub(super) struct Tracer<'a, A: Accel> {
     bailout: f32,
     /// Skip work that cannot change the image (see [`RenderSettings::skip`]).
     skip: bool,
-    /// Primary rays of a tile in packets of this many (see
-    /// [`RenderSettings::packet_width`]); 0 = one by one.
-    packet_width: u32,
 }
 
 /// Van der Corput radical inverse in base 2.
@@ -149,7 +146,6 @@ impl<'a, A: Accel> Tracer<'a, A> {
                 0.0
             },
             skip: s.skip,
-            packet_width: s.packet_width,
         }
     }
 
@@ -181,7 +177,7 @@ impl<'a, A: Accel> Tracer<'a, A> {
     /// The values of the grid positions of tile `t`, row by row, pushed onto `px`: as
     /// [`Tracer::pixel`] gives them, but with one sample per pixel the tile's eye rays
     /// are cast together first (packets on backends that have them; see
-    /// [`RenderSettings::packet_width`]), then each is shaded from its hit.
+    /// [`Accel::intersect_coherent`]), then each is shaded from its hit.
     pub(super) fn tile(
         &self,
         raygen: &RayGen,
@@ -189,7 +185,7 @@ impl<'a, A: Accel> Tracer<'a, A> {
         px: &mut Vec<Vec3>,
         counts: &mut RayCounts,
     ) {
-        if self.spp != 1 || self.packet_width == 0 {
+        if self.spp != 1 {
             for j in t.y0..t.y1 {
                 for i in t.x0..t.x1 {
                     px.push(self.pixel(raygen, i, j, counts));
@@ -201,8 +197,7 @@ impl<'a, A: Accel> Tracer<'a, A> {
             .flat_map(|j| (t.x0..t.x1).map(move |i| raygen.ray(i as f32 + 0.5, j as f32 + 0.5)))
             .collect();
         let mut hits = vec![None; rays.len()];
-        self.accel
-            .intersect_coherent(&rays, &mut hits, self.packet_width as usize);
+        self.accel.intersect_coherent(&rays, &mut hits);
         for (ray, hit) in rays.iter().zip(hits) {
             counts.eye += 1;
             px.push(self.trace_from(ray, hit, 1, Media::AIR, Vec3::ONE, counts));

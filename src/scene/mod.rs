@@ -1,16 +1,17 @@
 //! The backend-free scene: camera, lights, materials and primitives. No I/O here; the
 //! loaders in [`crate::load`] build it and the backends in [`crate::accel`] read it.
 
-use crate::Hit;
-use crate::accel::NO_INSTANCE;
 use crate::geometry::{
     Cone, Csg, Intersect, Kind, Param, QuadUv, Shape, ShapeHit, Sphere, SurfacePoint, Triangle,
 };
 use crate::math::{Aabb, Ray, Vec3, Xform};
 use glam::Vec2;
 
+mod hit;
 pub mod range;
 pub mod texture;
+
+pub use hit::{Hit, NO_INSTANCE};
 
 pub use texture::{Environment, Maps, NO_TEXTURE, Texture};
 

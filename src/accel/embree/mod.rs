@@ -45,6 +45,8 @@ pub struct EmbreeAccel {
     prims: usize,
     bytes: usize,
     detail: String,
+    /// Rays per packet for [`Accel::intersect_coherent`] (0: one by one).
+    packet_width: u32,
 }
 
 impl EmbreeAccel {
@@ -85,7 +87,15 @@ impl EmbreeAccel {
             device,
             prims: scene.prim_count(),
             detail,
+            packet_width: crate::accel::DEFAULT_PACKET_WIDTH,
         })
+    }
+
+    /// Cast coherent rays ([`Accel::intersect_coherent`]) in packets of `width` (4, 8
+    /// or 16; anything else casts them one by one).
+    pub fn with_packet_width(mut self, width: u32) -> Self {
+        self.packet_width = width;
+        self
     }
 
     /// The Embree library version as `major * 10000 + minor * 100 + patch`
@@ -111,8 +121,9 @@ impl Accel for EmbreeAccel {
         self.scene.occluded(ray)
     }
 
-    fn intersect_coherent(&self, rays: &[Ray], hits: &mut [Option<Hit>], width: usize) {
-        self.scene.intersect_packets(rays, hits, width);
+    fn intersect_coherent(&self, rays: &[Ray], hits: &mut [Option<Hit>]) {
+        self.scene
+            .intersect_packets(rays, hits, self.packet_width as usize);
     }
 
     fn stats(&self) -> AccelStats {

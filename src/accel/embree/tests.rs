@@ -569,14 +569,17 @@ fn triangles_spheres_cones() -> Scene {
 #[test]
 fn packets_find_what_single_rays_find() {
     let s = triangles_spheres_cones();
-    let accel = build(&s);
     let rays = packet_rays();
-    let single: Vec<Option<Hit>> = rays.iter().map(|r| accel.intersect(r)).collect();
+    let single: Vec<Option<Hit>> = {
+        let accel = build(&s);
+        rays.iter().map(|r| accel.intersect(r)).collect()
+    };
     let kinds = |k: Kind| single.iter().flatten().filter(|h| h.kind() == k).count();
     assert!(kinds(Kind::Triangle) > 50 && kinds(Kind::Sphere) > 50 && kinds(Kind::Cone) > 10);
     for width in [0, 4, 8, 16] {
+        let accel = build(&s).with_packet_width(width);
         let mut hits = vec![None; rays.len()];
-        accel.intersect_coherent(&rays, &mut hits, width);
+        accel.intersect_coherent(&rays, &mut hits);
         for ((r, a), b) in rays.iter().zip(&single).zip(&hits) {
             match (a, b) {
                 (Some(a), Some(b)) if a.kind() == Kind::Triangle => {
@@ -599,7 +602,7 @@ fn packets_with_an_unbounded_plane_fall_back_to_single_rays() {
     let accel = build(&s);
     let rays = packet_rays();
     let mut hits = vec![None; rays.len()];
-    accel.intersect_coherent(&rays, &mut hits, 8);
+    accel.intersect_coherent(&rays, &mut hits);
     let mut planes = 0;
     for (r, h) in rays.iter().zip(&hits) {
         assert_eq!(*h, accel.intersect(r), "{r:?}");
@@ -614,13 +617,12 @@ fn packets_with_an_unbounded_plane_fall_back_to_single_rays() {
 fn packet_width_does_not_change_a_render_of_spheres() {
     let nff = crate::spd::Database::Balls.generate(1);
     let s = crate::load::nff::parse_str(&nff, std::path::Path::new("balls.nff")).expect("balls");
-    let accel = build(&s);
     let mut settings = crate::render::RenderSettings::for_scene(&s);
     (settings.width, settings.height, settings.spd) = (48, 40, true);
     let images: Vec<Vec<f32>> = [0, 4, 8, 16]
         .iter()
         .map(|&w| {
-            settings.packet_width = w;
+            let accel = build(&s).with_packet_width(w);
             let (film, stats) = crate::render::render(&s, &accel, &settings, None);
             assert_eq!(stats.rays.eye, 49 * 41);
             film.pixels.iter().flat_map(|p| p.to_array()).collect()
