@@ -13,15 +13,13 @@ pub mod bench;
 pub mod geometry;
 pub mod load;
 pub mod math;
-pub mod metrics;
 pub mod output;
+pub mod quality;
 pub mod radiosity;
 pub mod render;
 pub mod run;
 pub mod scene;
 pub mod spd;
-pub mod stress;
-pub mod study;
 
 pub use accel::{Accel, Backend, Hit};
 pub use render::{Region, RenderSettings, RenderStats};

@@ -2,8 +2,10 @@
 //! `emray stress`: the numerical stress cases with their measured numbers.
 
 use clap::Args;
-use emray::metrics::{self, Metrics};
+#[cfg(feature = "quality")]
 use emray::output::Encoding;
+#[cfg(feature = "quality")]
+use emray::quality::metrics::{self, Metrics};
 use std::path::PathBuf;
 use std::process::ExitCode;
 
@@ -34,6 +36,7 @@ pub struct CompareArgs {
 }
 
 /// The table `emray compare` prints.
+#[cfg(feature = "quality")]
 pub fn table(m: &Metrics) -> String {
     format!(
         "rmse       {:.6e}\n\
@@ -52,6 +55,13 @@ pub fn table(m: &Metrics) -> String {
 }
 
 /// Exit status: 0 within the thresholds, 1 a threshold exceeded, 2 a usage or I/O error.
+#[cfg(not(feature = "quality"))]
+pub fn compare(_: &CompareArgs) -> ExitCode {
+    lacking("compare")
+}
+
+/// Exit status: 0 within the thresholds, 1 a threshold exceeded, 2 a usage or I/O error.
+#[cfg(feature = "quality")]
 pub fn compare(a: &CompareArgs) -> ExitCode {
     let run = || -> Result<bool, String> {
         for (name, v) in [("--max-rmse", a.max_rmse), ("--max-flip", a.max_flip)] {
@@ -112,7 +122,7 @@ pub struct StressArgs {
 pub fn stress(a: &StressArgs) -> ExitCode {
     use emray::Backend;
     use emray::accel::bvh::Bvh;
-    use emray::stress::*;
+    use emray::quality::stress::*;
     let mut ok = true;
     let mut check = |cond: bool, what: String| {
         println!("{} {what}", if cond { "ok  " } else { "FAIL" });
@@ -237,6 +247,13 @@ pub struct StudyArgs {
 }
 
 /// Exit status: 0 done, 1 a scene or render error, 2 a usage error.
+#[cfg(not(feature = "quality"))]
+pub fn study(_: &StudyArgs) -> ExitCode {
+    lacking("study")
+}
+
+/// Exit status: 0 done, 1 a scene or render error, 2 a usage error.
+#[cfg(feature = "quality")]
 pub fn study(a: &StudyArgs) -> ExitCode {
     let name = a.scene.display().to_string();
     let scene = match emray::spd::Database::parse_spec(&name) {
@@ -254,11 +271,12 @@ pub fn study(a: &StudyArgs) -> ExitCode {
         backends.push(emray::Backend::Embree);
     }
     let (w, h) = a.res;
-    let result = scene
-        .and_then(|s| emray::study::write(&s, &name, &a.out, w, h, a.reference_strata, &backends));
+    let result = scene.and_then(|s| {
+        emray::quality::study::write(&s, &name, &a.out, w, h, a.reference_strata, &backends)
+    });
     match result {
         Ok(rows) => {
-            print!("{}", emray::study::csv(&rows));
+            print!("{}", emray::quality::study::csv(&rows));
             ExitCode::SUCCESS
         }
         Err(e) => {
@@ -266,4 +284,14 @@ pub fn study(a: &StudyArgs) -> ExitCode {
             ExitCode::from(1)
         }
     }
+}
+
+/// A build without the `quality` feature has no FLIP and no plots.
+#[cfg(not(feature = "quality"))]
+fn lacking(command: &str) -> ExitCode {
+    eprintln!(
+        "emray: error: this emray was built without the `quality` feature, which `{command}` \
+         needs (build with the default features or `--features quality`)"
+    );
+    ExitCode::from(2)
 }

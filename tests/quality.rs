@@ -1,11 +1,15 @@
 //! Error metrics and the speed/accuracy knobs: `emray compare` and its exit status,
 //! adaptive antialiasing, `--bailout`, skipping work that cannot change the image.
+//! The tests that measure error need the `quality` feature (FLIP, the study's plots).
 
 use emray::Scene;
 use emray::accel::Backend;
 use emray::load::nff::parse_str;
-use emray::metrics::compare;
-use emray::render::{Aa, Film, RenderSettings};
+#[cfg(feature = "quality")]
+use emray::quality::metrics::compare;
+#[cfg(feature = "quality")]
+use emray::render::Aa;
+use emray::render::{Film, RenderSettings};
 use emray::run::{Report, render_scene};
 use std::path::Path;
 use std::process::Command;
@@ -30,6 +34,7 @@ fn rays(r: &Report, k: &str) -> u64 {
 }
 
 #[test]
+#[cfg(feature = "quality")]
 fn adaptive_aa_is_deterministic_shares_corners_and_beats_one_sample() {
     let s = scene(MIRRORS);
     let mut st = RenderSettings::for_scene(&s);
@@ -64,6 +69,7 @@ fn adaptive_aa_is_deterministic_shares_corners_and_beats_one_sample() {
 }
 
 #[test]
+#[cfg(feature = "quality")]
 fn bailout_prunes_weak_rays_and_zero_keeps_the_full_tree() {
     let s = scene(MIRRORS);
     let mut st = RenderSettings::for_scene(&s);
@@ -147,6 +153,7 @@ fn emray() -> Command {
 }
 
 #[test]
+#[cfg(feature = "quality")]
 fn compare_reports_metrics_and_exits_by_threshold() {
     let dir = tempfile::tempdir().unwrap();
     let (a, b) = (dir.path().join("a.exr"), dir.path().join("b.exr"));
@@ -201,9 +208,27 @@ fn compare_reports_metrics_and_exits_by_threshold() {
     assert!(String::from_utf8_lossy(&out.stderr).contains("none.png"));
 }
 
+#[test]
+#[cfg(not(feature = "quality"))]
+fn without_the_quality_feature_compare_and_study_say_so() {
+    for args in [
+        &["compare", "a.png", "b.png"][..],
+        &["study", "spd:balls?size=1", "--out", "never"][..],
+    ] {
+        let out = emray().args(args).output().unwrap();
+        assert_eq!(out.status.code(), Some(2), "{args:?}");
+        let err = String::from_utf8_lossy(&out.stderr);
+        assert!(
+            err.starts_with("emray: error: ") && err.contains("`quality` feature"),
+            "{err}"
+        );
+    }
+}
+
 /// A diffuse-and-specular sphere, a mirror, a glass sphere (refraction and total
 /// internal reflection) on a triangle floor, one light: the f32 renderer on both
 /// backends against the f64 reference, same depth, both supersampled.
+#[cfg(feature = "quality")]
 const ANALYTIC: &str = "v\nfrom 0 -5 1.6\nat 0 0 0.6\nup 0 0 1\nangle 40\nhither 0.1\n\
 resolution 20 20\nb 0.2 0.3 0.5\nl 3 -4 5 0.8 0.8 0.8\nl -4 -1 3 0.5 0.5 0.5\n\
 f 0.8 0.7 0.5 0.9 0 0 0 1\np 3 -4 -4 0 4 -4 0 0 4 0\n\
@@ -212,6 +237,7 @@ f 0.9 0.9 0.9 0.1 0.8 40 0 1\ns 1.1 0.4 0.7 0.7\n\
 f 1 1 1 0.05 0.1 60 0.85 1.5\ns 0 -1.2 0.45 0.45\n";
 
 #[test]
+#[cfg(feature = "quality")]
 fn f32_render_agrees_with_the_f64_reference() {
     let s = scene(ANALYTIC);
     assert_eq!(emray::render::reference::unsupported(&s), None);
@@ -257,10 +283,12 @@ fn the_reference_refuses_what_it_does_not_model() {
 }
 
 #[test]
+#[cfg(feature = "quality")]
 fn study_writes_a_row_per_setting_and_a_curve_per_knob() {
     let s = scene(ANALYTIC);
     let dir = tempfile::tempdir().unwrap();
-    let rows = emray::study::write(&s, "analytic", dir.path(), 8, 8, 2, &[Backend::Bvh]).unwrap();
+    let rows =
+        emray::quality::study::write(&s, "analytic", dir.path(), 8, 8, 2, &[Backend::Bvh]).unwrap();
     let csv = std::fs::read_to_string(dir.path().join("study.csv")).unwrap();
     assert_eq!(csv.lines().count(), rows.len() + 1);
     assert!(csv.starts_with("knob,setting,render_ms,rays,rmse,psnr"));
@@ -281,7 +309,7 @@ fn study_writes_a_row_per_setting_and_a_curve_per_knob() {
     // The PNG: the plot's size, with every curve's colour and dark (text) pixels.
     let png = image::open(dir.path().join("study.png")).unwrap().to_rgb8();
     assert_eq!(png.dimensions(), (800, 520));
-    for (r, g, b) in emray::study::COLOURS {
+    for (r, g, b) in emray::quality::study::COLOURS {
         assert!(png.pixels().any(|p| p.0 == [r, g, b]), "{r} {g} {b}");
     }
     let dark = png.pixels().filter(|p| p.0.iter().all(|&c| c < 80)).count();

@@ -6,7 +6,7 @@ use emray::accel::Accel;
 use emray::accel::bvh::Bvh;
 use emray::load::nff::parse_str;
 use emray::math::{Ray, Vec3};
-use emray::stress::{self, acne, convex_scene, differing_share, floor_scene, render};
+use emray::quality::stress::{self, acne, convex_scene, differing_share, floor_scene, render};
 use std::path::Path;
 
 fn backends() -> Vec<Backend> {

@@ -3,9 +3,9 @@
 //! each run's wall time, rays and error metrics to CSV, and error against time on
 //! log-log axes to SVG and PNG (plotters), one curve per knob.
 
+use super::metrics::{Metrics, compare};
 use crate::Scene;
 use crate::accel::{AccelError, Backend};
-use crate::metrics::{Metrics, compare};
 use crate::render::{Aa, RenderSettings};
 use crate::run::{render_reference, render_scene};
 use std::fmt::Write as _;
@@ -140,7 +140,7 @@ pub const COLOURS: [(u8, u8, u8); 6] = [
 
 /// DejaVu Sans (Bitstream Vera licence, see `assets/DejaVuSans.LICENSE`): the PNG's text
 /// is rasterised from it, so no system font is needed.
-static FONT: &[u8] = include_bytes!("../assets/DejaVuSans.ttf");
+static FONT: &[u8] = include_bytes!("../../assets/DejaVuSans.ttf");
 
 /// Register the embedded font as plotters' `sans-serif` (once).
 fn register_font() {
