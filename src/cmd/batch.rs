@@ -1,0 +1,149 @@
+//! `emray batch`: many scenes (arguments, globs or a manifest) rendered as isolated,
+//! resumable jobs, optionally one shard of them; Ctrl-C stops it after writing the
+//! report of what finished.
+
+use super::args::{BackendArg, EncodingArg, parse_res};
+use super::{Error, init_log};
+use emray::accel::Backend;
+use emray::batch::{self, BatchOptions, Job, JobSettings};
+use emray::output::Encoding;
+use std::path::PathBuf;
+
+/// `emray batch`.
+#[derive(clap::Args, Debug, Clone)]
+pub struct Args {
+    /// Scene files, globs (quoted, e.g. 'scenes/*.nff') or `spd:NAME[?size=N]` specs.
+    #[arg(value_name = "SCENE")]
+    pub scenes: Vec<PathBuf>,
+    /// A TOML manifest of jobs (README "Batch rendering"), instead of scene arguments.
+    #[arg(short, long, value_name = "FILE.toml", conflicts_with = "scenes")]
+    pub manifest: Option<PathBuf>,
+    /// Output template: `{stem}`, `{backend}`, `{index}`, `{spp}` [default: `{stem}.png`,
+    /// or the manifest's].
+    #[arg(short, long, value_name = "TEMPLATE")]
+    pub output: Option<String>,
+    /// Ray-query backend (overrides the manifest).
+    #[arg(long, value_enum)]
+    pub backend: Option<BackendArg>,
+    /// Image size, overriding the scenes' (and the manifest's).
+    #[arg(long, value_name = "WxH", value_parser = parse_res)]
+    pub res: Option<(u32, u32)>,
+    /// Samples per pixel (overrides the manifest).
+    #[arg(long, value_parser = clap::value_parser!(u32).range(1..=65536))]
+    pub spp: Option<u32>,
+    /// Maximum ray-tree depth (overrides the manifest).
+    #[arg(long, value_parser = clap::value_parser!(u32).range(1..=64))]
+    pub max_depth: Option<u32>,
+    /// SPD testing mode for every job.
+    #[arg(long)]
+    pub spd: bool,
+    /// PNG value encoding (overrides the manifest).
+    #[arg(long, value_enum)]
+    pub encoding: Option<EncodingArg>,
+    /// Worker threads in all (default: all cores).
+    #[arg(short, long, value_name = "N", value_parser = clap::value_parser!(u32).range(1..=4096))]
+    pub threads: Option<u32>,
+    /// Jobs rendered at once, sharing the threads.
+    #[arg(short, long, value_name = "N", default_value_t = 1, value_parser = clap::value_parser!(u32).range(1..=4096))]
+    pub jobs: u32,
+    /// Run only shard I of N: the jobs whose name hashes (FNV-1a 64) to I modulo N.
+    #[arg(long, value_name = "I/N", value_parser = emray::batch::parse_shard)]
+    pub shard: Option<(u32, u32)>,
+    /// Skip jobs whose output exists and decodes as a whole image (resume).
+    #[arg(long)]
+    pub skip_existing: bool,
+    /// Write a JSON report of every job to FILE (rewritten after each job); `{shard}`
+    /// in the name becomes the shard index.
+    #[arg(long, value_name = "FILE")]
+    pub report: Option<String>,
+    /// Print this shard's jobs (name, scene, output) and exit without rendering.
+    #[arg(long)]
+    pub list: bool,
+    /// Refuse jobs estimated to need more memory (e.g. 8G) [default: 3/4 of RAM].
+    #[arg(long, value_name = "SIZE", value_parser = emray::batch::limits::parse_size)]
+    pub max_memory: Option<u64>,
+    /// No progress, only errors.
+    #[arg(short, long)]
+    pub quiet: bool,
+}
+
+impl Args {
+    /// The settings that override every job's.
+    pub fn overrides(&self) -> emray::batch::manifest::Overrides {
+        emray::batch::manifest::Overrides {
+            output: self.output.clone(),
+            backend: self.backend.map(Backend::from),
+            res: self.res,
+            spp: self.spp,
+            max_depth: self.max_depth,
+            spd: self.spd,
+            encoding: self.encoding.map(Encoding::from),
+        }
+    }
+}
+
+/// Plan the jobs, keep this shard's, and list or run them.
+pub fn run(b: Args) -> Result<(), Error> {
+    init_log(b.quiet, 0);
+    let jobs = jobs(&b)?;
+    batch::check_jobs(&jobs).map_err(Error::usage)?;
+    let jobs: Vec<Job> = match b.shard {
+        Some((i, n)) => jobs
+            .into_iter()
+            .filter(|j| batch::shard_of(&j.name, n) == i)
+            .collect(),
+        None => jobs,
+    };
+    if b.list {
+        for j in &jobs {
+            println!("{}\t{}\t{}", j.name, j.scene.display(), j.output.display());
+        }
+        return Ok(());
+    }
+    let shard_index = b.shard.map_or(0, |(i, _)| i);
+    let opts = BatchOptions {
+        threads: b.threads.map(|t| t as usize),
+        jobs: b.jobs as usize,
+        skip_existing: b.skip_existing,
+        report: b
+            .report
+            .as_ref()
+            .map(|r| PathBuf::from(r.replace("{shard}", &shard_index.to_string()))),
+        quiet: b.quiet,
+        max_memory: b
+            .max_memory
+            .unwrap_or_else(batch::limits::default_max_memory),
+        shard: b.shard,
+    };
+    let report = batch::run(jobs, &opts);
+    let failed = (report.failed > 0)
+        .then(|| anyhow::anyhow!("{} of {} jobs failed", report.failed, report.total));
+    match (report.interrupted, failed) {
+        (true, failed) => Err(Error::Interrupted(failed)),
+        (false, Some(failed)) => Err(Error::Failed(failed)),
+        (false, None) => Ok(()),
+    }
+}
+
+/// The jobs of the manifest (an unreadable one is an input error) or of the scene
+/// arguments (a bad glob or template is a usage error).
+fn jobs(b: &Args) -> Result<Vec<Job>, Error> {
+    if let Some(m) = &b.manifest {
+        return Ok(batch::manifest::load(m, &b.overrides())?);
+    }
+    if b.scenes.is_empty() {
+        return Err(Error::usage("give scene files, globs or --manifest FILE"));
+    }
+    let settings = JobSettings {
+        backend: b.backend.map(Backend::from),
+        res: b.res,
+        spp: b.spp,
+        max_depth: b.max_depth,
+        spd: b.spd,
+        encoding: b.encoding.map(Into::into).unwrap_or_default(),
+    };
+    let template = b.output.as_deref().unwrap_or("{stem}.png");
+    batch::expand_scene_args(&b.scenes)
+        .and_then(|s| batch::jobs_from_scenes(&s, template, &settings))
+        .map_err(Error::usage)
+}

@@ -1,0 +1,102 @@
+//! How a command fails, and the one place that turns that into what is printed and
+//! the process's exit status.
+//!
+//! | status | when |
+//! |---|---|
+//! | 0 | success (`compare`: within the thresholds) |
+//! | 1 | [`Error::Failed`]: an input, render or output error; `batch`: a job failed |
+//! | 1 | [`Error::CheckFailed`]: `compare` over a threshold, `stress` outside a bound |
+//! | 2 | [`Error::Usage`]: bad arguments, found before any work (clap's own errors too); `compare`: an unreadable image |
+//! | 130 | [`Error::Interrupted`]: Ctrl-C stopped a `batch` |
+
+use std::fmt::Display;
+use std::process::ExitCode;
+
+/// Why a command did not succeed.
+#[derive(Debug)]
+pub enum Error {
+    /// Bad arguments or a request that cannot be met, found before any work: exit 2.
+    Usage(anyhow::Error),
+    /// The work failed (unreadable input, a failed render or write): exit 1.
+    Failed(anyhow::Error),
+    /// A check the command makes did not pass and says so itself (`compare`'s
+    /// thresholds, `stress`'s bounds): exit 1, nothing more printed.
+    CheckFailed,
+    /// Ctrl-C stopped a batch, with the error of the jobs that failed before if any:
+    /// exit 130.
+    Interrupted(Option<anyhow::Error>),
+}
+
+impl Error {
+    /// A usage error saying `message`.
+    pub fn usage(message: impl Display + std::fmt::Debug + Send + Sync + 'static) -> Self {
+        Error::Usage(anyhow::Error::msg(message))
+    }
+
+    /// A failure saying `message`.
+    pub fn failed(message: impl Display + std::fmt::Debug + Send + Sync + 'static) -> Self {
+        Error::Failed(anyhow::Error::msg(message))
+    }
+
+    /// The process's exit status.
+    pub fn exit_code(&self) -> u8 {
+        match self {
+            Error::Usage(_) => 2,
+            Error::Failed(_) | Error::CheckFailed => 1,
+            Error::Interrupted(_) => 130,
+        }
+    }
+
+    /// What to print, if anything.
+    fn message(&self) -> Option<&anyhow::Error> {
+        match self {
+            Error::Usage(e) | Error::Failed(e) | Error::Interrupted(Some(e)) => Some(e),
+            Error::CheckFailed | Error::Interrupted(None) => None,
+        }
+    }
+
+    /// Print the error (once, one line, no backtrace) and give the exit status.
+    pub fn report(&self) -> ExitCode {
+        if let Some(e) = self.message() {
+            eprintln!("{}", error_line(e));
+        }
+        ExitCode::from(self.exit_code())
+    }
+}
+
+/// Any library error is a failure (exit 1) unless the command says otherwise.
+impl<E: std::error::Error + Send + Sync + 'static> From<E> for Error {
+    fn from(e: E) -> Self {
+        Error::Failed(e.into())
+    }
+}
+
+/// The line an error is printed as: `emray: error: ` and the error with its causes
+/// (every error the command prints goes through here).
+pub fn error_line(e: impl Display) -> String {
+    format!("emray: error: {e:#}")
+}
+
+/// The usage error of a command this build lacks for want of `feature`.
+#[cfg(not(feature = "quality"))]
+pub fn lacks_feature(command: &str, feature: &str) -> Error {
+    Error::usage(format!(
+        "this emray was built without the `{feature}` feature, which `emray {command}` needs \
+         (build it with the default features or with `--features {feature}`)"
+    ))
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+
+    #[test]
+    fn statuses_follow_the_variant() {
+        assert_eq!(Error::usage("x").exit_code(), 2);
+        assert_eq!(Error::failed("x").exit_code(), 1);
+        assert_eq!(Error::CheckFailed.exit_code(), 1);
+        assert_eq!(Error::Interrupted(None).exit_code(), 130);
+        let e = anyhow::anyhow!("inner").context("outer");
+        assert_eq!(error_line(&e), "emray: error: outer: inner");
+    }
+}

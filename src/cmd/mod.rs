@@ -1,0 +1,112 @@
+//! The commands of the `emray` binary, one module each with its own arguments and a
+//! `run(args) -> Result<(), Error>`; [`args`] holds the argument types several share,
+//! [`error`] how a failure becomes a message and an exit status, [`progress`] the
+//! progress bar of a render.
+
+mod args;
+mod batch;
+mod bench;
+mod compare;
+mod error;
+mod generate;
+mod merge;
+mod progress;
+mod radiosity;
+mod render;
+mod stress;
+mod study;
+
+pub use error::Error;
+
+use anyhow::Context;
+use clap::{Parser, Subcommand};
+use std::io::Write;
+use std::path::Path;
+
+/// emray: a Whitted ray tracer for NFF scenes on Intel Embree or a pure-Rust BVH.
+#[derive(Parser, Debug)]
+#[command(name = "emray", version, about, long_about = None)]
+pub struct Cli {
+    /// What to do; with none, renders the built-in default scene to emray.png.
+    #[command(subcommand)]
+    pub command: Option<Command>,
+}
+
+/// Subcommands.
+#[derive(Subcommand, Debug)]
+pub enum Command {
+    /// Render one or more scene files (or `spd:NAME[?size=N]` generated scenes).
+    Render(render::Args),
+    /// Write a Standard Procedural Database as NFF, as the SPD 3.14 programs do.
+    Gen(generate::Args),
+    /// Render many scenes: failures isolated, resumable, split into shards.
+    Batch(batch::Args),
+    /// Stitch parts rendered with `render --tile` or `--crop` into the whole image.
+    Merge(merge::Args),
+    /// Benchmark suite: SPD scenes on both backends, 1 and all threads, raw casting,
+    /// Tachyon as a peer; markdown to standard output.
+    Bench(bench::Args),
+    /// Error metrics of an image against a reference (RMSE, PSNR, FLIP, ...); exit
+    /// status 0 within the thresholds, 1 beyond, 2 on a usage or I/O error.
+    Compare(compare::Args),
+    /// Numerical stress cases (scale, translation, far/tiny spheres, watertightness)
+    /// with their measured numbers; exit status 1 if a bound is broken.
+    Stress(stress::Args),
+    /// Error against time: the f64 reference once, then a sweep of spp, adaptive AA,
+    /// bailout, depth and backends, to DIR/study.csv; the error-against-time plot to
+    /// DIR/study.svg and DIR/study.png.
+    Study(study::Args),
+    /// Solve a scene's diffuse interreflection by radiosity and render a view of it.
+    Radiosity(radiosity::Args),
+}
+
+/// Run the command line's command (a bare `emray` renders the default scene).
+pub fn run(cli: Cli) -> Result<(), Error> {
+    match cli.command {
+        None => render::run(render::Args::default_scene()),
+        Some(Command::Render(a)) => render::run(a),
+        Some(Command::Gen(a)) => generate::run(a),
+        Some(Command::Batch(a)) => batch::run(a),
+        Some(Command::Merge(a)) => merge::run(a),
+        Some(Command::Bench(a)) => bench::run(a),
+        Some(Command::Compare(a)) => compare::run(a),
+        Some(Command::Stress(a)) => stress::run(a),
+        Some(Command::Study(a)) => study::run(a),
+        Some(Command::Radiosity(a)) => radiosity::run(a),
+    }
+}
+
+/// Log to standard error: errors only when `quiet`, else warnings and more with each
+/// `-v` (`RUST_LOG` wins).
+fn init_log(quiet: bool, verbose: u8) {
+    let level = match (quiet, verbose) {
+        (true, _) => "error",
+        (false, 0) => "warn",
+        (false, 1) => "info",
+        (false, 2) => "debug",
+        _ => "trace",
+    };
+    env_logger::Builder::from_env(env_logger::Env::default().default_filter_or(level))
+        .format_timestamp(None)
+        .init();
+}
+
+/// The worker threads: `threads` of them, or one per core.
+fn thread_pool(threads: Option<u32>) -> anyhow::Result<rayon::ThreadPool> {
+    let mut builder = rayon::ThreadPoolBuilder::new();
+    if let Some(t) = threads {
+        builder = builder.num_threads(t as usize);
+    }
+    builder.build().context("cannot start the worker threads")
+}
+
+/// Append `value` as one JSON line to `path` (the `--stats-json` log: one record per run).
+fn append_json_line(path: &Path, value: &impl serde::Serialize) -> anyhow::Result<()> {
+    let line = serde_json::to_string(value).expect("report serialises");
+    let mut f = std::fs::OpenOptions::new()
+        .create(true)
+        .append(true)
+        .open(path)
+        .with_context(|| format!("{}: cannot open for writing", path.display()))?;
+    writeln!(f, "{line}").with_context(|| format!("{}: cannot write", path.display()))
+}

@@ -1,0 +1,440 @@
+//! `emray render` (and a bare `emray`): render scene files or generated SPD scenes to
+//! PNG or EXR, whole or one part of an image for `emray merge`.
+
+use super::args::{
+    BackendArg, EncodingArg, QualityArg, RadiositySolveArgs, packet_width, parse_res,
+};
+use super::error::error_line;
+use super::progress::TileBar;
+use super::{Error, append_json_line, init_log, thread_pool};
+use anyhow::{Result, anyhow, bail};
+use clap::ValueEnum;
+use emray::Scene;
+use emray::accel::{Backend, BackendOptions};
+use emray::batch::{JobSettings, limits};
+use emray::load;
+use emray::output::{self, Format, part};
+use emray::render::{Aa, Film, Region, RenderSettings};
+use emray::run::{self, Report};
+use emray::scene::Environment;
+use emray::spd::Database;
+use std::path::{Path, PathBuf};
+use std::time::Instant;
+
+/// The built-in default scene.
+const DEFAULT_SCENE: &str = include_str!("../../scenes/default.nff");
+
+/// Antialiasing modes as named on the command line.
+#[derive(Clone, Copy, Debug, ValueEnum, PartialEq, Eq)]
+pub enum AaArg {
+    /// `--spp` stratified samples per pixel.
+    Uniform,
+    /// Adaptive corner subdivision (`--aa-threshold`, `--aa-depth`).
+    Adaptive,
+}
+
+/// `emray render`.
+#[derive(clap::Args, Debug, Clone)]
+pub struct Args {
+    /// Scene files (NFF), or generated SPD scenes as `spd:NAME` / `spd:NAME?size=N`.
+    #[arg(required = true, value_name = "SCENE")]
+    pub scenes: Vec<PathBuf>,
+    /// Output file (.png or .exr), or a template with `{stem}` for several scenes.
+    /// Default: `{stem}.png` in the current directory.
+    #[arg(short, long, value_name = "OUT")]
+    pub output: Option<String>,
+    /// Ray-query backend.
+    #[arg(long, value_enum)]
+    pub backend: Option<BackendArg>,
+    /// Image size, overriding the scene's resolution.
+    #[arg(long, value_name = "WxH", value_parser = parse_res)]
+    pub res: Option<(u32, u32)>,
+    /// Samples per pixel (stratified; 1 = pixel centre) [default: the scene file's
+    /// `[render] spp`, else 1].
+    #[arg(long, value_parser = clap::value_parser!(u32).range(1..=65536))]
+    pub spp: Option<u32>,
+    /// Maximum ray-tree depth, the eye ray being depth 1 [default: the scene file's
+    /// `[render] max_depth`, else 5].
+    #[arg(long, value_parser = clap::value_parser!(u32).range(1..=64))]
+    pub max_depth: Option<u32>,
+    /// Worker threads (default: all cores).
+    #[arg(short, long, value_name = "N", value_parser = clap::value_parser!(u32).range(1..=4096))]
+    pub threads: Option<u32>,
+    /// SPD testing mode: 513x513 corner rays for 512x512, depth 5, ray statistics.
+    #[arg(long)]
+    pub spd: bool,
+    /// Embree build quality (RTC_BUILD_QUALITY_*).
+    #[arg(long, value_enum, default_value_t = QualityArg::Medium)]
+    pub embree_quality: QualityArg,
+    /// Embree robust traversal (RTC_SCENE_FLAG_ROBUST) on every scene: no ray slips
+    /// between triangles sharing an edge, at some cost in speed.
+    #[arg(long)]
+    pub embree_robust: bool,
+    /// Cast each tile's primary rays together, as Embree packets of this many rays
+    /// (`rtcIntersect4/8/16`); 0 casts them one by one. Used with one sample per pixel
+    /// (SPD mode included). Analytic shapes give the same hits either way; Embree's
+    /// packet triangle test may round a ray through a shared edge to the other triangle.
+    #[arg(long, value_name = "N", default_value_t = 8, value_parser = packet_width)]
+    pub packet_width: u32,
+    /// Antialiasing: `uniform` (`--spp` stratified samples) or `adaptive` (corner rays
+    /// shared by neighbouring pixels, subdivided where the corners differ).
+    #[arg(long, value_enum, default_value_t = AaArg::Uniform)]
+    pub aa: AaArg,
+    /// Adaptive AA: largest corner difference (linear, any channel) left unsplit.
+    #[arg(long, value_name = "T", default_value_t = emray::render::DEFAULT_AA_THRESHOLD)]
+    pub aa_threshold: f32,
+    /// Adaptive AA: most subdivision levels per pixel (0 = the four corners only).
+    #[arg(long, value_name = "D", default_value_t = emray::render::DEFAULT_AA_DEPTH,
+          value_parser = clap::value_parser!(u32).range(0..=8))]
+    pub aa_depth: u32,
+    /// No reflected/refracted ray whose accumulated weight (product of Ks, T and filter
+    /// colours from the eye) is below W; 0 = the full ray tree [default: 0.001, 0 with
+    /// --spd].
+    #[arg(long, value_name = "W")]
+    pub bailout: Option<f32>,
+    /// Render the f64 reference instead: everything in double precision, brute-force
+    /// traversal, N×N stratified samples per pixel with N = floor(sqrt(--spp))
+    /// [default --spp 256: 16×16]. Spheres, cones and triangles only; other scenes are
+    /// refused.
+    #[arg(long)]
+    pub reference: bool,
+    /// Cast the rays that cannot change the image too (shadow rays to lights behind the
+    /// surface, reflection rays off Ks = 0): only to measure what skipping them saves.
+    #[arg(long)]
+    pub no_skip: bool,
+    /// Print primitives, timings, ray counts and Mrays/s.
+    #[arg(long)]
+    pub stats: bool,
+    /// Append one JSON object per render to FILE.
+    #[arg(long, value_name = "FILE")]
+    pub stats_json: Option<PathBuf>,
+    /// PNG value encoding.
+    #[arg(long, value_enum, default_value_t = EncodingArg::Srgb)]
+    pub encoding: EncodingArg,
+    /// Render only band I of N horizontal bands, to an EXR part for `emray merge`.
+    #[arg(long, value_name = "I/N", value_parser = emray::batch::parse_shard, conflicts_with = "crop")]
+    pub tile: Option<(u32, u32)>,
+    /// Render only columns x0..x1 and rows y0..y1 (half-open), to an EXR part.
+    #[arg(long, value_name = "x0,x1,y0,y1", value_parser = emray::batch::parse_crop)]
+    pub crop: Option<emray::Region>,
+    /// Refuse a render estimated to need more memory (e.g. 8G) [default: 3/4 of RAM].
+    #[arg(long, value_name = "SIZE", value_parser = emray::batch::limits::parse_size)]
+    pub max_memory: Option<u64>,
+    /// Environment map for rays that leave the scene (PNG/JPEG: 2:1 latitude-longitude
+    /// or a 4:3 cube cross, or a directory of six cube faces px, nx, py, ny, pz, nz),
+    /// replacing the scene's own.
+    #[arg(long, value_name = "FILE|DIR")]
+    pub envmap: Option<PathBuf>,
+    /// No progress bar and no messages but errors.
+    #[arg(short, long)]
+    pub quiet: bool,
+    /// More log output (repeat for more).
+    #[arg(short, long, action = clap::ArgAction::Count)]
+    pub verbose: u8,
+    /// Global illumination: `radiosity` solves the diffuse interreflection first and
+    /// takes the diffuse term of polygons and meshes from it (two-pass).
+    #[arg(long, value_enum)]
+    pub gi: Option<GiArg>,
+    /// The radiosity pass of `--gi radiosity` (the same options as `emray radiosity`).
+    #[command(flatten)]
+    pub radiosity: RadiositySolveArgs,
+    /// Shadow rays per emitting triangle (area light), a square number: 16 = 4×4
+    /// strata.
+    #[arg(long, default_value_t = 16, value_parser = clap::value_parser!(u32).range(1..=4096))]
+    pub area_samples: u32,
+}
+
+/// Global-illumination methods.
+#[derive(Clone, Copy, Debug, ValueEnum, PartialEq, Eq)]
+pub enum GiArg {
+    /// Two-pass: radiosity for the diffuse term, Whitted for the specular paths.
+    Radiosity,
+}
+
+impl Args {
+    /// The arguments for a bare `emray`: the default scene to `emray.png`.
+    pub fn default_scene() -> Self {
+        Args {
+            scenes: Vec::new(),
+            output: Some("emray.png".into()),
+            backend: None,
+            res: None,
+            spp: None,
+            max_depth: None,
+            threads: None,
+            spd: false,
+            embree_quality: QualityArg::Medium,
+            embree_robust: false,
+            packet_width: 8,
+            aa: AaArg::Uniform,
+            aa_threshold: emray::render::DEFAULT_AA_THRESHOLD,
+            aa_depth: emray::render::DEFAULT_AA_DEPTH,
+            bailout: None,
+            no_skip: false,
+            reference: false,
+            stats: false,
+            stats_json: None,
+            encoding: EncodingArg::Srgb,
+            tile: None,
+            crop: None,
+            max_memory: None,
+            envmap: None,
+            quiet: false,
+            verbose: 0,
+            gi: None,
+            radiosity: RadiositySolveArgs::default(),
+            area_samples: 16,
+        }
+    }
+}
+
+/// One render: the scene (`None` = the built-in default) and its output file.
+type Job = (Option<PathBuf>, PathBuf);
+
+/// Render every scene; with several, a failing one is reported and the others go on.
+pub fn run(args: Args) -> Result<(), Error> {
+    init_log(args.quiet, args.verbose);
+    let jobs = plan(&args).map_err(Error::Usage)?;
+    let pool = thread_pool(args.threads).map_err(Error::Failed)?;
+    let mut failed = 0usize;
+    for (scene, out) in &jobs {
+        if let Err(e) = pool.install(|| render_one(&args, scene.as_deref(), out)) {
+            if jobs.len() == 1 {
+                return Err(Error::Failed(e));
+            }
+            eprintln!("{}", error_line(&e));
+            failed += 1;
+        }
+    }
+    if failed > 0 {
+        return Err(Error::failed(format!(
+            "{failed} of {} scenes failed",
+            jobs.len()
+        )));
+    }
+    Ok(())
+}
+
+/// Where scene `scene` goes.
+fn output_for(args: &Args, scene: &Path) -> PathBuf {
+    let stem = emray::batch::scene_stem(scene);
+    PathBuf::from(match &args.output {
+        Some(t) if t.contains("{stem}") => t.replace("{stem}", &stem),
+        Some(t) => t.clone(),
+        None => format!("{stem}.png"),
+    })
+}
+
+/// The jobs, or a usage error found before any work is done.
+fn plan(args: &Args) -> Result<Vec<Job>> {
+    check_options(args)?;
+    if args.scenes.len() > 1 {
+        if let Some(o) = &args.output {
+            if !o.contains("{stem}") {
+                bail!(
+                    "{} scenes but one output file '{o}': use a template such as '{{stem}}.png'",
+                    args.scenes.len()
+                );
+            }
+        }
+    }
+    let jobs: Vec<Job> = if args.scenes.is_empty() {
+        vec![(None, output_for(args, Path::new("emray")))]
+    } else {
+        args.scenes
+            .iter()
+            .map(|s| (Some(s.clone()), output_for(args, s)))
+            .collect()
+    };
+    if args.tile.is_some() || args.crop.is_some() {
+        check_part(args, &jobs)?;
+    }
+    for (scene, out) in &jobs {
+        Format::from_path(out)?;
+        if let Some(s) = scene {
+            Database::parse_spec(&s.to_string_lossy()).map_err(anyhow::Error::msg)?;
+        }
+    }
+    Ok(jobs)
+}
+
+/// Options that cannot go together, and numbers out of range.
+fn check_options(args: &Args) -> Result<()> {
+    if args.reference && (args.spd || args.aa != AaArg::Uniform) {
+        bail!(
+            "--reference samples N×N stratified: it cannot be combined with --spd or --aa adaptive"
+        );
+    }
+    for (name, v) in [
+        ("--bailout", args.bailout.unwrap_or(0.0)),
+        ("--aa-threshold", args.aa_threshold),
+    ] {
+        if !v.is_finite() || v < 0.0 {
+            bail!("{name} must be a finite number >= 0, not {v}");
+        }
+    }
+    Ok(())
+}
+
+/// `--tile` and `--crop` render one scene, whole-image modes aside, to an EXR part.
+fn check_part(args: &Args, jobs: &[Job]) -> Result<()> {
+    if args.reference {
+        bail!("--reference renders whole images: not with --tile or --crop");
+    }
+    if args.gi.is_some() {
+        // Each part would solve the radiosity on its own; the hash does not cover it.
+        bail!("--gi renders whole images: not with --tile or --crop");
+    }
+    if jobs.len() != 1 {
+        bail!("--tile and --crop render one scene");
+    }
+    if !matches!(Format::from_path(&jobs[0].1), Ok(Format::Exr)) {
+        bail!(
+            "--tile and --crop write an EXR part (for emray merge), not '{}'",
+            jobs[0].1.display()
+        );
+    }
+    Ok(())
+}
+
+/// The settings for `scene` (named `name`): the scene's, overridden by the options.
+fn settings(args: &Args, name: &str, scene: &Scene) -> Result<RenderSettings> {
+    let job = JobSettings {
+        backend: args.backend.map(Backend::from),
+        res: args.res,
+        spp: args.spp,
+        max_depth: args.max_depth,
+        spd: args.spd,
+        encoding: args.encoding.into(),
+    };
+    let mut settings = job.apply(scene);
+    settings.bailout = args.bailout.unwrap_or(settings.bailout);
+    if args.aa == AaArg::Adaptive {
+        settings.aa = Aa::Adaptive {
+            threshold: args.aa_threshold,
+            depth: args.aa_depth,
+        };
+    }
+    settings.skip = !args.no_skip;
+    settings.area_samples = (args.area_samples as f32).sqrt().floor().max(1.0) as u32;
+    settings.region = region(args, name, settings.width, settings.height)?;
+    Ok(settings)
+}
+
+/// The part of the `w × h` image that `--tile` or `--crop` asks for.
+fn region(args: &Args, name: &str, w: u32, h: u32) -> Result<Option<Region>> {
+    let region = match (args.tile, args.crop) {
+        (Some((i, n)), _) => Some(Region::band(i, n, w, h)),
+        (None, Some(c)) if !c.fits(w, h) => bail!(
+            "{name}: crop {},{},{},{} is not inside the {w}x{h} image",
+            c.x0,
+            c.x1,
+            c.y0,
+            c.y1
+        ),
+        (None, c) => c,
+    };
+    if region.is_some_and(|r| r.height() == 0) {
+        bail!("{name}: --tile leaves no rows for this part of a {h}-row image (use fewer tiles)");
+    }
+    Ok(region)
+}
+
+/// The backend and its build options.
+fn backend_options(args: &Args) -> BackendOptions {
+    BackendOptions {
+        backend: args
+            .backend
+            .map(Backend::from)
+            .unwrap_or_else(Backend::default_available),
+        embree_quality: args.embree_quality.into(),
+        embree_robust: args.embree_robust,
+        packet_width: args.packet_width,
+    }
+}
+
+/// The scene's name and the scene, with `--envmap` in place of its own.
+fn load_scene(args: &Args, path: Option<&Path>) -> Result<(String, Scene)> {
+    let (name, mut scene) = match path {
+        Some(p) => (
+            p.display().to_string(),
+            emray::batch::load_scene(p).map_err(anyhow::Error::msg)?,
+        ),
+        None => (
+            "default".into(),
+            load::nff::parse_str(DEFAULT_SCENE, Path::new("<default scene>"))?,
+        ),
+    };
+    if let Some(env) = &args.envmap {
+        scene.environment = Some(Environment::load(env).map_err(anyhow::Error::msg)?);
+    }
+    Ok((name, scene))
+}
+
+/// Load, render and write one scene.
+fn render_one(args: &Args, scene_path: Option<&Path>, out: &Path) -> Result<()> {
+    let t0 = Instant::now();
+    let (name, scene) = load_scene(args, scene_path)?;
+    let load_ms = t0.elapsed().as_secs_f64() * 1e3;
+    let settings = settings(args, &name, &scene)?;
+    let max_memory = args.max_memory.unwrap_or_else(limits::default_max_memory);
+    limits::check(Path::new(&name), &scene, &settings, max_memory).map_err(anyhow::Error::msg)?;
+    let options = backend_options(args);
+    let bar = TileBar::new(&name, args.quiet);
+    let (film, report) = trace(args, &name, &scene, &settings, options, load_ms, &bar)?;
+    bar.finish();
+    match settings.region {
+        Some(region) => {
+            let info = part::PartInfo {
+                full: (settings.width, settings.height),
+                region,
+                hash: Some(emray::batch::merge::render_hash(
+                    &scene,
+                    &settings,
+                    options.backend,
+                )),
+            };
+            part::write_exr(out, &film, Some(&info))?
+        }
+        None => output::write_image(out, &film, args.encoding.into())?,
+    }
+    if args.stats {
+        println!("{}\noutput     {}", report.summary(), out.display());
+    } else if !args.quiet {
+        log::info!("wrote {}", out.display());
+    }
+    if let Some(path) = &args.stats_json {
+        append_json_line(path, &report)?;
+    }
+    Ok(())
+}
+
+/// Build the backend and render: the f64 reference, two-pass, or Whitted alone.
+fn trace(
+    args: &Args,
+    name: &str,
+    scene: &Scene,
+    settings: &RenderSettings,
+    options: BackendOptions,
+    load_ms: f64,
+    bar: &TileBar,
+) -> Result<(Film, Report)> {
+    let progress = |done: usize, total: usize| bar.set(done, total);
+    if args.reference {
+        let strata = (args.spp.unwrap_or(256) as f64).sqrt().floor() as u32;
+        return run::render_reference(name, scene, settings, strata, load_ms)
+            .map_err(|why| anyhow!("{name}: {why}"));
+    }
+    Ok(match args.gi {
+        Some(GiArg::Radiosity) => run::render_two_pass(
+            name,
+            scene,
+            options,
+            settings,
+            &args.radiosity.settings(),
+            load_ms,
+            Some(&progress),
+        )?,
+        None => run::render_scene(name, scene, options, settings, load_ms, Some(&progress))?,
+    })
+}

@@ -1,0 +1,155 @@
+//! `emray stress`: every numerical stress case at full counts, with what was measured
+//! and whether the bounds of `tests/stability.rs` hold.
+
+use super::Error;
+use emray::Backend;
+use emray::accel::bvh::Bvh;
+use emray::quality::stress::*;
+
+/// `emray stress`.
+#[derive(clap::Args, Debug, Clone)]
+pub struct Args {
+    /// Random rays per far/tiny sphere case.
+    #[arg(long, default_value_t = 1_000_000)]
+    pub rays: u32,
+}
+
+/// The verdicts so far: each printed as `ok` or `FAIL` with what was measured.
+struct Checks {
+    ok: bool,
+}
+
+impl Checks {
+    fn check(&mut self, holds: bool, what: String) {
+        println!("{} {what}", if holds { "ok  " } else { "FAIL" });
+        self.ok &= holds;
+    }
+}
+
+/// Run every case; a broken bound is [`Error::CheckFailed`].
+pub fn run(a: Args) -> Result<(), Error> {
+    let mut checks = Checks { ok: true };
+    let mut backends = vec![Backend::Bvh];
+    if cfg!(feature = "embree") {
+        backends.push(Backend::Embree);
+    }
+    scale(&mut checks, &backends);
+    offset(&mut checks);
+    far_spheres(&mut checks, a.rays);
+    quadric_roots(&mut checks, a.rays);
+    watertight(&mut checks);
+    if checks.ok {
+        Ok(())
+    } else {
+        Err(Error::CheckFailed)
+    }
+}
+
+/// Scaled scenes render as the unscaled one, without self-shadowing acne.
+fn scale(checks: &mut Checks, backends: &[Backend]) {
+    for &b in backends {
+        let want = render(&floor_scene(1.0, 256), b);
+        for e in -4..=4 {
+            if e == 0 {
+                continue;
+            }
+            let share = differing_share(&render(&floor_scene(10f64.powi(e), 256), b), &want);
+            checks.check(
+                share <= 1e-3,
+                format!(
+                    "scale 1e{e} ({b:?}, 256x256): {:.4}% pixels differ (bound 0.1%)",
+                    share * 100.0
+                ),
+            );
+        }
+    }
+    for e in -4..=4 {
+        let c = convex_scene(10f64.powi(e), 0.0, 256);
+        let (lit, bad) = acne(&c, &Bvh::build(&c));
+        checks.check(
+            bad == 0,
+            format!("scale 1e{e}: acne {bad} of {lit} lit points"),
+        );
+    }
+}
+
+/// Scenes far from the origin: no acne up to 1e5.
+fn offset(checks: &mut Checks) {
+    let base = render(&convex_scene(1.0, 0.0, 256), Backend::Bvh);
+    for e in 3..=6 {
+        let s = convex_scene(1.0, 10f64.powi(e), 256);
+        let (lit, bad) = acne(&s, &Bvh::build(&s));
+        let share = differing_share(&render(&s, Backend::Bvh), &base);
+        checks.check(
+            e > 5 || bad == 0,
+            format!(
+                "offset 1e{e}: acne {bad} of {lit} lit points, {:.3}% pixels differ",
+                share * 100.0
+            ),
+        );
+    }
+}
+
+/// Far and tiny spheres: the hit distance against f64, and the silhouette.
+fn far_spheres(checks: &mut Checks, rays: u32) {
+    for (dist, radius) in [(1e4f32, 1.0f32), (1e2, 1e-4), (1e6, 1e3), (1e5, 1e-2)] {
+        let (worst, miss, extra) = far_sphere(dist, radius, rays, 7);
+        checks.check(
+            worst < 1e-5,
+            format!(
+                "sphere r={radius:e} at {dist:e}: worst relative t error {worst:.3e} over {rays} rays; \
+                 silhouette: {miss} f32 misses, {extra} f32 extra hits"
+            ),
+        );
+    }
+}
+
+/// Quadric roots against f64.
+fn quadric_roots(checks: &mut Checks, rays: u32) {
+    for (name, case) in quadric_root_cases() {
+        let st = case(rays);
+        checks.check(
+            st.nan == 0 && st.disagree == 0 && st.worst_dist < ROOT_DIST_BOUND,
+            format!(
+                "{name}: {} rays ({} hit in f64): {} NaN, {} hit/miss disagreements \
+                 outside the band ({} rays in it), worst |dt|/max(t,1) {:.3e}, \
+                 worst f32 hit point distance from the surface {:.3e}",
+                st.rays, st.hits, st.nan, st.disagree, st.in_band, st.worst_t, st.worst_dist
+            ),
+        );
+    }
+}
+
+/// Rays through closed meshes: none may slip through on the BVH (Embree's numbers,
+/// with and without its robust mode, are printed for information).
+fn watertight(checks: &mut Checks) {
+    let touching = |st: &WatertightStats| {
+        format!(
+            "{} misses of {} rays (and {} of {} rays that may only touch an apex or ridge)",
+            st.misses, st.rays, st.touching_misses, st.touching
+        )
+    };
+    for (name, case, n) in watertight_cases() {
+        let st = case.run(&Bvh::build(&case.scene), n, 3.0);
+        checks.check(
+            st.misses == 0,
+            format!("watertight ({name}, bvh): {}", touching(&st)),
+        );
+        #[cfg(feature = "embree")]
+        for robust in [false, true] {
+            let flag = if robust { "robust" } else { "default flags" };
+            match emray::accel::embree::EmbreeAccel::build_with(
+                &case.scene,
+                "",
+                Default::default(),
+                robust,
+            ) {
+                Ok(e) => {
+                    let st = case.run(&e, n, 3.0);
+                    println!("info watertight ({name}, embree {flag}): {}", touching(&st));
+                }
+                Err(e) => println!("info embree unavailable: {e}"),
+            }
+        }
+    }
+}

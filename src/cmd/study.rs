@@ -1,0 +1,51 @@
+//! `emray study`: error against time for every speed/accuracy knob, against the f64
+//! reference, to CSV, SVG and PNG. Needs the `quality` feature (FLIP, plots).
+
+use super::Error;
+use super::args::parse_res;
+use std::path::PathBuf;
+
+/// `emray study`.
+#[derive(clap::Args, Debug, Clone)]
+pub struct Args {
+    /// Scene file or `spd:NAME[?size=N]` (spheres, cones and triangles only: the f64
+    /// reference refuses the rest).
+    #[arg(value_name = "SCENE")]
+    pub scene: PathBuf,
+    /// Output directory for study.csv, study.svg and study.png.
+    #[arg(long, value_name = "DIR")]
+    pub out: PathBuf,
+    /// Image size of every run.
+    #[arg(long, value_name = "WxH", default_value = "128x128", value_parser = parse_res)]
+    pub res: (u32, u32),
+    /// Reference samples per pixel side (N×N).
+    #[arg(long, default_value_t = 16, value_parser = clap::value_parser!(u32).range(1..=64))]
+    pub reference_strata: u32,
+}
+
+/// Run the study and print its CSV; a bad `spd:` spec is a usage error.
+#[cfg(feature = "quality")]
+pub fn run(a: Args) -> Result<(), Error> {
+    let name = a.scene.display().to_string();
+    let scene = match emray::spd::Database::parse_spec(&name).map_err(Error::usage)? {
+        Some((db, size)) => emray::load::nff::parse_str(&db.generate(size), &a.scene),
+        None => emray::load::load_path(&a.scene),
+    }
+    .map_err(|e| Error::failed(format!("{name}: {e}")))?;
+    let mut backends = vec![emray::Backend::Bvh];
+    if cfg!(feature = "embree") {
+        backends.push(emray::Backend::Embree);
+    }
+    let (w, h) = a.res;
+    let rows =
+        emray::quality::study::write(&scene, &name, &a.out, w, h, a.reference_strata, &backends)
+            .map_err(|e| Error::failed(format!("{name}: {e}")))?;
+    print!("{}", emray::quality::study::csv(&rows));
+    Ok(())
+}
+
+/// This build has no FLIP and no plots.
+#[cfg(not(feature = "quality"))]
+pub fn run(_: Args) -> Result<(), Error> {
+    Err(super::error::lacks_feature("study", "quality"))
+}
