@@ -1,14 +1,49 @@
 //! One render from start to end, with the phases timed separately (the SPD rule:
-//! preprocessing apart from ray tracing): load, build the backend, render.
+//! preprocessing apart from ray tracing): load ([`load_scene`]), resolve the settings
+//! ([`RenderRequest::settings`]), check the memory it needs ([`limits`]), build the
+//! backend and render ([`render_scene`], [`render_two_pass`], [`render_reference`]).
+
+pub mod limits;
+mod request;
+
+pub use request::{
+    CropSpecError, DEFAULT_MAX_DEPTH, DEFAULT_SPP, IndexOfError, Part, RenderRequest,
+    SPD_MAX_DEPTH, SPD_SIDE, SettingsError, parse_crop, parse_index_of, parse_tile,
+};
 
 use crate::accel::{self, Accel, AccelError, AccelStats, BackendOptions, WithAccel};
 use crate::geometry::Kind;
+use crate::load::{self, LoadError};
 use crate::radiosity::{RadiosityError, RadiositySettings};
 use crate::render::{self, Film, Progress, RenderSettings, RenderStats};
 use crate::scene::Scene;
+use crate::spd::Database;
 use serde::Serialize;
 use std::collections::BTreeMap;
+use std::path::Path;
 use std::time::Instant;
+
+/// Why a scene named on the command line (a file or `spd:NAME[?size=N]`) could not
+/// be had.
+#[derive(Debug, thiserror::Error)]
+pub enum SceneError {
+    /// An `spd:` spec that names no database or a size it cannot generate.
+    #[error("{0}")]
+    Spec(String),
+    /// The file could not be read or does not parse (`path:line:col: message`).
+    #[error(transparent)]
+    Load(#[from] LoadError),
+}
+
+/// Load a scene file or generate an `spd:NAME[?size=N]` scene; errors name the file
+/// (and line and column where there is one).
+pub fn load_scene(spec: impl AsRef<Path>) -> Result<Scene, SceneError> {
+    let spec = spec.as_ref();
+    match Database::parse_spec(&spec.to_string_lossy()).map_err(SceneError::Spec)? {
+        Some((db, size)) => Ok(load::nff::parse_str(&db.generate(size), spec)?),
+        None => Ok(load::load_path(spec)?),
+    }
+}
 
 /// Wall times of the three phases in milliseconds.
 #[derive(Clone, Copy, Debug, Default, PartialEq, Serialize)]
@@ -308,6 +343,11 @@ pub fn render_two_pass(
     accel::build(scene, &backend.into(), work)?
 }
 
+/// What the f64 reference renderer does not model, found in a scene.
+#[derive(Clone, Debug, PartialEq, Eq, thiserror::Error)]
+#[error("{0}")]
+pub struct ReferenceUnsupported(pub String);
+
 /// Render `scene` with the f64 reference renderer ([`render::reference`]) using
 /// `strata × strata` samples per pixel; `Err` names what the reference does not model.
 pub fn render_reference(
@@ -316,9 +356,9 @@ pub fn render_reference(
     settings: &RenderSettings,
     strata: u32,
     load_ms: f64,
-) -> Result<(Film, Report), String> {
+) -> Result<(Film, Report), ReferenceUnsupported> {
     if let Some(why) = render::reference::unsupported(scene) {
-        return Err(why);
+        return Err(ReferenceUnsupported(why));
     }
     let t0 = Instant::now();
     let (film, rays) = render::reference::render(

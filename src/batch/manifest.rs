@@ -25,6 +25,7 @@ use super::{Job, JobSettings, expand_template};
 use crate::accel::Backend;
 use crate::load::LoadError;
 use crate::output::Encoding;
+use crate::run::RenderRequest;
 use serde::Deserialize;
 use std::path::{Path, PathBuf};
 
@@ -171,10 +172,13 @@ pub fn load(path: &Path, cli: &Overrides) -> Result<Vec<Job>, LoadError> {
                 BackendName::Embree => Backend::Embree,
                 BackendName::Bvh => Backend::Bvh,
             })),
-            res: cli.res.or(k.res.or(d.res).map(|r| (r.0, r.1))),
-            spp: cli.spp.or(k.spp).or(d.spp),
-            max_depth: cli.max_depth.or(k.max_depth).or(d.max_depth),
-            spd: cli.spd || k.spd.or(d.spd).unwrap_or(false),
+            render: RenderRequest {
+                res: cli.res.or(k.res.or(d.res).map(|r| (r.0, r.1))),
+                spp: cli.spp.or(k.spp).or(d.spp),
+                max_depth: cli.max_depth.or(k.max_depth).or(d.max_depth),
+                spd: cli.spd || k.spd.or(d.spd).unwrap_or(false),
+                ..RenderRequest::default()
+            },
             encoding: cli.encoding.unwrap_or(match k.encoding.or(d.encoding) {
                 Some(EncodingName::Linear) => Encoding::Linear,
                 _ => Encoding::Srgb,
@@ -235,10 +239,10 @@ mod tests {
         assert_eq!(jobs[0].scene, dir.path().join("a.nff"));
         assert_eq!(jobs[0].output, dir.path().join("out/a-bvh.png"));
         assert_eq!(jobs[0].name, jobs[0].output.to_string_lossy());
-        assert_eq!(jobs[0].settings.res, Some((32, 16)));
+        assert_eq!(jobs[0].settings.render.res, Some((32, 16)));
         assert_eq!(jobs[1].name, "g");
         assert_eq!(jobs[1].scene, PathBuf::from("spd:gears?size=1"));
-        assert_eq!(jobs[1].settings.spp, Some(4));
+        assert_eq!(jobs[1].settings.render.spp, Some(4));
         let cli = Overrides {
             spp: Some(2),
             ..Overrides::default()
@@ -247,7 +251,7 @@ mod tests {
             load(&p, &cli)
                 .unwrap()
                 .iter()
-                .all(|j| j.settings.spp == Some(2))
+                .all(|j| j.settings.render.spp == Some(2))
         );
     }
 

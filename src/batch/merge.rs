@@ -5,7 +5,7 @@
 
 use crate::Scene;
 use crate::accel::Backend;
-use crate::output::part::{PartInfo, read_exr};
+use crate::output::part::{HASH_ATTRIBUTE, PartInfo, read_exr};
 use crate::render::{Film, RenderSettings};
 use std::fmt::Write as _;
 use std::path::{Path, PathBuf};
@@ -38,44 +38,113 @@ pub fn render_hash(scene: &Scene, settings: &RenderSettings, backend: Backend) -
     format!("{:016x}", h.0)
 }
 
+/// Why parts do not make one image.
+#[derive(Debug, thiserror::Error)]
+pub enum MergeError {
+    /// A part could not be read.
+    #[error("{0}")]
+    Read(String),
+    /// An EXR that is not a part (no hash).
+    #[error(
+        "{}: not a part (no {} attribute; render it with --tile or --crop)",
+        path.display(), HASH_ATTRIBUTE
+    )]
+    NotAPart {
+        /// The file.
+        path: PathBuf,
+    },
+    /// No part given.
+    #[error("no parts to merge")]
+    NoParts,
+    /// A part of an image of another size than the first part's.
+    #[error(
+        "{}: part of a {}x{} image, but {} is of a {}x{} image",
+        part.display(), full.0, full.1, first.display(), first_full.0, first_full.1
+    )]
+    OtherImage {
+        /// The part.
+        part: PathBuf,
+        /// Its image's size.
+        full: (u32, u32),
+        /// The first part.
+        first: PathBuf,
+        /// The first part's image's size.
+        first_full: (u32, u32),
+    },
+    /// A part of another render (scene, settings or backend) than the first part.
+    #[error(
+        "{}: rendered from another scene or other settings than {} (hash {hash} vs \
+         {first_hash})",
+        part.display(), first.display()
+    )]
+    OtherRender {
+        /// The part.
+        part: PathBuf,
+        /// The first part.
+        first: PathBuf,
+        /// The part's render hash.
+        hash: String,
+        /// The first part's.
+        first_hash: String,
+    },
+    /// Two parts hold one pixel.
+    #[error(
+        "{}: pixel ({x}, {y}) is also in {}: the parts overlap",
+        part.display(), other.display()
+    )]
+    Overlap {
+        /// The later part.
+        part: PathBuf,
+        /// The pixel's column.
+        x: u32,
+        /// Its row.
+        y: u32,
+        /// The earlier part holding it.
+        other: PathBuf,
+    },
+    /// Pixels no part holds.
+    #[error("the parts leave {missing} pixels uncovered, the first at ({x}, {y})")]
+    Uncovered {
+        /// How many.
+        missing: usize,
+        /// The first one's column.
+        x: u32,
+        /// Its row.
+        y: u32,
+    },
+}
+
 /// Read `parts` and stitch them into the whole image, refusing parts of different
 /// images or renders, overlapping parts and uncovered pixels.
-pub fn merge(parts: &[PathBuf]) -> Result<Film, String> {
+pub fn merge(parts: &[PathBuf]) -> Result<Film, MergeError> {
     let mut read: Vec<(&Path, Film, PartInfo)> = Vec::with_capacity(parts.len());
     for p in parts {
-        let (film, info) = read_exr(p)?;
+        let (film, info) = read_exr(p).map_err(MergeError::Read)?;
         if info.hash.is_none() {
-            return Err(format!(
-                "{}: not a part (no {} attribute; render it with --tile or --crop)",
-                p.display(),
-                crate::output::part::HASH_ATTRIBUTE
-            ));
+            return Err(MergeError::NotAPart { path: p.clone() });
         }
         read.push((p, film, info));
     }
     let Some((first, _, info0)) = read.first() else {
-        return Err("no parts to merge".into());
+        return Err(MergeError::NoParts);
     };
     for (p, _, info) in &read[1..] {
         if info.full != info0.full {
-            return Err(format!(
-                "{}: part of a {}x{} image, but {} is of a {}x{} image",
-                p.display(),
-                info.full.0,
-                info.full.1,
-                first.display(),
-                info0.full.0,
-                info0.full.1
-            ));
+            return Err(MergeError::OtherImage {
+                part: p.to_path_buf(),
+                full: info.full,
+                first: first.to_path_buf(),
+                first_full: info0.full,
+            });
         }
         if info.hash != info0.hash {
-            return Err(format!(
-                "{}: rendered from another scene or other settings than {} (hash {} vs {})",
-                p.display(),
-                first.display(),
-                info.hash.as_deref().unwrap_or("-"),
-                info0.hash.as_deref().unwrap_or("-")
-            ));
+            let hash = |i: &PartInfo| i.hash.clone().unwrap_or_else(|| "-".into());
+            return Err(MergeError::OtherRender {
+                part: p.to_path_buf(),
+                first: first.to_path_buf(),
+                hash: hash(info),
+                first_hash: hash(info0),
+            });
         }
     }
     let (w, h) = info0.full;
@@ -87,11 +156,12 @@ pub fn merge(parts: &[PathBuf]) -> Result<Film, String> {
             for i in r.x0..r.x1 {
                 let o = &mut owner[(j * w + i) as usize];
                 if *o != u32::MAX {
-                    return Err(format!(
-                        "{}: pixel ({i}, {j}) is also in {}: the parts overlap",
-                        p.display(),
-                        read[*o as usize].0.display()
-                    ));
+                    return Err(MergeError::Overlap {
+                        part: p.to_path_buf(),
+                        x: i,
+                        y: j,
+                        other: read[*o as usize].0.to_path_buf(),
+                    });
                 }
                 *o = k as u32;
                 out.set(i, j, film.get(i - r.x0, j - r.y0));
@@ -99,12 +169,11 @@ pub fn merge(parts: &[PathBuf]) -> Result<Film, String> {
         }
     }
     if let Some(idx) = owner.iter().position(|&o| o == u32::MAX) {
-        let missing = owner.iter().filter(|&&o| o == u32::MAX).count();
-        return Err(format!(
-            "the parts leave {missing} pixels uncovered, the first at ({}, {})",
-            idx as u32 % w,
-            idx as u32 / w
-        ));
+        return Err(MergeError::Uncovered {
+            missing: owner.iter().filter(|&&o| o == u32::MAX).count(),
+            x: idx as u32 % w,
+            y: idx as u32 / w,
+        });
     }
     Ok(out)
 }

@@ -4,36 +4,28 @@
 //! A batch is a list of [`Job`]s (from scene paths, globs or a TOML manifest,
 //! [`manifest`]); [`run`] renders them one after another (or `jobs` at a time sharing
 //! the threads), writes a JSON [`BatchReport`] after every job, and stops cleanly on
-//! Ctrl-C. A job's shard is a stable hash of its name ([`shard_of`]).
+//! Ctrl-C. A job's shard is a stable hash of its name ([`shard_of`]); parts of one
+//! image rendered apart are put together by [`merge`].
 
-pub mod limits;
 pub mod manifest;
 pub mod merge;
 mod runner;
 
 pub use runner::{BatchOptions, BatchReport, JobRecord, JobStatus, run};
 
-use crate::Scene;
 use crate::accel::Backend;
-use crate::load;
-use crate::output::Encoding;
-use crate::render::{Region, RenderSettings};
+use crate::output::{Encoding, OutputError};
+use crate::run::{IndexOfError, RenderRequest, parse_index_of};
 use crate::spd::Database;
 use std::path::{Path, PathBuf};
 
-/// How one job renders; `None` leaves the scene's or the renderer's default.
+/// How one job renders.
 #[derive(Clone, Debug, Default, PartialEq)]
 pub struct JobSettings {
     /// Ray-query backend (default: Embree when built in, else the BVH).
     pub backend: Option<Backend>,
-    /// Image size, overriding the scene's.
-    pub res: Option<(u32, u32)>,
-    /// Samples per pixel (default: the scene file's, else 1).
-    pub spp: Option<u32>,
-    /// Maximum ray-tree depth (default: the scene file's, else 5).
-    pub max_depth: Option<u32>,
-    /// SPD testing mode (512×512 unless `res` is given, 1 spp, depth 5).
-    pub spd: bool,
+    /// What the render asks for besides the scene (resolution, spp, depth, SPD mode).
+    pub render: RenderRequest,
     /// PNG value encoding.
     pub encoding: Encoding,
 }
@@ -42,31 +34,6 @@ impl JobSettings {
     /// The backend this job uses.
     pub fn backend(&self) -> Backend {
         self.backend.unwrap_or_else(Backend::default_available)
-    }
-
-    /// The render settings for `scene`: the scene's own, overridden by these, with the
-    /// command line's defaults (the default bailout, none in SPD mode).
-    pub fn apply(&self, scene: &Scene) -> RenderSettings {
-        let mut s = RenderSettings::for_scene(scene);
-        if let Some((w, h)) = self.res {
-            s.width = w;
-            s.height = h;
-        }
-        s.spp = self.spp.or(scene.render.spp).unwrap_or(1);
-        s.bailout = crate::render::DEFAULT_BAILOUT;
-        s.max_depth = self.max_depth.or(scene.render.max_depth).unwrap_or(5);
-        if self.spd {
-            // SPD testing mode: 512x512 from a 513x513 corner grid, depth 5, one sample.
-            if self.res.is_none() {
-                s.width = 512;
-                s.height = 512;
-            }
-            s.spd = true;
-            s.spp = 1;
-            s.max_depth = 5;
-            s.bailout = 0.0;
-        }
-        s
     }
 }
 
@@ -83,16 +50,76 @@ pub struct Job {
     pub settings: JobSettings,
 }
 
-/// Load a scene file or generate an `spd:NAME[?size=N]` scene; errors name the file
-/// (and line and column where there is one).
-pub fn load_scene(spec: &Path) -> Result<Scene, String> {
-    let name = spec.to_string_lossy();
-    match Database::parse_spec(&name)? {
-        Some((db, size)) => {
-            load::nff::parse_str(&db.generate(size), spec).map_err(|e| e.to_string())
-        }
-        None => load::load_path(spec).map_err(|e| e.to_string()),
-    }
+/// Why a batch cannot be put together: found before any job runs.
+#[derive(Debug, thiserror::Error)]
+pub enum BatchError {
+    /// An output template with a `{` and no `}` after it.
+    #[error("output template '{template}': '{{' without '}}'")]
+    UnclosedPlaceholder {
+        /// The template.
+        template: String,
+    },
+    /// An output template with a `{key}` not in [`TEMPLATE_KEYS`].
+    #[error(
+        "output template '{template}': unknown placeholder '{{{key}}}' (one of {})",
+        placeholder_list()
+    )]
+    UnknownPlaceholder {
+        /// The template.
+        template: String,
+        /// The unknown key.
+        key: String,
+    },
+    /// A scene argument that is not a valid glob.
+    #[error("bad glob '{pattern}': {message}")]
+    BadGlob {
+        /// The argument.
+        pattern: String,
+        /// What is wrong with it.
+        message: String,
+    },
+    /// A glob that matches nothing.
+    #[error("glob '{0}' matches no file")]
+    NoMatch(String),
+    /// An `spd:` scene spec that names no database or a size it cannot generate.
+    #[error("{0}")]
+    Spec(String),
+    /// An output file of an unsupported format.
+    #[error(transparent)]
+    Output(#[from] OutputError),
+    /// Two jobs with one name.
+    #[error("jobs {first} and {second} have the same name '{name}'")]
+    SameName {
+        /// The first job's index.
+        first: usize,
+        /// The second job's index.
+        second: usize,
+        /// Their name.
+        name: String,
+    },
+    /// Two jobs writing one file.
+    #[error(
+        "jobs {first} and {second} write the same file '{}' (use {{stem}}, {{backend}} or \
+         {{index}} in the template)",
+        output.display()
+    )]
+    SameOutput {
+        /// The first job's index.
+        first: usize,
+        /// The second job's index.
+        second: usize,
+        /// Their output file.
+        output: PathBuf,
+    },
+}
+
+/// `{stem}, {backend}, {index}, {spp}`: the placeholders, for messages.
+fn placeholder_list() -> String {
+    TEMPLATE_KEYS
+        .iter()
+        .map(|k| format!("{{{k}}}"))
+        .collect::<Vec<_>>()
+        .join(", ")
 }
 
 /// The file-name stem of a scene: the file's, or `NAME_sN` for a generated one.
@@ -116,7 +143,7 @@ pub fn expand_template(
     scene: &Path,
     settings: &JobSettings,
     index: usize,
-) -> Result<String, String> {
+) -> Result<String, BatchError> {
     let mut out = String::with_capacity(template.len() + 16);
     let mut rest = template;
     while let Some(open) = rest.find('{') {
@@ -124,22 +151,20 @@ pub fn expand_template(
         let after = &rest[open + 1..];
         let close = after
             .find('}')
-            .ok_or_else(|| format!("output template '{template}': '{{' without '}}'"))?;
+            .ok_or_else(|| BatchError::UnclosedPlaceholder {
+                template: template.to_string(),
+            })?;
         let key = &after[..close];
         match key {
             "stem" => out.push_str(&scene_stem(scene)),
             "backend" => out.push_str(settings.backend().name()),
             "index" => out.push_str(&index.to_string()),
-            "spp" => out.push_str(&settings.spp.unwrap_or(1).to_string()),
+            "spp" => out.push_str(&settings.render.spp.unwrap_or(1).to_string()),
             _ => {
-                return Err(format!(
-                    "output template '{template}': unknown placeholder '{{{key}}}' (one of {})",
-                    TEMPLATE_KEYS
-                        .iter()
-                        .map(|k| format!("{{{k}}}"))
-                        .collect::<Vec<_>>()
-                        .join(", ")
-                ));
+                return Err(BatchError::UnknownPlaceholder {
+                    template: template.to_string(),
+                    key: key.to_string(),
+                });
             }
         }
         rest = &after[close + 1..];
@@ -166,46 +191,14 @@ pub fn shard_of(name: &str, count: u32) -> u32 {
     (fnv1a64(name.as_bytes()) % count.max(1) as u64) as u32
 }
 
-/// Parse `I/N` (0 ≤ I < N).
-pub fn parse_shard(s: &str) -> Result<(u32, u32), String> {
-    let (i, n) = s
-        .split_once('/')
-        .ok_or_else(|| format!("shard '{s}' is not I/N (e.g. 0/4)"))?;
-    let i: u32 = i
-        .trim()
-        .parse()
-        .map_err(|_| format!("bad shard index in '{s}'"))?;
-    let n: u32 = n
-        .trim()
-        .parse()
-        .map_err(|_| format!("bad shard count in '{s}'"))?;
-    if n == 0 || i >= n {
-        return Err(format!("shard '{s}': need 0 <= I < N"));
-    }
-    Ok((i, n))
-}
-
-/// Parse a crop `x0,x1,y0,y1` (pixel columns x0..x1 and rows y0..y1, half-open).
-pub fn parse_crop(s: &str) -> Result<Region, String> {
-    let v: Vec<u32> = s
-        .split(',')
-        .map(|t| t.trim().parse::<u32>())
-        .collect::<Result<_, _>>()
-        .map_err(|_| format!("crop '{s}' is not x0,x1,y0,y1 (four whole numbers)"))?;
-    let [x0, x1, y0, y1] = v[..] else {
-        return Err(format!(
-            "crop '{s}' is not x0,x1,y0,y1 (four whole numbers)"
-        ));
-    };
-    if x0 >= x1 || y0 >= y1 {
-        return Err(format!("crop '{s}': need x0 < x1 and y0 < y1"));
-    }
-    Ok(Region { x0, x1, y0, y1 })
+/// Parse `--shard I/N` (shard `I` of `N`, `0 <= I < N`).
+pub fn parse_shard(s: &str) -> Result<(u32, u32), IndexOfError> {
+    parse_index_of("shard", s)
 }
 
 /// Expand scene arguments: an argument holding `*`, `?` or `[` is a glob (sorted
 /// matches; none is an error), anything else a path or `spd:` spec taken as it is.
-pub fn expand_scene_args(args: &[PathBuf]) -> Result<Vec<PathBuf>, String> {
+pub fn expand_scene_args(args: &[PathBuf]) -> Result<Vec<PathBuf>, BatchError> {
     let mut out = Vec::new();
     for a in args {
         let s = a.to_string_lossy();
@@ -213,10 +206,13 @@ pub fn expand_scene_args(args: &[PathBuf]) -> Result<Vec<PathBuf>, String> {
             out.push(a.clone());
             continue;
         }
-        let paths = glob::glob(&s).map_err(|e| format!("bad glob '{s}': {e}"))?;
+        let paths = glob::glob(&s).map_err(|e| BatchError::BadGlob {
+            pattern: s.to_string(),
+            message: e.to_string(),
+        })?;
         let mut matched: Vec<PathBuf> = paths.filter_map(Result::ok).collect();
         if matched.is_empty() {
-            return Err(format!("glob '{s}' matches no file"));
+            return Err(BatchError::NoMatch(s.to_string()));
         }
         matched.sort();
         out.extend(matched);
@@ -229,7 +225,7 @@ pub fn jobs_from_scenes(
     scenes: &[PathBuf],
     template: &str,
     settings: &JobSettings,
-) -> Result<Vec<Job>, String> {
+) -> Result<Vec<Job>, BatchError> {
     scenes
         .iter()
         .enumerate()
@@ -247,20 +243,25 @@ pub fn jobs_from_scenes(
 
 /// Refuse a batch whose jobs share a name or an output file, or write an unsupported
 /// format, before anything runs.
-pub fn check_jobs(jobs: &[Job]) -> Result<(), String> {
+pub fn check_jobs(jobs: &[Job]) -> Result<(), BatchError> {
     let mut names = std::collections::HashMap::new();
     let mut outputs = std::collections::HashMap::new();
     for (i, j) in jobs.iter().enumerate() {
-        crate::output::Format::from_path(&j.output).map_err(|e| e.to_string())?;
-        Database::parse_spec(&j.scene.to_string_lossy())?;
+        crate::output::Format::from_path(&j.output)?;
+        Database::parse_spec(&j.scene.to_string_lossy()).map_err(BatchError::Spec)?;
         if let Some(k) = names.insert(j.name.as_str(), i) {
-            return Err(format!("jobs {k} and {i} have the same name '{}'", j.name));
+            return Err(BatchError::SameName {
+                first: k,
+                second: i,
+                name: j.name.clone(),
+            });
         }
         if let Some(k) = outputs.insert(j.output.as_path(), i) {
-            return Err(format!(
-                "jobs {k} and {i} write the same file '{}' (use {{stem}}, {{backend}} or {{index}} in the template)",
-                j.output.display()
-            ));
+            return Err(BatchError::SameOutput {
+                first: k,
+                second: i,
+                output: j.output.clone(),
+            });
         }
     }
     Ok(())
@@ -281,7 +282,10 @@ mod tests {
     fn templates_expand_and_refuse_unknown_keys() {
         let s = JobSettings {
             backend: Some(Backend::Bvh),
-            spp: Some(4),
+            render: RenderRequest {
+                spp: Some(4),
+                ..RenderRequest::default()
+            },
             ..JobSettings::default()
         };
         let p = Path::new("dir/balls.nff");
@@ -293,43 +297,48 @@ mod tests {
             expand_template("{stem}.png", Path::new("spd:gears?size=2"), &s, 0).unwrap(),
             "gears_s2.png"
         );
-        assert!(
+        assert_eq!(
             expand_template("{colour}.png", p, &s, 0)
                 .unwrap_err()
-                .contains("unknown placeholder")
+                .to_string(),
+            "output template '{colour}.png': unknown placeholder '{colour}' (one of {stem}, \
+             {backend}, {index}, {spp})"
+        );
+        assert_eq!(
+            expand_template("{stem.png", p, &s, 0)
+                .unwrap_err()
+                .to_string(),
+            "output template '{stem.png': '{' without '}'"
         );
         assert!(expand_template("{stem.png", p, &s, 0).is_err());
     }
 
     #[test]
-    fn shards_and_crops_parse() {
+    fn shards_parse() {
         assert_eq!(parse_shard("2/5"), Ok((2, 5)));
-        assert!(parse_shard("5/5").is_err());
+        assert_eq!(
+            parse_shard("5/5").unwrap_err().to_string(),
+            "shard '5/5': need 0 <= I < N"
+        );
         assert!(parse_shard("1/0").is_err());
         assert!(parse_shard("x").is_err());
-        assert_eq!(
-            parse_crop("1,5,2,9"),
-            Ok(Region {
-                x0: 1,
-                x1: 5,
-                y0: 2,
-                y1: 9
-            })
-        );
-        assert!(parse_crop("5,1,2,9").is_err());
-        assert!(parse_crop("1,2,3").is_err());
     }
 
     #[test]
-    fn bands_cover_every_row_once() {
-        for n in 1..=9 {
-            let mut next = 0;
-            for i in 0..n {
-                let r = Region::band(i, n, 7, 23);
-                assert_eq!(r.y0, next);
-                next = r.y1;
-            }
-            assert_eq!(next, 23);
-        }
+    fn duplicate_names_and_outputs_are_refused() {
+        let job = |name: &str, out: &str| Job {
+            name: name.into(),
+            scene: "a.nff".into(),
+            output: out.into(),
+            settings: JobSettings::default(),
+        };
+        let e = check_jobs(&[job("a", "a.png"), job("a", "b.png")]).unwrap_err();
+        assert_eq!(e.to_string(), "jobs 0 and 1 have the same name 'a'");
+        let e = check_jobs(&[job("a", "a.png"), job("b", "a.png")]).unwrap_err();
+        assert_eq!(
+            e.to_string(),
+            "jobs 0 and 1 write the same file 'a.png' (use {stem}, {backend} or {index} in \
+             the template)"
+        );
     }
 }

@@ -1,7 +1,7 @@
 //! Running a batch: workers, progress, the JSON report, Ctrl-C.
 
-use super::{Job, load_scene};
-use crate::run::Report;
+use super::Job;
+use crate::run::{Report, limits, load_scene};
 use serde::Serialize;
 use std::io::IsTerminal;
 use std::path::{Path, PathBuf};
@@ -132,18 +132,20 @@ enum Msg {
     Finished(Box<JobRecord>),
 }
 
-/// Load and render one job.
+/// Load and render one job; the error is the report's `error`.
 fn render_job(
     job: &Job,
     max_memory: u64,
     progress: &(dyn Fn(usize, usize) + Sync),
 ) -> Result<(crate::render::Film, Report), String> {
     let t0 = Instant::now();
-    let scene = load_scene(&job.scene)?;
+    let scene = load_scene(&job.scene).map_err(|e| e.to_string())?;
     let load_ms = t0.elapsed().as_secs_f64() * 1e3;
-    let settings = job.settings.apply(&scene);
-    super::limits::check(&job.scene, &scene, &settings, max_memory)?;
     let name = job.scene.to_string_lossy();
+    let settings = (job.settings.render)
+        .settings(&scene)
+        .map_err(|e| format!("{name}: {e}"))?;
+    limits::check(&job.scene, &scene, &settings, max_memory).map_err(|e| e.to_string())?;
     let (film, report) = crate::run::render_scene(
         &name,
         &scene,

@@ -7,15 +7,111 @@ pub mod peer;
 pub mod raw;
 pub mod report;
 
-use crate::accel::Backend;
-use crate::accel::{BackendOptions, WithAccel};
+use crate::accel::{AccelError, Backend, BackendOptions, WithAccel};
+use crate::output::OutputError;
 use crate::render::RenderSettings;
+use crate::run::{RenderRequest, SceneError, load_scene};
 use crate::scene::Scene;
 use crate::spd::Database;
 use serde::{Deserialize, Serialize};
-use std::path::Path;
+use std::path::{Path, PathBuf};
 use std::process::Command;
 use std::time::Instant;
+
+/// Why a benchmark (or one of its runs) failed.
+#[derive(Debug, thiserror::Error)]
+pub enum BenchError {
+    /// A scene could not be generated, read or parsed.
+    #[error(transparent)]
+    Scene(#[from] SceneError),
+    /// A scene file that is not there.
+    #[error("{0}: no such scene file")]
+    NoSuchScene(String),
+    /// A backend name other than `embree` and `bvh`.
+    #[error("unknown backend '{0}' (embree or bvh)")]
+    UnknownBackend(String),
+    /// The worker threads could not be started.
+    #[error("cannot start {threads} threads: {message}")]
+    Threads {
+        /// How many were asked for.
+        threads: usize,
+        /// Why they could not be.
+        message: String,
+    },
+    /// The backend could not be built.
+    #[error(transparent)]
+    Accel(#[from] AccelError),
+    /// The child process could not be started.
+    #[error("cannot run {}: {message}", exe.display())]
+    Spawn {
+        /// The executable.
+        exe: PathBuf,
+        /// Why.
+        message: String,
+    },
+    /// A run failed in its child process.
+    #[error("{scene} on {backend} ({threads} threads, {mode:?}) failed ({status}): {stderr}")]
+    RunFailed {
+        /// The run's scene.
+        scene: String,
+        /// Its backend.
+        backend: String,
+        /// Its threads.
+        threads: usize,
+        /// What it measured.
+        mode: Mode,
+        /// The child's exit status.
+        status: String,
+        /// What the child printed on standard error.
+        stderr: String,
+    },
+    /// A child's answer is not a run result.
+    #[error("bad answer from a bench run ({message}): {line}")]
+    BadAnswer {
+        /// Why it does not parse.
+        message: String,
+        /// The answer.
+        line: String,
+    },
+    /// A file or directory could not be read, written or created.
+    #[error("{}: cannot {action}: {message}", path.display())]
+    Io {
+        /// The file or directory.
+        path: PathBuf,
+        /// `read`, `write` or `create`.
+        action: &'static str,
+        /// Why.
+        message: String,
+    },
+    /// A `--baseline` file that is not what `emray bench --json` writes.
+    #[error("{}:{line}:{column}: not an `emray bench --json` file: {message}", path.display())]
+    NotSaved {
+        /// The file.
+        path: PathBuf,
+        /// Where it stops making sense.
+        line: usize,
+        /// The column.
+        column: usize,
+        /// What is wrong.
+        message: String,
+    },
+    /// Tachyon failed.
+    #[error(transparent)]
+    Peer(#[from] peer::PeerError),
+    /// A report file could not be written.
+    #[error(transparent)]
+    Output(#[from] OutputError),
+}
+
+impl BenchError {
+    fn io(path: impl Into<PathBuf>, action: &'static str, e: std::io::Error) -> Self {
+        BenchError::Io {
+            path: path.into(),
+            action,
+            message: e.to_string(),
+        }
+    }
+}
 
 /// What a run measures.
 #[derive(Clone, Copy, Debug, PartialEq, Eq, Hash, Serialize, Deserialize)]
@@ -104,20 +200,11 @@ pub struct RunResult {
     pub accel: String,
 }
 
-/// Load a scene named as on the command line.
-pub fn load_scene(name: &str) -> Result<Scene, String> {
-    match Database::parse_spec(name)? {
-        Some((db, size)) => crate::load::nff::parse_str(&db.generate(size), Path::new(name))
-            .map_err(|e| e.to_string()),
-        None => crate::load::load_path(Path::new(name)).map_err(|e| e.to_string()),
-    }
-}
-
-fn backend_named(name: &str) -> Result<Backend, String> {
+fn backend_named(name: &str) -> Result<Backend, BenchError> {
     match name {
         "embree" => Ok(Backend::Embree),
         "bvh" => Ok(Backend::Bvh),
-        _ => Err(format!("unknown backend '{name}' (embree or bvh)")),
+        _ => Err(BenchError::UnknownBackend(name.to_string())),
     }
 }
 
@@ -136,24 +223,37 @@ impl WithAccel for RawWork<'_> {
     }
 }
 
+/// The settings of every run: the image size asked for, one sample per pixel, depth 5
+/// and the full ray tree (no bailout) whatever the scene file says, so that runs of
+/// every version measure the same work; SPD mode if asked.
+fn run_settings(spec: &RunSpec, scene: &Scene) -> RenderSettings {
+    let request = RenderRequest {
+        res: Some((spec.width, spec.height)),
+        spp: Some(1),
+        max_depth: Some(5),
+        spd: spec.spd,
+        bailout: Some(0.0),
+        ..RenderRequest::default()
+    };
+    request
+        .settings(scene)
+        .expect("a request without a part fits every scene")
+}
+
 /// Do one run in this process (the child side of `emray bench`).
-pub fn run_child(spec: &RunSpec) -> Result<RunResult, String> {
+pub fn run_child(spec: &RunSpec) -> Result<RunResult, BenchError> {
     let backend = backend_named(&spec.backend)?;
     let pool = rayon::ThreadPoolBuilder::new()
         .num_threads(spec.threads.max(1))
         .build()
-        .map_err(|e| format!("cannot start {} threads: {e}", spec.threads))?;
+        .map_err(|e| BenchError::Threads {
+            threads: spec.threads,
+            message: e.to_string(),
+        })?;
     let t0 = Instant::now();
     let scene = load_scene(&spec.scene)?;
     let load_ms = t0.elapsed().as_secs_f64() * 1e3;
-    let mut settings = RenderSettings::for_scene(&scene);
-    settings.width = spec.width;
-    settings.height = spec.height;
-    if spec.spd {
-        settings.spd = true;
-        settings.spp = 1;
-        settings.max_depth = 5;
-    }
+    let settings = run_settings(spec, &scene);
     let options = BackendOptions {
         backend,
         embree_quality: spec.embree_quality,
@@ -163,8 +263,7 @@ pub fn run_child(spec: &RunSpec) -> Result<RunResult, String> {
     let (build_ms, ms, rays, accel) = pool.install(|| match spec.mode {
         Mode::Render => {
             let (_, rep) =
-                crate::run::render_scene(&spec.scene, &scene, options, &settings, load_ms, None)
-                    .map_err(|e| e.to_string())?;
+                crate::run::render_scene(&spec.scene, &scene, options, &settings, load_ms, None)?;
             let r = |k: &str| rep.rays.get(k).copied().unwrap_or(0);
             let rays = Rays {
                 eye: r("eye"),
@@ -173,15 +272,14 @@ pub fn run_child(spec: &RunSpec) -> Result<RunResult, String> {
                 shadow: r("shadow"),
                 total: r("total"),
             };
-            Ok::<_, String>((rep.time_ms.build, rep.time_ms.render, rays, rep.accel))
+            Ok::<_, AccelError>((rep.time_ms.build, rep.time_ms.render, rays, rep.accel))
         }
         Mode::Raw => {
             let work = RawWork {
                 scene: &scene,
                 settings: &settings,
             };
-            let (build_ms, cast, counts, detail) =
-                crate::accel::build(&scene, &options, work).map_err(|e| e.to_string())?;
+            let (build_ms, cast, counts, detail) = crate::accel::build(&scene, &options, work)?;
             Ok((build_ms, cast.ms, Rays::from(counts), detail))
         }
     })?;
@@ -211,27 +309,32 @@ pub fn peak_rss_kib() -> Option<u64> {
 }
 
 /// Run `spec` in a child process `exe bench --child JSON` and parse its answer.
-pub fn run_in_child(exe: &Path, spec: &RunSpec) -> Result<RunResult, String> {
+pub fn run_in_child(exe: &Path, spec: &RunSpec) -> Result<RunResult, BenchError> {
     let json = serde_json::to_string(spec).expect("spec serialises");
     let out = Command::new(exe)
         .args(["bench", "--child", &json])
         .output()
-        .map_err(|e| format!("cannot run {}: {e}", exe.display()))?;
+        .map_err(|e| BenchError::Spawn {
+            exe: exe.to_path_buf(),
+            message: e.to_string(),
+        })?;
     let stdout = String::from_utf8_lossy(&out.stdout);
     if !out.status.success() {
-        return Err(format!(
-            "{} on {} ({} threads, {:?}) failed ({}): {}",
-            spec.scene,
-            spec.backend,
-            spec.threads,
-            spec.mode,
-            out.status,
-            String::from_utf8_lossy(&out.stderr).trim()
-        ));
+        return Err(BenchError::RunFailed {
+            scene: spec.scene.clone(),
+            backend: spec.backend.clone(),
+            threads: spec.threads,
+            mode: spec.mode,
+            status: out.status.to_string(),
+            stderr: String::from_utf8_lossy(&out.stderr).trim().to_string(),
+        });
     }
     // The answer is the last line (a library may print above it).
     let line = stdout.lines().last().unwrap_or("");
-    serde_json::from_str(line).map_err(|e| format!("bad answer from a bench run ({e}): {line}"))
+    serde_json::from_str(line).map_err(|e| BenchError::BadAnswer {
+        message: e.to_string(),
+        line: line.to_string(),
+    })
 }
 
 /// What to benchmark.
@@ -310,22 +413,22 @@ struct PeerFiles {
 }
 
 impl PeerFiles {
-    fn new(scenes: &[String]) -> Result<PeerFiles, String> {
+    fn new(scenes: &[String]) -> Result<PeerFiles, BenchError> {
         let dir = std::env::temp_dir().join(format!("emray-bench-{}", std::process::id()));
-        std::fs::create_dir_all(&dir)
-            .map_err(|e| format!("{}: cannot create: {e}", dir.display()))?;
+        std::fs::create_dir_all(&dir).map_err(|e| BenchError::io(&dir, "create", e))?;
         let mut files = std::collections::BTreeMap::new();
         for (k, name) in scenes.iter().enumerate() {
-            let text = match Database::parse_spec(name)? {
+            let spec = Database::parse_spec(name).map_err(SceneError::Spec)?;
+            let text = match spec {
                 Some((db, size)) => db.generate(size),
                 // Tachyon reads NFF only.
-                None if name.ends_with(".nff") => std::fs::read_to_string(name)
-                    .map_err(|e| format!("{name}: cannot read: {e}"))?,
+                None if name.ends_with(".nff") => {
+                    std::fs::read_to_string(name).map_err(|e| BenchError::io(name, "read", e))?
+                }
                 None => continue,
             };
             let path = dir.join(format!("scene{k}.nff"));
-            std::fs::write(&path, &text)
-                .map_err(|e| format!("{}: cannot write: {e}", path.display()))?;
+            std::fs::write(&path, &text).map_err(|e| BenchError::io(&path, "write", e))?;
             let scene = load_scene(name)?;
             files.insert(name.clone(), (path, peer::differences(&scene)));
         }
@@ -355,10 +458,15 @@ pub struct Measured {
 /// Run the suite: for every repetition, every scene, every thread count, every backend
 /// and then Tachyon (interleaved, so that load changes on the machine hit every row
 /// alike). `log` is told of every finished run.
-pub fn run_suite(cfg: &Config, exe: &Path, log: &mut dyn FnMut(&str)) -> Result<Measured, String> {
+pub fn run_suite(
+    cfg: &Config,
+    exe: &Path,
+    log: &mut dyn FnMut(&str),
+) -> Result<Measured, BenchError> {
     for s in &cfg.scenes {
-        if Database::parse_spec(s)?.is_none() && !Path::new(s).is_file() {
-            return Err(format!("{s}: no such scene file"));
+        let spec = Database::parse_spec(s).map_err(SceneError::Spec)?;
+        if spec.is_none() && !Path::new(s).is_file() {
+            return Err(BenchError::NoSuchScene(s.clone()));
         }
     }
     let mut m = Measured::default();
@@ -438,16 +546,13 @@ pub struct Outputs {
 }
 
 /// Read a JSON file written by `emray bench --json`.
-pub fn read_saved(path: &Path) -> Result<report::Saved, String> {
-    let text = std::fs::read_to_string(path)
-        .map_err(|e| format!("{}: cannot read: {e}", path.display()))?;
-    serde_json::from_str(&text).map_err(|e| {
-        format!(
-            "{}:{}:{}: not an `emray bench --json` file: {e}",
-            path.display(),
-            e.line(),
-            e.column()
-        )
+pub fn read_saved(path: &Path) -> Result<report::Saved, BenchError> {
+    let text = std::fs::read_to_string(path).map_err(|e| BenchError::io(path, "read", e))?;
+    serde_json::from_str(&text).map_err(|e| BenchError::NotSaved {
+        path: path.to_path_buf(),
+        line: e.line(),
+        column: e.column(),
+        message: e.to_string(),
     })
 }
 
@@ -457,7 +562,7 @@ pub fn bench(
     outs: &Outputs,
     exe: &Path,
     log: &mut dyn FnMut(&str),
-) -> Result<String, String> {
+) -> Result<String, BenchError> {
     let base = outs.baseline.as_deref().map(read_saved).transpose()?;
     let mut machine = Machine::probe();
     let m = run_suite(cfg, exe, log)?;
@@ -471,7 +576,7 @@ pub fn bench(
         md.push_str(&report::compare(&rows, &b.rows));
     }
     if let Some(p) = &outs.csv {
-        crate::output::write_text(p, &report::csv(&rows)).map_err(|e| e.to_string())?;
+        crate::output::write_text(p, &report::csv(&rows))?;
     }
     if let Some(p) = &outs.json {
         let saved = report::Saved {
@@ -482,7 +587,7 @@ pub fn bench(
             samples: m.samples,
         };
         let text = serde_json::to_string_pretty(&saved).expect("report serialises");
-        crate::output::write_text(p, &text).map_err(|e| e.to_string())?;
+        crate::output::write_text(p, &text)?;
     }
     Ok(md)
 }
@@ -575,7 +680,9 @@ mod tests {
         assert!(r.rays.reflection > 0 && r.rays.shadow > 0);
         assert_eq!(
             r.prims,
-            load_scene("spd:balls?size=1").unwrap().prim_count()
+            crate::run::load_scene("spd:balls?size=1")
+                .unwrap()
+                .prim_count()
         );
         let raw = run_child(&RunSpec {
             mode: Mode::Raw,

@@ -4,7 +4,7 @@
 
 use crate::scene::Scene;
 use serde::{Deserialize, Serialize};
-use std::path::Path;
+use std::path::{Path, PathBuf};
 use std::process::Command;
 
 /// One scene × thread count on Tachyon.
@@ -83,6 +83,27 @@ pub fn differences(scene: &Scene) -> String {
     notes.join("; ")
 }
 
+/// Why a Tachyon run gave no time.
+#[derive(Debug, thiserror::Error)]
+pub enum PeerError {
+    /// `tachyon` could not be started.
+    #[error("cannot run tachyon: {0}")]
+    Spawn(String),
+    /// It exited with a failure.
+    #[error("tachyon on {} failed ({status}): {stderr}", nff.display())]
+    Failed {
+        /// The scene.
+        nff: PathBuf,
+        /// Its exit status.
+        status: String,
+        /// What it printed on standard error.
+        stderr: String,
+    },
+    /// Its output has no ray-tracing time.
+    #[error("tachyon on {}: no 'Ray Tracing Time' in its output", .0.display())]
+    NoTime(PathBuf),
+}
+
 /// Render the NFF file `nff` with Tachyon at `width × height` on `threads` threads,
 /// depth 5, writing its image to `image`.
 pub fn run(
@@ -91,7 +112,7 @@ pub fn run(
     width: u32,
     height: u32,
     threads: usize,
-) -> Result<TachyonTimes, String> {
+) -> Result<TachyonTimes, PeerError> {
     let out = Command::new("tachyon")
         .arg(nff)
         .args(["-res", &width.to_string(), &height.to_string()])
@@ -99,22 +120,16 @@ pub fn run(
         .args(["-format", "PPM", "-o"])
         .arg(image)
         .output()
-        .map_err(|e| format!("cannot run tachyon: {e}"))?;
+        .map_err(|e| PeerError::Spawn(e.to_string()))?;
     let text = String::from_utf8_lossy(&out.stdout);
     if !out.status.success() {
-        return Err(format!(
-            "tachyon on {} failed ({}): {}",
-            nff.display(),
-            out.status,
-            String::from_utf8_lossy(&out.stderr).trim()
-        ));
+        return Err(PeerError::Failed {
+            nff: nff.to_path_buf(),
+            status: out.status.to_string(),
+            stderr: String::from_utf8_lossy(&out.stderr).trim().to_string(),
+        });
     }
-    parse_times(&text).ok_or_else(|| {
-        format!(
-            "tachyon on {}: no 'Ray Tracing Time' in its output",
-            nff.display()
-        )
-    })
+    parse_times(&text).ok_or_else(|| PeerError::NoTime(nff.to_path_buf()))
 }
 
 #[cfg(test)]

@@ -7,6 +7,7 @@ use super::{Error, init_log};
 use emray::accel::Backend;
 use emray::batch::{self, BatchOptions, Job, JobSettings};
 use emray::output::Encoding;
+use emray::run::RenderRequest;
 use std::path::PathBuf;
 
 /// `emray batch`.
@@ -60,7 +61,7 @@ pub struct Args {
     #[arg(long)]
     pub list: bool,
     /// Refuse jobs estimated to need more memory (e.g. 8G) [default: 3/4 of RAM].
-    #[arg(long, value_name = "SIZE", value_parser = emray::batch::limits::parse_size)]
+    #[arg(long, value_name = "SIZE", value_parser = emray::run::limits::parse_size)]
     pub max_memory: Option<u64>,
     /// No progress, only errors.
     #[arg(short, long)]
@@ -86,7 +87,7 @@ impl Args {
 pub fn run(b: Args) -> Result<(), Error> {
     init_log(b.quiet, 0);
     let jobs = jobs(&b)?;
-    batch::check_jobs(&jobs).map_err(Error::usage)?;
+    batch::check_jobs(&jobs).map_err(|e| Error::Usage(e.into()))?;
     let jobs: Vec<Job> = match b.shard {
         Some((i, n)) => jobs
             .into_iter()
@@ -112,7 +113,7 @@ pub fn run(b: Args) -> Result<(), Error> {
         quiet: b.quiet,
         max_memory: b
             .max_memory
-            .unwrap_or_else(batch::limits::default_max_memory),
+            .unwrap_or_else(emray::run::limits::default_max_memory),
         shard: b.shard,
     };
     let report = batch::run(jobs, &opts);
@@ -136,14 +137,17 @@ fn jobs(b: &Args) -> Result<Vec<Job>, Error> {
     }
     let settings = JobSettings {
         backend: b.backend.map(Backend::from),
-        res: b.res,
-        spp: b.spp,
-        max_depth: b.max_depth,
-        spd: b.spd,
+        render: RenderRequest {
+            res: b.res,
+            spp: b.spp,
+            max_depth: b.max_depth,
+            spd: b.spd,
+            ..RenderRequest::default()
+        },
         encoding: b.encoding.map(Into::into).unwrap_or_default(),
     };
     let template = b.output.as_deref().unwrap_or("{stem}.png");
     batch::expand_scene_args(&b.scenes)
         .and_then(|s| batch::jobs_from_scenes(&s, template, &settings))
-        .map_err(Error::usage)
+        .map_err(|e| Error::Usage(e.into()))
 }

@@ -74,7 +74,7 @@ pub fn run(b: Args) -> Result<(), Error> {
     let exe = std::env::current_exe()
         .map_err(|e| Error::failed(format!("cannot find the emray executable: {e}")))?;
     let mut log = |line: &str| eprintln!("{line}");
-    let md = bench::bench(&cfg, &outs, &exe, &mut log).map_err(Error::failed)?;
+    let md = bench::bench(&cfg, &outs, &exe, &mut log)?;
     print!("{md}");
     Ok(())
 }
@@ -83,7 +83,7 @@ pub fn run(b: Args) -> Result<(), Error> {
 fn child(json: &str) -> Result<(), Error> {
     let spec = serde_json::from_str::<RunSpec>(json)
         .map_err(|e| Error::failed(format!("bad run description: {e}")))?;
-    let result = bench::run_child(&spec).map_err(Error::failed)?;
+    let result = bench::run_child(&spec)?;
     println!(
         "{}",
         serde_json::to_string(&result).expect("result serialises")

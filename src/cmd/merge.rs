@@ -23,7 +23,7 @@ pub struct Args {
 /// Check that the parts make one image, and write it.
 pub fn run(m: Args) -> Result<(), Error> {
     Format::from_path(&m.output)?;
-    let film = emray::batch::merge::merge(&m.parts).map_err(Error::failed)?;
+    let film = emray::batch::merge::merge(&m.parts)?;
     output::write_image(&m.output, &film, m.encoding.into())?;
     Ok(())
 }

@@ -6,6 +6,7 @@ use super::{Error, append_json_line, init_log, thread_pool};
 use anyhow::{Context, Result};
 use emray::accel::Backend;
 use emray::output::{self, Encoding, Format};
+use emray::run::RenderRequest;
 use std::path::PathBuf;
 
 /// `emray radiosity`.
@@ -54,14 +55,20 @@ fn solve_and_write(a: &Args) -> Result<()> {
     let pool = thread_pool(a.threads)?;
     let scene = emray::load::load_path(&a.scene)?;
     let settings = a.solve.settings();
-    let (w, h) = a.res.unwrap_or((scene.camera.width, scene.camera.height));
+    let view = RenderRequest {
+        res: a.res,
+        ..RenderRequest::default()
+    }
+    .settings(&scene)?;
     let spp = (a.spp as f32).sqrt().floor().max(1.0) as u32;
     let backend: Backend = a
         .backend
         .map(Backend::from)
         .unwrap_or_else(Backend::default_available);
     let (sol, film, report) = pool
-        .install(|| emray::radiosity::run(&scene, backend, &settings, (w, h, spp)))
+        .install(|| {
+            emray::radiosity::run(&scene, backend, &settings, (view.width, view.height, spp))
+        })
         .with_context(|| a.scene.display().to_string())?;
     output::write_image(&a.output, &film, Encoding::Srgb)?;
     if let Some(p) = &a.ply {

@@ -11,11 +11,10 @@ use anyhow::{Result, anyhow, bail};
 use clap::ValueEnum;
 use emray::Scene;
 use emray::accel::{Backend, BackendOptions};
-use emray::batch::{JobSettings, limits};
 use emray::load;
 use emray::output::{self, Format, part};
-use emray::render::{Aa, Film, Region, RenderSettings};
-use emray::run::{self, Report};
+use emray::render::{Aa, Film, RenderSettings};
+use emray::run::{self, Part, RenderRequest, Report, limits};
 use emray::scene::Environment;
 use emray::spd::Database;
 use std::path::{Path, PathBuf};
@@ -115,10 +114,10 @@ pub struct Args {
     #[arg(long, value_name = "I/N", value_parser = emray::batch::parse_shard, conflicts_with = "crop")]
     pub tile: Option<(u32, u32)>,
     /// Render only columns x0..x1 and rows y0..y1 (half-open), to an EXR part.
-    #[arg(long, value_name = "x0,x1,y0,y1", value_parser = emray::batch::parse_crop)]
+    #[arg(long, value_name = "x0,x1,y0,y1", value_parser = emray::run::parse_crop)]
     pub crop: Option<emray::Region>,
     /// Refuse a render estimated to need more memory (e.g. 8G) [default: 3/4 of RAM].
-    #[arg(long, value_name = "SIZE", value_parser = emray::batch::limits::parse_size)]
+    #[arg(long, value_name = "SIZE", value_parser = emray::run::limits::parse_size)]
     pub max_memory: Option<u64>,
     /// Environment map for rays that leave the scene (PNG/JPEG: 2:1 latitude-longitude
     /// or a 4:3 cube cross, or a directory of six cube faces px, nx, py, ny, pz, nz),
@@ -297,47 +296,25 @@ fn check_part(args: &Args, jobs: &[Job]) -> Result<()> {
     Ok(())
 }
 
-/// The settings for `scene` (named `name`): the scene's, overridden by the options.
-fn settings(args: &Args, name: &str, scene: &Scene) -> Result<RenderSettings> {
-    let job = JobSettings {
-        backend: args.backend.map(Backend::from),
+/// What the options ask of the render besides the scene.
+fn request(args: &Args) -> RenderRequest {
+    RenderRequest {
         res: args.res,
         spp: args.spp,
         max_depth: args.max_depth,
         spd: args.spd,
-        encoding: args.encoding.into(),
-    };
-    let mut settings = job.apply(scene);
-    settings.bailout = args.bailout.unwrap_or(settings.bailout);
-    if args.aa == AaArg::Adaptive {
-        settings.aa = Aa::Adaptive {
+        bailout: args.bailout,
+        aa: (args.aa == AaArg::Adaptive).then_some(Aa::Adaptive {
             threshold: args.aa_threshold,
             depth: args.aa_depth,
-        };
+        }),
+        cast_skippable: args.no_skip,
+        area_samples: Some(args.area_samples),
+        part: match (args.tile, args.crop) {
+            (Some((index, count)), _) => Some(Part::Tile { index, count }),
+            (None, crop) => crop.map(Part::Crop),
+        },
     }
-    settings.skip = !args.no_skip;
-    settings.area_samples = (args.area_samples as f32).sqrt().floor().max(1.0) as u32;
-    settings.region = region(args, name, settings.width, settings.height)?;
-    Ok(settings)
-}
-
-/// The part of the `w × h` image that `--tile` or `--crop` asks for.
-fn region(args: &Args, name: &str, w: u32, h: u32) -> Result<Option<Region>> {
-    let region = match (args.tile, args.crop) {
-        (Some((i, n)), _) => Some(Region::band(i, n, w, h)),
-        (None, Some(c)) if !c.fits(w, h) => bail!(
-            "{name}: crop {},{},{},{} is not inside the {w}x{h} image",
-            c.x0,
-            c.x1,
-            c.y0,
-            c.y1
-        ),
-        (None, c) => c,
-    };
-    if region.is_some_and(|r| r.height() == 0) {
-        bail!("{name}: --tile leaves no rows for this part of a {h}-row image (use fewer tiles)");
-    }
-    Ok(region)
 }
 
 /// The backend and its build options.
@@ -356,10 +333,7 @@ fn backend_options(args: &Args) -> BackendOptions {
 /// The scene's name and the scene, with `--envmap` in place of its own.
 fn load_scene(args: &Args, path: Option<&Path>) -> Result<(String, Scene)> {
     let (name, mut scene) = match path {
-        Some(p) => (
-            p.display().to_string(),
-            emray::batch::load_scene(p).map_err(anyhow::Error::msg)?,
-        ),
+        Some(p) => (p.display().to_string(), run::load_scene(p)?),
         None => (
             "default".into(),
             load::nff::parse_str(DEFAULT_SCENE, Path::new("<default scene>"))?,
@@ -376,9 +350,11 @@ fn render_one(args: &Args, scene_path: Option<&Path>, out: &Path) -> Result<()> 
     let t0 = Instant::now();
     let (name, scene) = load_scene(args, scene_path)?;
     let load_ms = t0.elapsed().as_secs_f64() * 1e3;
-    let settings = settings(args, &name, &scene)?;
+    let settings = request(args)
+        .settings(&scene)
+        .map_err(|e| anyhow!("{name}: {e}"))?;
     let max_memory = args.max_memory.unwrap_or_else(limits::default_max_memory);
-    limits::check(Path::new(&name), &scene, &settings, max_memory).map_err(anyhow::Error::msg)?;
+    limits::check(Path::new(&name), &scene, &settings, max_memory)?;
     let options = backend_options(args);
     let bar = TileBar::new(&name, args.quiet);
     let (film, report) = trace(args, &name, &scene, &settings, options, load_ms, &bar)?;

@@ -26,12 +26,13 @@ pub struct Args {
 /// Run the study and print its CSV; a bad `spd:` spec is a usage error.
 #[cfg(feature = "quality")]
 pub fn run(a: Args) -> Result<(), Error> {
+    use emray::run::{SceneError, load_scene};
     let name = a.scene.display().to_string();
-    let scene = match emray::spd::Database::parse_spec(&name).map_err(Error::usage)? {
-        Some((db, size)) => emray::load::nff::parse_str(&db.generate(size), &a.scene),
-        None => emray::load::load_path(&a.scene),
-    }
-    .map_err(|e| Error::failed(format!("{name}: {e}")))?;
+    let scene = match load_scene(&a.scene) {
+        Err(SceneError::Spec(e)) => return Err(Error::usage(e)),
+        Err(e) => return Err(Error::failed(format!("{name}: {e}"))),
+        Ok(s) => s,
+    };
     let mut backends = vec![emray::Backend::Bvh];
     if cfg!(feature = "embree") {
         backends.push(emray::Backend::Embree);

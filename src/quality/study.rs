@@ -6,10 +6,36 @@
 use super::metrics::{Metrics, compare};
 use crate::Scene;
 use crate::accel::{AccelError, Backend};
+use crate::output::OutputError;
 use crate::render::{Aa, RenderSettings};
-use crate::run::{render_reference, render_scene};
+use crate::run::{ReferenceUnsupported, render_reference, render_scene};
 use std::fmt::Write as _;
-use std::path::Path;
+use std::path::{Path, PathBuf};
+
+/// Why the study could not be run or written.
+#[derive(Debug, thiserror::Error)]
+pub enum StudyError {
+    /// The f64 reference does not model something in the scene.
+    #[error(transparent)]
+    Reference(#[from] ReferenceUnsupported),
+    /// A backend could not be built.
+    #[error(transparent)]
+    Accel(#[from] AccelError),
+    /// The output directory could not be created.
+    #[error("{}: cannot create: {message}", dir.display())]
+    CreateDir {
+        /// The directory.
+        dir: PathBuf,
+        /// Why.
+        message: String,
+    },
+    /// The plot could not be drawn.
+    #[error("plotting: {0}")]
+    Plot(String),
+    /// A file could not be written.
+    #[error(transparent)]
+    Output(#[from] OutputError),
+}
 
 /// One run of the sweep.
 #[derive(Clone, Debug)]
@@ -33,7 +59,7 @@ pub fn run(
     h: u32,
     strata: u32,
     backends: &[Backend],
-) -> Result<Vec<Row>, String> {
+) -> Result<Vec<Row>, StudyError> {
     let mut base = RenderSettings::for_scene(scene);
     base.width = w;
     base.height = h;
@@ -54,12 +80,11 @@ pub fn run(
         });
         Ok(())
     };
-    let err = |e: AccelError| e.to_string();
     let b0 = backends[0];
     for spp in [1, 2, 4, 8, 16, 32, 64] {
         let mut st = base.clone();
         st.spp = spp;
-        go("spp", spp.to_string(), &st, b0).map_err(err)?;
+        go("spp", spp.to_string(), &st, b0)?;
     }
     for t in [0.2f32, 0.1, 0.05, 0.02, 0.01] {
         let mut st = base.clone();
@@ -67,24 +92,24 @@ pub fn run(
             threshold: t,
             depth: 2,
         };
-        go("adaptive", format!("t={t} d=2"), &st, b0).map_err(err)?;
+        go("adaptive", format!("t={t} d=2"), &st, b0)?;
     }
     for wgt in [0.3f32, 0.1, 0.03, 0.01, 0.001] {
         let mut st = base.clone();
         st.spp = 16;
         st.bailout = wgt;
-        go("bailout", format!("{wgt} @16spp"), &st, b0).map_err(err)?;
+        go("bailout", format!("{wgt} @16spp"), &st, b0)?;
     }
     for depth in [1, 2, 3, 5, 8] {
         let mut st = base.clone();
         st.spp = 16;
         st.max_depth = depth;
-        go("depth", format!("{depth} @16spp"), &st, b0).map_err(err)?;
+        go("depth", format!("{depth} @16spp"), &st, b0)?;
     }
     for &b in backends {
         let mut st = base.clone();
         st.spp = 16;
-        go("backend", format!("{} @16spp", b.name()), &st, b).map_err(err)?;
+        go("backend", format!("{} @16spp", b.name()), &st, b)?;
     }
     // f64 against the reference: the reference's own sampling noise.
     for n in [2u32, 4] {
@@ -157,10 +182,10 @@ fn plot<DB: plotters::prelude::DrawingBackend>(
     root: plotters::prelude::DrawingArea<DB, plotters::coord::Shift>,
     rows: &[Row],
     title: &str,
-) -> Result<(), String> {
+) -> Result<(), StudyError> {
     use plotters::prelude::*;
     register_font();
-    let e = |e: DrawingAreaErrorKind<DB::ErrorType>| format!("plotting: {e}");
+    let e = |e: DrawingAreaErrorKind<DB::ErrorType>| StudyError::Plot(e.to_string());
     let pts: Vec<(f64, f64)> = rows
         .iter()
         .map(|r| (r.ms.max(1e-3), r.m.rmse.max(1e-9)))
@@ -235,7 +260,7 @@ fn plot<DB: plotters::prelude::DrawingBackend>(
 }
 
 /// The plot as SVG.
-pub fn svg(rows: &[Row], title: &str) -> Result<String, String> {
+pub fn svg(rows: &[Row], title: &str) -> Result<String, StudyError> {
     let mut out = String::new();
     {
         let root = plotters::prelude::SVGBackend::with_string(&mut out, PLOT_SIZE);
@@ -249,7 +274,7 @@ pub fn svg(rows: &[Row], title: &str) -> Result<String, String> {
 }
 
 /// The plot as an RGB image.
-pub fn raster(rows: &[Row], title: &str) -> Result<image::RgbImage, String> {
+pub fn raster(rows: &[Row], title: &str) -> Result<image::RgbImage, StudyError> {
     let (w, h) = PLOT_SIZE;
     let mut buf = vec![0u8; (w * h * 3) as usize];
     {
@@ -260,7 +285,7 @@ pub fn raster(rows: &[Row], title: &str) -> Result<image::RgbImage, String> {
             title,
         )?;
     }
-    image::RgbImage::from_raw(w, h, buf).ok_or_else(|| "plotting: bad buffer size".into())
+    image::RgbImage::from_raw(w, h, buf).ok_or_else(|| StudyError::Plot("bad buffer size".into()))
 }
 
 /// Run the study and write `study.csv`, `study.svg` and `study.png` into `dir`
@@ -273,20 +298,21 @@ pub fn write(
     h: u32,
     strata: u32,
     backends: &[Backend],
-) -> Result<Vec<Row>, String> {
+) -> Result<Vec<Row>, StudyError> {
     let rows = run(scene, w, h, strata, backends)?;
-    std::fs::create_dir_all(dir).map_err(|e| format!("{}: cannot create: {e}", dir.display()))?;
+    std::fs::create_dir_all(dir).map_err(|e| StudyError::CreateDir {
+        dir: dir.to_path_buf(),
+        message: e.to_string(),
+    })?;
     let title = format!("{name}, {w}x{h}: error vs time");
-    crate::output::write_text(&dir.join("study.csv"), &csv(&rows)).map_err(|e| e.to_string())?;
-    crate::output::write_text(&dir.join("study.svg"), &svg(&rows, &title)?)
-        .map_err(|e| e.to_string())?;
+    crate::output::write_text(&dir.join("study.csv"), &csv(&rows))?;
+    crate::output::write_text(&dir.join("study.svg"), &svg(&rows, &title)?)?;
     let png = raster(&rows, &title)?;
     crate::output::write_atomic(&dir.join("study.png"), |f| {
         let mut f = std::io::BufWriter::new(f);
         png.write_to(&mut f, image::ImageFormat::Png)
             .map_err(|e| e.to_string())?;
         std::io::Write::flush(&mut f).map_err(|e| e.to_string())
-    })
-    .map_err(|e| e.to_string())?;
+    })?;
     Ok(rows)
 }

@@ -3,7 +3,7 @@
 
 use crate::Scene;
 use crate::render::{Region, RenderSettings};
-use std::path::Path;
+use std::path::{Path, PathBuf};
 
 /// Bytes per primitive allowed for the acceleration structure (either backend's nodes
 /// and references, with room to spare).
@@ -42,11 +42,16 @@ pub fn default_max_memory() -> u64 {
         .unwrap_or(16 << 30)
 }
 
+/// A `--max-memory` value that is not a size.
+#[derive(Clone, Debug, PartialEq, Eq, thiserror::Error)]
+#[error("'{0}' is not a size (e.g. 512M, 4G, 1.5G, 1000000)")]
+pub struct SizeError(pub String);
+
 /// Parse a size: bytes, or a number with `K`, `M`, `G` or `T` (binary multiples;
 /// `KiB`/`KB`-style suffixes are accepted too).
-pub fn parse_size(s: &str) -> Result<u64, String> {
+pub fn parse_size(s: &str) -> Result<u64, SizeError> {
     let t = s.trim();
-    let bad = || format!("'{s}' is not a size (e.g. 512M, 4G, 1.5G, 1000000)");
+    let bad = || SizeError(s.to_string());
     let split = t
         .find(|c: char| !(c.is_ascii_digit() || c == '.'))
         .unwrap_or(t.len());
@@ -78,24 +83,45 @@ pub fn format_bytes(b: u64) -> String {
     }
 }
 
+/// A render refused because its estimated memory is over the limit.
+#[derive(Clone, Debug, PartialEq, thiserror::Error)]
+#[error(
+    "{}: rendering {width}x{height} with {prims} primitives needs about {}, over the memory \
+     limit of {} (--max-memory)",
+    scene.display(), format_bytes(*need), format_bytes(*limit)
+)]
+pub struct MemoryLimitError {
+    /// The scene.
+    pub scene: PathBuf,
+    /// Image width.
+    pub width: u32,
+    /// Image height.
+    pub height: u32,
+    /// Primitives in the scene.
+    pub prims: usize,
+    /// The estimate in bytes.
+    pub need: u64,
+    /// The limit in bytes.
+    pub limit: u64,
+}
+
 /// Refuse the render when its estimate is over `max` bytes.
 pub fn check(
     scene_path: &Path,
     scene: &Scene,
     settings: &RenderSettings,
     max: u64,
-) -> Result<(), String> {
+) -> Result<(), MemoryLimitError> {
     let need = estimate_bytes(scene, settings);
     if need > max {
-        return Err(format!(
-            "{}: rendering {}x{} with {} primitives needs about {}, over the memory limit of {} (--max-memory)",
-            scene_path.display(),
-            settings.width,
-            settings.height,
-            scene.prim_count(),
-            format_bytes(need),
-            format_bytes(max)
-        ));
+        return Err(MemoryLimitError {
+            scene: scene_path.to_path_buf(),
+            width: settings.width,
+            height: settings.height,
+            prims: scene.prim_count(),
+            need,
+            limit: max,
+        });
     }
     Ok(())
 }
@@ -107,6 +133,10 @@ mod tests {
     #[test]
     fn sizes_parse() {
         assert_eq!(parse_size("1000"), Ok(1000));
+        assert_eq!(
+            parse_size("lots").unwrap_err().to_string(),
+            "'lots' is not a size (e.g. 512M, 4G, 1.5G, 1000000)"
+        );
         assert_eq!(parse_size("512M"), Ok(512 << 20));
         assert_eq!(parse_size("4GiB"), Ok(4 << 30));
         assert_eq!(parse_size("1.5g"), Ok(3 << 29));
@@ -126,8 +156,13 @@ mod tests {
         assert!(check(Path::new("t.nff"), &scene, &s, 1 << 20).is_ok());
         s.width = 30000;
         s.height = 30000;
-        let e = check(Path::new("t.nff"), &scene, &s, 1 << 30).unwrap_err();
+        let e = check(Path::new("t.nff"), &scene, &s, 1 << 30)
+            .unwrap_err()
+            .to_string();
         assert!(e.starts_with("t.nff: rendering 30000x30000"), "{e}");
-        assert!(e.contains("--max-memory"), "{e}");
+        assert!(
+            e.ends_with("over the memory limit of 1.0 GiB (--max-memory)"),
+            "{e}"
+        );
     }
 }
