@@ -3,15 +3,16 @@
 //!
 //! A batch is a list of [`Job`]s (from scene paths, globs or a TOML manifest,
 //! [`manifest`]); [`run`] renders them one after another (or `jobs` at a time sharing
-//! the threads), writes a JSON [`BatchReport`] after every job, and stops cleanly on
-//! Ctrl-C. A job's shard is a stable hash of its name ([`shard_of`]); parts of one
-//! image rendered apart are put together by [`merge`].
+//! the threads), writes a JSON [`BatchReport`] after every job, tells an [`Observer`]
+//! how far it is, and stops cleanly when its [`Cancel`] flag is set (the command sets
+//! it on Ctrl-C). A job's shard is a stable hash of its name ([`shard_of`]); parts of
+//! one image rendered apart are put together by [`merge`].
 
 pub mod manifest;
 pub mod merge;
 mod runner;
 
-pub use runner::{BatchOptions, BatchReport, JobRecord, JobStatus, run};
+pub use runner::{BatchOptions, BatchReport, Cancel, JobRecord, JobStatus, Observer, run};
 
 use crate::accel::Backend;
 use crate::output::{Encoding, OutputError};

@@ -1,12 +1,13 @@
-//! Running a batch: workers, progress, the JSON report, Ctrl-C.
+//! Running a batch: workers, the JSON report, progress through an [`Observer`], and a
+//! clean stop when the [`Cancel`] flag is set.
 
 use super::Job;
+use crate::output::OutputError;
 use crate::run::{Report, limits, load_scene};
 use serde::Serialize;
-use std::io::IsTerminal;
 use std::path::{Path, PathBuf};
 use std::sync::atomic::{AtomicBool, AtomicUsize, Ordering};
-use std::sync::{Arc, Once, RwLock, mpsc};
+use std::sync::{Arc, RwLock, mpsc};
 use std::time::{Duration, Instant};
 
 /// How to run a batch.
@@ -20,8 +21,6 @@ pub struct BatchOptions {
     pub skip_existing: bool,
     /// Where the JSON report goes, rewritten after every job.
     pub report: Option<PathBuf>,
-    /// No progress, only errors.
-    pub quiet: bool,
     /// Refuse a job whose estimated memory exceeds this many bytes.
     pub max_memory: u64,
     /// The shard `I/N` being run, for the report.
@@ -65,6 +64,22 @@ pub struct JobRecord {
     pub error: Option<String>,
 }
 
+impl JobRecord {
+    /// The record of job `index` before it runs.
+    fn not_run(index: usize, job: &Job) -> Self {
+        JobRecord {
+            index,
+            name: job.name.clone(),
+            scene: job.scene.to_string_lossy().into_owned(),
+            output: job.output.to_string_lossy().into_owned(),
+            status: JobStatus::NotRun,
+            wall_ms: 0.0,
+            stats: None,
+            error: None,
+        }
+    }
+}
+
 /// The JSON report of a batch.
 #[derive(Clone, Debug, Serialize)]
 pub struct BatchReport {
@@ -96,34 +111,70 @@ impl BatchReport {
         self.skipped = n(JobStatus::Skipped);
         self.unfinished = n(JobStatus::Interrupted) + n(JobStatus::NotRun);
     }
+}
 
-    /// The process exit status: 130 when interrupted, 1 when a job failed, else 0.
-    pub fn exit_code(&self) -> u8 {
-        if self.interrupted {
-            130
-        } else if self.failed > 0 {
-            1
-        } else {
-            0
-        }
+/// A flag that stops a batch (set it from a Ctrl-C handler, say); clones share it.
+#[derive(Clone, Debug, Default)]
+pub struct Cancel(Arc<AtomicBool>);
+
+impl Cancel {
+    /// Ask the batch to stop.
+    pub fn cancel(&self) {
+        self.0.store(true, Ordering::SeqCst);
+    }
+
+    /// Whether it was asked to.
+    pub fn is_cancelled(&self) -> bool {
+        self.0.load(Ordering::SeqCst)
     }
 }
 
-/// Set by Ctrl-C.
-static STOP: AtomicBool = AtomicBool::new(false);
+/// What a batch tells while it runs (the command draws progress bars from it). Every
+/// method is called from the thread that called [`run`]; each does nothing by default.
+pub trait Observer {
+    /// Job `index` started.
+    fn started(&mut self, index: usize, job: &Job) {
+        let _ = (index, job);
+    }
 
-/// Workers hold it shared while they write an image (after checking [`STOP`]); on
-/// Ctrl-C the batch takes it exclusively, so it returns with no image half-written and
-/// no temporary file left, and every image in place is in the report.
-static WRITE_GATE: RwLock<()> = RwLock::new(());
+    /// Job `index` has rendered `done` of its `total` tiles.
+    fn progress(&mut self, index: usize, done: usize, total: usize) {
+        let _ = (index, done, total);
+    }
 
-fn catch_ctrl_c() {
-    static ONCE: Once = Once::new();
-    ONCE.call_once(|| {
-        if let Err(e) = ctrlc::set_handler(|| STOP.store(true, Ordering::SeqCst)) {
-            log::warn!("cannot catch Ctrl-C: {e}");
-        }
-    });
+    /// A job finished (rendered, failed or skipped): `done` of `total` jobs are, and
+    /// about `eta_s` seconds of rendering are left.
+    fn finished(&mut self, record: &JobRecord, done: usize, total: usize, eta_s: Option<f64>) {
+        let _ = (record, done, total, eta_s);
+    }
+
+    /// No job runs any more (all finished, or the batch was cancelled); the report is
+    /// written next.
+    fn stopped(&mut self) {}
+
+    /// The JSON report could not be written (the batch goes on).
+    fn report_not_written(&mut self, error: &OutputError) {
+        let _ = error;
+    }
+}
+
+/// Tells nothing.
+impl Observer for () {}
+
+/// What the workers of one batch share.
+struct Shared {
+    jobs: Vec<Job>,
+    /// The next job to take.
+    next: AtomicUsize,
+    cancel: Cancel,
+    /// Workers hold it shared while they write an image (after checking `cancel`);
+    /// once cancelled the batch takes it exclusively, so it returns with no image
+    /// half-written and no temporary file left, and every image in place is in the
+    /// report.
+    write_gate: RwLock<()>,
+    /// Worker threads per job.
+    threads: usize,
+    opts: BatchOptions,
 }
 
 enum Msg {
@@ -165,14 +216,12 @@ fn panic_message(p: &(dyn std::any::Any + Send)) -> String {
         .unwrap_or_else(|| "unknown panic".into())
 }
 
-fn worker(
-    jobs: Arc<Vec<Job>>,
-    next: Arc<AtomicUsize>,
-    tx: mpsc::Sender<Msg>,
-    threads: usize,
-    opts: BatchOptions,
-) {
-    let pool = match rayon::ThreadPoolBuilder::new().num_threads(threads).build() {
+/// Take jobs until none is left or the batch is cancelled, telling the batch of each.
+fn worker(shared: Arc<Shared>, tx: mpsc::Sender<Msg>) {
+    let pool = match rayon::ThreadPoolBuilder::new()
+        .num_threads(shared.threads)
+        .build()
+    {
         Ok(p) => p,
         Err(e) => {
             log::error!("cannot start worker threads: {e}");
@@ -180,180 +229,102 @@ fn worker(
         }
     };
     loop {
-        if STOP.load(Ordering::SeqCst) {
+        if shared.cancel.is_cancelled() {
             return;
         }
-        let i = next.fetch_add(1, Ordering::SeqCst);
-        let Some(job) = jobs.get(i) else { return };
+        let i = shared.next.fetch_add(1, Ordering::SeqCst);
+        let Some(job) = shared.jobs.get(i) else {
+            return;
+        };
         if tx.send(Msg::Started(i)).is_err() {
             return;
         }
-        let t0 = Instant::now();
-        crate::output::remove_stale_temps(&job.output);
-        let mut record = JobRecord {
-            index: i,
-            name: job.name.clone(),
-            scene: job.scene.to_string_lossy().into_owned(),
-            output: job.output.to_string_lossy().into_owned(),
-            status: JobStatus::Ok,
-            wall_ms: 0.0,
-            stats: None,
-            error: None,
+        let Some(record) = run_job(&shared, &pool, i, job, &tx) else {
+            return;
         };
-        if opts.skip_existing && crate::output::is_complete_image(&job.output) {
-            record.status = JobStatus::Skipped;
-        } else {
-            if let Some(dir) = job.output.parent().filter(|d| !d.as_os_str().is_empty()) {
-                let _ = std::fs::create_dir_all(dir);
-            }
-            let txp = tx.clone();
-            let progress = move |d: usize, t: usize| {
-                let _ = txp.send(Msg::Progress(i, d, t));
-            };
-            let result = std::panic::catch_unwind(std::panic::AssertUnwindSafe(|| {
-                pool.install(|| render_job(job, opts.max_memory, &progress))
-            }));
-            // The image is written and the job reported with the gate held shared, and
-            // not at all once the batch is interrupted (see WRITE_GATE).
-            let _gate = WRITE_GATE.read().unwrap_or_else(|e| e.into_inner());
-            if STOP.load(Ordering::SeqCst) {
-                return;
-            }
-            let result = result.map(|r| {
-                r.and_then(|(film, report)| {
-                    crate::output::write_image(&job.output, &film, job.settings.encoding)
-                        .map(|()| report)
-                        .map_err(|e| e.to_string())
-                })
-            });
-            match result {
-                Ok(Ok(report)) => record.stats = Some(report),
-                Ok(Err(e)) => {
-                    record.status = JobStatus::Failed;
-                    record.error = Some(e);
-                }
-                Err(p) => {
-                    record.status = JobStatus::Failed;
-                    record.error = Some(format!(
-                        "{}: internal error: {}",
-                        job.scene.display(),
-                        panic_message(&*p)
-                    ));
-                }
-            }
-            record.wall_ms = t0.elapsed().as_secs_f64() * 1e3;
-            if tx.send(Msg::Finished(Box::new(record))).is_err() {
-                return;
-            }
-            continue;
-        }
-        record.wall_ms = t0.elapsed().as_secs_f64() * 1e3;
         if tx.send(Msg::Finished(Box::new(record))).is_err() {
             return;
         }
     }
 }
 
-/// What the user sees while a batch runs.
-struct Display {
-    bars: Option<(indicatif::MultiProgress, indicatif::ProgressBar)>,
-    job_bars: std::collections::HashMap<usize, indicatif::ProgressBar>,
-    quiet: bool,
+/// Skip, or render and write, job `i`; `None` when the batch was cancelled before its
+/// image was written.
+fn run_job(
+    shared: &Shared,
+    pool: &rayon::ThreadPool,
+    i: usize,
+    job: &Job,
+    tx: &mpsc::Sender<Msg>,
+) -> Option<JobRecord> {
+    let t0 = Instant::now();
+    crate::output::remove_stale_temps(&job.output);
+    let mut record = JobRecord::not_run(i, job);
+    record.status = JobStatus::Ok;
+    if shared.opts.skip_existing && crate::output::is_complete_image(&job.output) {
+        record.status = JobStatus::Skipped;
+        record.wall_ms = t0.elapsed().as_secs_f64() * 1e3;
+        return Some(record);
+    }
+    if let Some(dir) = job.output.parent().filter(|d| !d.as_os_str().is_empty()) {
+        let _ = std::fs::create_dir_all(dir);
+    }
+    let txp = tx.clone();
+    let progress = move |d: usize, t: usize| {
+        let _ = txp.send(Msg::Progress(i, d, t));
+    };
+    let result = std::panic::catch_unwind(std::panic::AssertUnwindSafe(|| {
+        pool.install(|| render_job(job, shared.opts.max_memory, &progress))
+    }));
+    // The image is written and the job reported with the gate held shared, and not at
+    // all once the batch is cancelled (see `Shared::write_gate`).
+    let _gate = shared.write_gate.read().unwrap_or_else(|e| e.into_inner());
+    if shared.cancel.is_cancelled() {
+        return None;
+    }
+    let result = result.map(|r| {
+        r.and_then(|(film, report)| {
+            crate::output::write_image(&job.output, &film, job.settings.encoding)
+                .map(|()| report)
+                .map_err(|e| e.to_string())
+        })
+    });
+    match result {
+        Ok(Ok(report)) => record.stats = Some(report),
+        Ok(Err(e)) => {
+            record.status = JobStatus::Failed;
+            record.error = Some(e);
+        }
+        Err(p) => {
+            record.status = JobStatus::Failed;
+            record.error = Some(format!(
+                "{}: internal error: {}",
+                job.scene.display(),
+                panic_message(&*p)
+            ));
+        }
+    }
+    record.wall_ms = t0.elapsed().as_secs_f64() * 1e3;
+    Some(record)
 }
 
-impl Display {
-    fn new(total: usize, quiet: bool) -> Self {
-        let bars = (!quiet && std::io::stderr().is_terminal()).then(|| {
-            let m = indicatif::MultiProgress::new();
-            let b = m.add(indicatif::ProgressBar::new(total as u64));
-            b.set_style(
-                indicatif::ProgressStyle::with_template(
-                    "batch [{bar:30}] {pos}/{len} jobs {elapsed_precise} eta {eta}",
-                )
-                .expect("static template")
-                .progress_chars("=> "),
-            );
-            (m, b)
-        });
-        Display {
-            bars,
-            job_bars: Default::default(),
-            quiet,
-        }
-    }
-
-    fn started(&mut self, i: usize, job: &Job) {
-        if let Some((m, _)) = &self.bars {
-            let b = m.add(indicatif::ProgressBar::new(0));
-            b.set_style(
-                indicatif::ProgressStyle::with_template(
-                    "  {msg} [{bar:30}] {pos}/{len} tiles eta {eta}",
-                )
-                .expect("static template")
-                .progress_chars("=> "),
-            );
-            b.set_message(job.name.clone());
-            self.job_bars.insert(i, b);
-        }
-    }
-
-    fn progress(&self, i: usize, done: usize, total: usize) {
-        if let Some(b) = self.job_bars.get(&i) {
-            b.set_length(total as u64);
-            b.set_position(done as u64);
-        }
-    }
-
-    fn finished(&mut self, r: &JobRecord, done: usize, total: usize, eta: Option<f64>) {
-        if let Some(b) = self.job_bars.remove(&r.index) {
-            b.finish_and_clear();
-            if let Some((m, _)) = &self.bars {
-                m.remove(&b);
-            }
-        }
-        let line = match (&r.status, &r.error) {
-            (JobStatus::Failed, Some(e)) => format!("emray: error: job '{}': {e}", r.name),
-            _ if self.quiet => return,
-            (s, _) => format!(
-                "emray: [{done}/{total}] {} {} ({:.2} s{})",
-                match s {
-                    JobStatus::Skipped => "skipped",
-                    _ => "ok",
-                },
-                r.output,
-                r.wall_ms / 1e3,
-                eta.map(|e| format!(", eta {e:.0} s")).unwrap_or_default()
-            ),
-        };
-        match &self.bars {
-            Some((m, b)) => {
-                b.inc(1);
-                let _ = m.println(line);
-            }
-            None => eprintln!("{line}"),
-        }
-    }
-
-    fn finish(&self) {
-        if let Some((_, b)) = &self.bars {
-            b.finish_and_clear();
-        }
-    }
-}
-
-fn write_report(path: &Path, report: &BatchReport) {
+fn write_report(path: &Path, report: &BatchReport, observer: &mut dyn Observer) {
     let text = serde_json::to_string_pretty(report).expect("report serialises") + "\n";
     if let Err(e) = crate::output::write_text(path, &text) {
-        eprintln!("emray: error: {e}");
+        observer.report_not_written(&e);
     }
 }
 
-/// Run `jobs`, writing the report after each one; returns the final report. Ctrl-C
-/// stops the batch: the report of what finished is written and the call returns at
-/// once with `interrupted` set (running jobs are abandoned before their output is
-/// renamed into place, so no partial image is left under an output name).
-pub fn run(jobs: Vec<Job>, opts: &BatchOptions) -> BatchReport {
-    catch_ctrl_c();
+/// Run `jobs`, writing the report after each one; returns the final report. Setting
+/// `cancel` stops the batch: the report of what finished is written and the call
+/// returns at once with `interrupted` set (running jobs are abandoned before their
+/// output is renamed into place, so no partial image is left under an output name).
+pub fn run(
+    jobs: Vec<Job>,
+    opts: &BatchOptions,
+    cancel: &Cancel,
+    observer: &mut dyn Observer,
+) -> BatchReport {
     let start = Instant::now();
     let total = jobs.len();
     let threads = opts.threads.unwrap_or_else(|| {
@@ -362,7 +333,6 @@ pub fn run(jobs: Vec<Job>, opts: &BatchOptions) -> BatchReport {
             .unwrap_or(1)
     });
     let workers = opts.jobs.clamp(1, total.max(1));
-    let per_worker = (threads / workers).max(1);
     let mut report = BatchReport {
         shard: opts.shard.map(|(i, n)| format!("{i}/{n}")),
         total,
@@ -375,50 +345,66 @@ pub fn run(jobs: Vec<Job>, opts: &BatchOptions) -> BatchReport {
         jobs: jobs
             .iter()
             .enumerate()
-            .map(|(i, j)| JobRecord {
-                index: i,
-                name: j.name.clone(),
-                scene: j.scene.to_string_lossy().into_owned(),
-                output: j.output.to_string_lossy().into_owned(),
-                status: JobStatus::NotRun,
-                wall_ms: 0.0,
-                stats: None,
-                error: None,
-            })
+            .map(|(i, j)| JobRecord::not_run(i, j))
             .collect(),
     };
-    let jobs = Arc::new(jobs);
-    let next = Arc::new(AtomicUsize::new(0));
+    let shared = Arc::new(Shared {
+        jobs,
+        next: AtomicUsize::new(0),
+        cancel: cancel.clone(),
+        write_gate: RwLock::new(()),
+        threads: (threads / workers).max(1),
+        opts: opts.clone(),
+    });
     let (tx, rx) = mpsc::channel();
     for _ in 0..workers {
-        let (jobs, next, tx, opts) = (jobs.clone(), next.clone(), tx.clone(), opts.clone());
-        std::thread::spawn(move || worker(jobs, next, tx, per_worker, opts));
+        let (shared, tx) = (shared.clone(), tx.clone());
+        std::thread::spawn(move || worker(shared, tx));
     }
     drop(tx);
-    let mut display = Display::new(total, opts.quiet);
+    collect(&shared, &rx, &mut report, workers, start, observer);
+    observer.stopped();
+    report.tally();
+    report.wall_ms = start.elapsed().as_secs_f64() * 1e3;
+    if let Some(p) = &opts.report {
+        write_report(p, &report, observer);
+    }
+    report
+}
+
+/// Take in the workers' messages until every job finished or the batch is cancelled.
+fn collect(
+    shared: &Shared,
+    rx: &mpsc::Receiver<Msg>,
+    report: &mut BatchReport,
+    workers: usize,
+    start: Instant,
+    observer: &mut dyn Observer,
+) {
+    let total = report.total;
     let mut done = 0;
     let mut rendered_ms = 0.0;
     let mut rendered = 0usize;
     while done < total {
-        if STOP.load(Ordering::SeqCst) {
+        if shared.cancel.is_cancelled() {
             report.interrupted = true;
             // Wait for images being written; then take in what finished meanwhile.
             // Running jobs are abandoned.
-            let _gate = WRITE_GATE.write().unwrap_or_else(|e| e.into_inner());
+            let _gate = shared.write_gate.write().unwrap_or_else(|e| e.into_inner());
             while let Ok(m) = rx.try_recv() {
                 if let Msg::Finished(r) = m {
                     let i = r.index;
                     report.jobs[i] = *r;
                 }
             }
-            break;
+            return;
         }
         match rx.recv_timeout(Duration::from_millis(100)) {
             Ok(Msg::Started(i)) => {
                 report.jobs[i].status = JobStatus::Interrupted;
-                display.started(i, &jobs[i]);
+                observer.started(i, &shared.jobs[i]);
             }
-            Ok(Msg::Progress(i, d, t)) => display.progress(i, d, t),
+            Ok(Msg::Progress(i, d, t)) => observer.progress(i, d, t),
             Ok(Msg::Finished(r)) => {
                 done += 1;
                 if r.status != JobStatus::Skipped {
@@ -428,31 +414,17 @@ pub fn run(jobs: Vec<Job>, opts: &BatchOptions) -> BatchReport {
                 let eta = (rendered > 0 && done < total).then(|| {
                     rendered_ms / rendered as f64 * (total - done) as f64 / workers as f64 / 1e3
                 });
-                display.finished(&r, done, total, eta);
+                observer.finished(&r, done, total, eta);
                 let i = r.index;
                 report.jobs[i] = *r;
                 report.tally();
                 report.wall_ms = start.elapsed().as_secs_f64() * 1e3;
-                if let Some(p) = &opts.report {
-                    write_report(p, &report);
+                if let Some(p) = &shared.opts.report {
+                    write_report(p, report, observer);
                 }
             }
             Err(mpsc::RecvTimeoutError::Timeout) => {}
-            Err(mpsc::RecvTimeoutError::Disconnected) => break,
+            Err(mpsc::RecvTimeoutError::Disconnected) => return,
         }
     }
-    display.finish();
-    report.tally();
-    report.wall_ms = start.elapsed().as_secs_f64() * 1e3;
-    if let Some(p) = &opts.report {
-        write_report(p, &report);
-    }
-    if report.interrupted && !opts.quiet {
-        eprintln!(
-            "emray: interrupted: {} of {} jobs finished",
-            report.ok + report.failed + report.skipped,
-            total
-        );
-    }
-    report
 }

@@ -3,6 +3,8 @@
 //! report of what finished.
 
 use super::args::{BackendArg, EncodingArg, parse_res};
+use super::interrupt::cancel_on_ctrl_c;
+use super::progress::BatchDisplay;
 use super::{Error, init_log};
 use emray::accel::Backend;
 use emray::batch::{self, BatchOptions, Job, JobSettings};
@@ -110,13 +112,21 @@ pub fn run(b: Args) -> Result<(), Error> {
             .report
             .as_ref()
             .map(|r| PathBuf::from(r.replace("{shard}", &shard_index.to_string()))),
-        quiet: b.quiet,
         max_memory: b
             .max_memory
             .unwrap_or_else(emray::run::limits::default_max_memory),
         shard: b.shard,
     };
-    let report = batch::run(jobs, &opts);
+    let cancel = cancel_on_ctrl_c();
+    let mut display = BatchDisplay::new(jobs.len(), b.quiet);
+    let report = batch::run(jobs, &opts, &cancel, &mut display);
+    if report.interrupted && !b.quiet {
+        eprintln!(
+            "emray: interrupted: {} of {} jobs finished",
+            report.ok + report.failed + report.skipped,
+            report.total
+        );
+    }
     let failed = (report.failed > 0)
         .then(|| anyhow::anyhow!("{} of {} jobs failed", report.failed, report.total));
     match (report.interrupted, failed) {

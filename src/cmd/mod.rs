@@ -1,7 +1,8 @@
 //! The commands of the `emray` binary, one module each with its own arguments and a
 //! `run(args) -> Result<(), Error>`; [`args`] holds the argument types several share,
-//! [`error`] how a failure becomes a message and an exit status, [`progress`] the
-//! progress bar of a render.
+//! [`error`] how a failure becomes a message and an exit status, [`progress`] and
+//! [`interrupt`] the terminal's progress bars and the Ctrl-C handler (neither of which
+//! the library has).
 
 mod args;
 mod batch;
@@ -9,6 +10,7 @@ mod bench;
 mod compare;
 mod error;
 mod generate;
+mod interrupt;
 mod merge;
 mod progress;
 mod radiosity;
