@@ -119,6 +119,11 @@ fn usage_errors_exit_2() {
         vec!["render"],
         vec!["render", "a.nff", "a.nff", "-o", "one.png"],
         vec!["render", "a.nff", "-o", "out.jpg"],
+        vec!["render", "a.nff", "--reference", "--spd"],
+        vec!["render", "a.nff", "--bailout=-1"],
+        vec!["render", "a.nff", "--tile", "0/2", "-o", "part.png"],
+        vec!["render", "a.nff", "--tile", "4/4", "-o", "part.exr"],
+        vec!["render", "a.nff", "--crop", "5,1,0,9", "-o", "part.exr"],
     ] {
         let o = emray(&args, dir.path());
         assert_eq!(o.status.code(), Some(2), "{args:?}: {}", stderr(&o));
@@ -198,4 +203,123 @@ fn gen_refuses_bad_databases_and_sizes() {
         assert!(stderr(&o).contains("emray: error:"), "{}", stderr(&o));
     }
     assert_eq!(std::fs::read_dir(dir.path()).unwrap().count(), 0);
+}
+
+#[test]
+fn input_errors_exit_1_with_one_line_and_write_nothing() {
+    let dir = tempfile::tempdir().unwrap();
+    std::fs::write(dir.path().join("a.nff"), SCENE).unwrap();
+    for (args, wanted) in [
+        (
+            vec!["render", "a.nff", "--crop", "0,50,0,10", "-o", "x.exr"],
+            "emray: error: a.nff: crop 0,50,0,10 is not inside the 40x30 image",
+        ),
+        (
+            vec!["render", "a.nff", "--tile", "0/31", "-o", "x.exr"],
+            "emray: error: a.nff: --tile leaves no rows for this part of a 30-row image",
+        ),
+        (
+            vec!["render", "a.nff", "--max-memory", "1K"],
+            "over the memory limit of 0.0 MiB (--max-memory)",
+        ),
+        (
+            vec!["batch", "--manifest", "missing.toml"],
+            "emray: error: missing.toml: cannot read",
+        ),
+        (
+            vec!["merge", "nope.exr", "-o", "m.png"],
+            "emray: error: nope.exr: ",
+        ),
+        (
+            vec!["radiosity", "nope.toml"],
+            "emray: error: nope.toml: cannot read",
+        ),
+        (
+            vec!["gen", "tetra", "-o", "nodir/t.nff"],
+            "emray: error: nodir/t.nff: cannot write",
+        ),
+    ] {
+        let o = emray(&args, dir.path());
+        assert_eq!(o.status.code(), Some(1), "{args:?}: {}", stderr(&o));
+        let e = stderr(&o);
+        assert!(e.contains(wanted), "{args:?}: {e}");
+        assert_eq!(
+            e.lines().count(),
+            1,
+            "{args:?}: one line, no backtrace: {e}"
+        );
+    }
+    assert_eq!(std::fs::read_dir(dir.path()).unwrap().count(), 1);
+}
+
+#[test]
+fn batch_usage_errors_exit_2_before_any_job() {
+    let dir = tempfile::tempdir().unwrap();
+    std::fs::write(dir.path().join("a.nff"), SCENE).unwrap();
+    for (args, wanted) in [
+        (vec!["batch"], "give scene files, globs or --manifest FILE"),
+        (
+            vec!["batch", "nomatch*.nff"],
+            "glob 'nomatch*.nff' matches no file",
+        ),
+        (
+            vec!["batch", "a.nff", "-o", "{colour}.png"],
+            "unknown placeholder '{colour}' (one of {stem}, {backend}, {index}, {spp})",
+        ),
+        (
+            vec!["batch", "a.nff", "a.nff", "-o", "same.png"],
+            "jobs 0 and 1 have the same name 'same.png'",
+        ),
+        (vec!["batch", "spd:nope"], "unknown database 'nope'"),
+    ] {
+        let o = emray(&args, dir.path());
+        assert_eq!(o.status.code(), Some(2), "{args:?}: {}", stderr(&o));
+        let e = stderr(&o);
+        assert!(
+            e.starts_with("emray: error: ") && e.contains(wanted),
+            "{args:?}: {e}"
+        );
+    }
+    assert_eq!(std::fs::read_dir(dir.path()).unwrap().count(), 1);
+}
+
+#[test]
+fn an_out_of_range_tile_is_called_a_tile_and_a_shard_a_shard() {
+    let dir = tempfile::tempdir().unwrap();
+    std::fs::write(dir.path().join("a.nff"), SCENE).unwrap();
+    let o = emray(
+        &["render", "a.nff", "--tile", "4/4", "-o", "x.exr"],
+        dir.path(),
+    );
+    assert_eq!(o.status.code(), Some(2));
+    let e = stderr(&o);
+    assert!(e.contains("tile '4/4': need 0 <= I < N"), "{e}");
+    assert!(!e.contains("shard"), "{e}");
+    let o = emray(&["batch", "a.nff", "--shard", "4/4"], dir.path());
+    assert_eq!(o.status.code(), Some(2));
+    assert!(
+        stderr(&o).contains("shard '4/4': need 0 <= I < N"),
+        "{}",
+        stderr(&o)
+    );
+}
+
+#[test]
+fn help_names_every_scene_format_and_counts_parts_from_zero() {
+    let dir = tempfile::tempdir().unwrap();
+    let help = |args: &[&str]| String::from_utf8(emray(args, dir.path()).stdout).unwrap();
+    let render = help(&["render", "--help"]);
+    assert!(
+        render.contains("Scene files: NFF, TOML (`.toml`), OBJ (`.obj`), or `spd:NAME[?size=N]`"),
+        "{render}"
+    );
+    assert!(
+        render.contains("horizontal bands (I counts from 0: 0 ≤ I < N)"),
+        "{render}"
+    );
+    let batch = help(&["batch", "--help"]);
+    assert!(
+        batch.contains("Run only shard I of N (I counts from 0: 0 ≤ I < N)"),
+        "{batch}"
+    );
 }

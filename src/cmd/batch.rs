@@ -49,7 +49,8 @@ pub struct Args {
     /// Jobs rendered at once, sharing the threads.
     #[arg(short, long, value_name = "N", default_value_t = 1, value_parser = clap::value_parser!(u32).range(1..=4096))]
     pub jobs: u32,
-    /// Run only shard I of N: the jobs whose name hashes (FNV-1a 64) to I modulo N.
+    /// Run only shard I of N (I counts from 0: 0 ≤ I < N): the jobs whose name hashes
+    /// (FNV-1a 64) to I modulo N.
     #[arg(long, value_name = "I/N", value_parser = emray::batch::parse_shard)]
     pub shard: Option<(u32, u32)>,
     /// Skip jobs whose output exists and decodes as a whole image (resume).

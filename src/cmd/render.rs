@@ -35,7 +35,7 @@ pub enum AaArg {
 /// `emray render`.
 #[derive(clap::Args, Debug, Clone)]
 pub struct Args {
-    /// Scene files (NFF), or generated SPD scenes as `spd:NAME` / `spd:NAME?size=N`.
+    /// Scene files: NFF, TOML (`.toml`), OBJ (`.obj`), or `spd:NAME[?size=N]`.
     #[arg(required = true, value_name = "SCENE")]
     pub scenes: Vec<PathBuf>,
     /// Output file (.png or .exr), or a template with `{stem}` for several scenes.
@@ -110,8 +110,9 @@ pub struct Args {
     /// PNG value encoding.
     #[arg(long, value_enum, default_value_t = EncodingArg::Srgb)]
     pub encoding: EncodingArg,
-    /// Render only band I of N horizontal bands, to an EXR part for `emray merge`.
-    #[arg(long, value_name = "I/N", value_parser = emray::batch::parse_shard, conflicts_with = "crop")]
+    /// Render only band I of N horizontal bands (I counts from 0: 0 ≤ I < N), to an EXR
+    /// part for `emray merge`.
+    #[arg(long, value_name = "I/N", value_parser = emray::run::parse_tile, conflicts_with = "crop")]
     pub tile: Option<(u32, u32)>,
     /// Render only columns x0..x1 and rows y0..y1 (half-open), to an EXR part.
     #[arg(long, value_name = "x0,x1,y0,y1", value_parser = emray::run::parse_crop)]
