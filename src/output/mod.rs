@@ -122,8 +122,9 @@ pub fn write_image(path: &Path, film: &Film, encoding: Encoding) -> Result<(), O
     }
 }
 
-/// Write `path` through a temporary file beside it that `write` fills, then a rename;
-/// on failure the temporary file is removed and the target left as it was.
+/// Write `path` through a temporary file beside it (`.NAME.XXXXXX.tmp`, so that the
+/// rename is atomic) that `write` fills, then a rename; on failure the temporary file is
+/// removed and the target left as it was.
 pub(crate) fn write_atomic(
     path: &Path,
     write: impl FnOnce(fs::File) -> Result<(), String>,
@@ -132,17 +133,31 @@ pub(crate) fn write_atomic(
         path: path.to_path_buf(),
         message,
     };
-    let tmp = temp_name(path);
-    let result = fs::File::create(&tmp)
-        .map_err(|e| e.to_string())
-        .and_then(write)
-        .and_then(|()| fs::rename(&tmp, path).map_err(|e| e.to_string()))
-        .map_err(err);
-    if result.is_err() {
-        let _ = fs::remove_file(&tmp);
-    }
-    result
+    let dir = match path.parent() {
+        Some(d) if !d.as_os_str().is_empty() => d,
+        _ => Path::new("."),
+    };
+    let name = path
+        .file_name()
+        .map(|n| n.to_string_lossy().into_owned())
+        .unwrap_or_default();
+    // Dropping an unpersisted temporary file deletes it.
+    let tmp = tempfile::Builder::new()
+        .prefix(&format!(".{name}."))
+        .suffix(TEMP_SUFFIX)
+        .rand_bytes(TEMP_RAND)
+        .tempfile_in(dir)
+        .map_err(|e| err(e.to_string()))?;
+    let file = tmp.reopen().map_err(|e| err(e.to_string()))?;
+    write(file).map_err(err)?;
+    tmp.persist(path).map_err(|e| err(e.error.to_string()))?;
+    Ok(())
 }
+
+/// Temporary files end in this.
+const TEMP_SUFFIX: &str = ".tmp";
+/// Random characters in a temporary file's name.
+const TEMP_RAND: usize = 8;
 
 /// Write a text file through a temporary file and a rename.
 pub fn write_text(path: &Path, text: &str) -> Result<(), OutputError> {
@@ -152,7 +167,8 @@ pub fn write_text(path: &Path, text: &str) -> Result<(), OutputError> {
 }
 
 /// Remove temporary files that an earlier, killed process left for `path` (their
-/// names are `.NAME.PID.tmp`); returns how many went.
+/// names are `.NAME.XXXXXXXX.tmp`, see [`write_atomic`]; older versions put their
+/// process id there); returns how many went.
 pub fn remove_stale_temps(path: &Path) -> usize {
     let (Some(dir), Some(name)) = (path.parent(), path.file_name()) else {
         return 0;
@@ -171,8 +187,8 @@ pub fn remove_stale_temps(path: &Path) -> usize {
         let n = e.file_name().to_string_lossy().into_owned();
         let stale = n
             .strip_prefix(&prefix)
-            .and_then(|rest| rest.strip_suffix(".tmp"))
-            .is_some_and(|pid| !pid.is_empty() && pid.bytes().all(|b| b.is_ascii_digit()));
+            .and_then(|rest| rest.strip_suffix(TEMP_SUFFIX))
+            .is_some_and(|r| !r.is_empty() && r.bytes().all(|b| b.is_ascii_alphanumeric()));
         if stale && fs::remove_file(e.path()).is_ok() {
             removed += 1;
         }
@@ -187,15 +203,6 @@ pub fn is_complete_image(path: &Path) -> bool {
         Ok(Format::Exr) => part::read_exr(path).is_ok(),
         Err(_) => false,
     }
-}
-
-/// A hidden temporary name in the same directory (so the rename is atomic).
-fn temp_name(path: &Path) -> PathBuf {
-    let name = path
-        .file_name()
-        .map(|n| n.to_string_lossy().into_owned())
-        .unwrap_or_default();
-    path.with_file_name(format!(".{name}.{}.tmp", std::process::id()))
 }
 
 #[cfg(test)]
