@@ -33,6 +33,9 @@ pub use sphere::Sphere;
 pub use torus::Torus;
 pub use triangle::{Triangle, WatertightRay};
 
+// A hit point with its error bound: defined in `math`, whose transforms map it.
+pub use crate::math::SurfacePoint;
+
 use crate::math::{Aabb, Ray, Vec3};
 use std::sync::Arc;
 
@@ -47,17 +50,6 @@ pub struct ShapeHit {
     /// Second surface parameter (triangles: barycentric weight of vertex 2).
     pub v: f32,
     /// Geometric normal, not normalised.
-    pub ng: Vec3,
-}
-
-/// A hit point with the bound of its rounding error, for robust ray spawning.
-#[derive(Clone, Copy, Debug, PartialEq)]
-pub struct SurfacePoint {
-    /// The point, computed as accurately as the shape allows (not `o + t·d`).
-    pub p: Vec3,
-    /// Per-axis absolute error bound of `p`.
-    pub err: Vec3,
-    /// Unit geometric normal (outwards for closed shapes, by winding for triangles).
     pub ng: Vec3,
 }
 

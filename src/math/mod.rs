@@ -1,5 +1,7 @@
-//! Rays, boxes, orthonormal frames and the floating-point error tools used for robust
-//! ray spawning.
+//! The bottom layer: rays, boxes, transforms, orthonormal frames, surface points with
+//! their error bounds, the floating-point error tools used for robust ray spawning and
+//! the coordinate hashes that drive sampling. It imports nothing from the rest of the
+//! crate.
 
 mod aabb;
 mod robust;
@@ -8,7 +10,7 @@ mod xform;
 pub use aabb::Aabb;
 pub use glam::{DVec3, Vec3};
 pub use robust::{RayOrigins, gamma, next_float_down, next_float_up, offset_ray_origin};
-pub use xform::Xform;
+pub use xform::{Xform, XformError};
 
 /// A ray with its valid parameter interval `[tmin, tmax]`.
 ///
@@ -78,6 +80,17 @@ impl From<&Ray> for DRay {
             dir: r.dir.as_dvec3(),
         }
     }
+}
+
+/// A hit point with the bound of its rounding error, for robust ray spawning.
+#[derive(Clone, Copy, Debug, PartialEq)]
+pub struct SurfacePoint {
+    /// The point, computed as accurately as the shape allows (not `o + t·d`).
+    pub p: Vec3,
+    /// Per-axis absolute error bound of `p`.
+    pub err: Vec3,
+    /// Unit geometric normal (outwards for closed shapes, by winding for triangles).
+    pub ng: Vec3,
 }
 
 /// A right-handed orthonormal frame.
