@@ -1,14 +1,17 @@
 //! The bottom layer: rays, boxes, transforms, orthonormal frames, surface points with
-//! their error bounds, the floating-point error tools used for robust ray spawning and
-//! the coordinate hashes that drive sampling. It imports nothing from the rest of the
-//! crate.
+//! their error bounds and the floating-point error tools used for robust ray spawning,
+//! the coordinate hashes that drive sampling, and the one seeded random number
+//! generator ([`Rng`]) for tests, benches and stress rays. It imports nothing from the
+//! rest of the crate.
 
 mod aabb;
+mod rng;
 mod robust;
 mod xform;
 
 pub use aabb::Aabb;
 pub use glam::{DVec3, Vec3};
+pub use rng::Rng;
 pub use robust::{RayOrigins, gamma, next_float_down, next_float_up, offset_ray_origin};
 pub use xform::{Xform, XformError};
 
