@@ -460,7 +460,7 @@ fn the_view_shows_the_interpolated_solution() {
 
 #[test]
 fn area_light_sampling_matches_the_form_factor_and_softens_shadows() {
-    use emray::radiosity::area;
+    use emray::render::area;
     // A 1 × 1 emitter facing down, 1 above the origin of a floor facing up.
     let mut s = Scene::new(camera());
     s.materials.push(Material::DEFAULT);

@@ -1,11 +1,10 @@
 //! Whitted shading (DESIGN.md §4).
 
-use super::{RayGen, Region, RenderSettings};
+use super::{GlobalIllumination, RayGen, Region, RenderSettings, area};
 use crate::accel::{Accel, Hit};
 use crate::math::{
     Ray, RayOrigins, Vec3, hash, hash_unit as unit, next_float_down, offset_ray_origin,
 };
-use crate::radiosity::{Solution, area};
 use crate::scene::{Light, Material, Scene, Surface};
 
 /// Rays cast, by type.
@@ -67,8 +66,8 @@ pub(super) struct Tracer<'a, A: Accel> {
     area_lights: Vec<area::AreaLight>,
     /// Shadow rays per area light: `area_samples²`.
     area_samples: u32,
-    /// Two-pass mode: the diffuse term of meshed surfaces from this solution.
-    gi: Option<&'a Solution>,
+    /// Two-pass mode: the diffuse term of the surfaces this solution covers.
+    gi: Option<&'a dyn GlobalIllumination>,
     /// Hall & Greenberg's adaptive tree depth: no secondary ray whose weight (largest
     /// channel) is below this; 0 = off.
     bailout: f32,
@@ -149,8 +148,8 @@ impl<'a, A: Accel> Tracer<'a, A> {
         }
     }
 
-    /// Take the diffuse term of meshed surfaces from a radiosity solution (two-pass).
-    pub(super) fn with_gi(mut self, gi: Option<&'a Solution>) -> Self {
+    /// Take the diffuse term of the surfaces `gi` covers from it (two-pass).
+    pub(super) fn with_gi(mut self, gi: Option<&'a dyn GlobalIllumination>) -> Self {
         self.gi = gi;
         self
     }
