@@ -23,6 +23,7 @@ pub mod tessellate;
 use crate::accel::{Accel, AccelError, BackendOptions, Hit, WithAccel};
 use crate::geometry::Kind;
 use crate::math::Vec3;
+use crate::render::color::srgb_encode;
 use crate::render::{Film, GlobalIllumination, gi};
 use crate::scene::Scene;
 use formfactor::Sampling;
@@ -223,7 +224,7 @@ impl Solution {
             m.vertices.len(),
             m.elements.len()
         );
-        let byte = |x: f32| (crate::output::srgb_encode(x * exposure) * 255.0).round() as u8;
+        let byte = |x: f32| (srgb_encode(x * exposure) * 255.0).round() as u8;
         for (p, c) in m.vertices.iter().zip(&self.vertex_radiosity) {
             let _ = writeln!(
                 s,

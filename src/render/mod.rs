@@ -2,10 +2,11 @@
 //! ([`area`]), mirror reflection, Snell refraction with total internal reflection, a
 //! depth limit; tiles rendered in parallel, deterministic whatever the thread count.
 //! Global illumination comes in through [`GlobalIllumination`] (a radiosity solution
-//! implements it).
+//! implements it); [`color`] turns the film's linear values into encoded 8-bit ones.
 
 pub mod area;
 mod camera;
+pub mod color;
 mod film;
 pub mod gi;
 pub mod reference;
