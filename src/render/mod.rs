@@ -34,7 +34,7 @@ pub struct RenderSettings {
     /// Maximum ray-tree depth, counting the eye ray as depth 1.
     pub max_depth: u32,
     /// SPD testing mode: `(w+1) × (h+1)` corner rays, each pixel the mean of its four
-    /// corners (DESIGN.md §3).
+    /// corners; the corner grid's outer rows span the camera's angle.
     pub spd: bool,
     /// Tile edge in pixels.
     pub tile: u32,
