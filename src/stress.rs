@@ -4,7 +4,7 @@
 use crate::accel::Accel;
 use crate::geometry::reference as r64;
 use crate::load::nff::parse_str;
-use crate::math::{DRay, DVec3, Ray, Vec3, next_float_down, offset_ray_origin};
+use crate::math::{DRay, DVec3, Ray, Rng, Vec3, next_float_down, offset_ray_origin};
 use crate::render::{Film, RayGen, RenderSettings};
 use crate::run::render_scene;
 use crate::{Backend, Scene};
@@ -334,8 +334,8 @@ pub fn far_sphere(dist: f32, radius: f32, n: u32, seed: u32) -> (f64, u64, u64) 
     let sphere = crate::geometry::Sphere::new(c, radius);
     let mut worst = 0.0f64;
     let (mut miss, mut extra) = (0, 0);
-    let mut rng = Rng::new(seed);
-    let mut rnd = || rng.unit() as f32;
+    let mut rng = Rng::new(u64::from(seed));
+    let mut rnd = || rng.next_f32();
     for _ in 0..n {
         // Points up to 1.1 radii from the centre, on the plane through it.
         let (a, b) = (rnd() * std::f32::consts::TAU, rnd().sqrt() * 1.1 * radius);
@@ -353,25 +353,23 @@ pub fn far_sphere(dist: f32, radius: f32, n: u32, seed: u32) -> (f64, u64, u64) 
     (worst, miss, extra)
 }
 
-/// A small deterministic generator (xorshift32) for the random stress rays.
-struct Rng(u32);
+/// The draws the random stress rays are made of, in double precision, from the
+/// crate's seeded generator.
+struct Draws(Rng);
 
-impl Rng {
-    fn new(seed: u32) -> Rng {
-        Rng(seed.wrapping_mul(0x9e37_79b9) | 1)
+impl Draws {
+    fn new(seed: u32) -> Draws {
+        Draws(Rng::new(u64::from(seed)))
     }
 
     /// Uniform in `[0, 1)`.
     fn unit(&mut self) -> f64 {
-        self.0 ^= self.0 << 13;
-        self.0 ^= self.0 >> 17;
-        self.0 ^= self.0 << 5;
-        (self.0 >> 8) as f64 / (1u32 << 24) as f64
+        self.0.next_f64()
     }
 
     /// Uniform in `[lo, hi)`.
     fn range(&mut self, lo: f64, hi: f64) -> f64 {
-        lo + (hi - lo) * self.unit()
+        self.0.range_f64(lo, hi)
     }
 
     /// A unit vector perpendicular to unit `w`, at a random angle around it.
@@ -423,11 +421,11 @@ pub type RootCase = (&'static str, fn(u32) -> RootStats);
 fn roots<S: crate::geometry::Intersect>(
     n: u32,
     shape: &S,
-    mut raygen: impl FnMut(&mut Rng) -> (Ray, bool),
+    mut raygen: impl FnMut(&mut Draws) -> (Ray, bool),
     exact: impl Fn(&DRay) -> Option<f64>,
     dist: impl Fn(DVec3) -> f64,
 ) -> RootStats {
-    let mut rng = Rng::new(n ^ 0x5eed);
+    let mut rng = Draws::new(n ^ 0x5eed);
     let mut st = RootStats::default();
     for _ in 0..n {
         let (ray, band) = raygen(&mut rng);
@@ -579,7 +577,13 @@ pub fn quadric_root_cases() -> Vec<RootCase> {
 /// A ray passing at distance `r (1 + δ)` from `center` (from the line through it along
 /// `axis` for a cylinder), δ = ±10⁻ᵏ, k in 1..9; whether its exact (f64) distance is
 /// within `band` of tangency.
-fn tangent_ray(g: &mut Rng, center: DVec3, axis: Option<DVec3>, r: f64, band: f64) -> (Ray, bool) {
+fn tangent_ray(
+    g: &mut Draws,
+    center: DVec3,
+    axis: Option<DVec3>,
+    r: f64,
+    band: f64,
+) -> (Ray, bool) {
     let delta = g.tiny(1.0, 9.0);
     // Direction: any for the sphere, perpendicular to the axis (± 30°) for a cylinder.
     let d = match axis {

@@ -430,14 +430,10 @@ mod tests {
         assert_ne!(naive, 1.0);
         assert_eq!(diff_of_products(4097.0, 4097.0, 4096.0, 4098.0), 1.0);
         // Within half an ulp of the exact value, checked in exact integer arithmetic.
-        let mut seed = 0x2545_f491u32;
+        let mut rng = crate::math::Rng::new(0x2545_f491);
         for _ in 0..10_000 {
-            let mut next = || {
-                seed ^= seed << 13;
-                seed ^= seed >> 17;
-                seed ^= seed << 5;
-                (seed >> 8) as i64 - (1 << 23)
-            };
+            // Integers of up to 24 bits, exact in f32.
+            let mut next = || i64::from(rng.next_u32() >> 8) - (1 << 23);
             let (a, b, c, d) = (next(), next(), next(), next());
             let exact = i128::from(a) * i128::from(b) - i128::from(c) * i128::from(d);
             let got = diff_of_products(a as f32, b as f32, c as f32, d as f32);
