@@ -467,6 +467,8 @@ fn quadric_dist(c: &[f64; 10], p: DVec3) -> f64 {
 /// The quadric-root stress cases: rays that make the quadratic degenerate (`a → 0`:
 /// almost parallel to a paraboloid's axis or a cone's generator) or nearly tangent
 /// (discriminant ≈ 0: impact parameter `r (1 ± 10⁻ᵏ)`, k in 1..9, band `|δ| < 1e-5`).
+/// On the finite cone primitive the band is the rays meeting its surface within 1e-5
+/// of its base or apex, where the clip to its height decides hit or miss.
 pub fn quadric_root_cases() -> Vec<RootCase> {
     /// Relative impact-parameter band around tangency where hit or miss may go
     /// either way in f32.
@@ -517,7 +519,8 @@ pub fn quadric_root_cases() -> Vec<RootCase> {
                     let raygen = DVec3::new(-0.5 * a.cos(), -0.5 * a.sin(), 1.0).normalize();
                     let o = DVec3::new(g.range(-0.5, 0.5), g.range(-0.5, 0.5), -1.0);
                     let d = (raygen + g.perpendicular(raygen) * g.tiny(1.0, 8.0)).normalize();
-                    (ray32(o, d), false)
+                    let ray = ray32(o, d);
+                    (ray, meets_cone_near_an_end(&DRay::from(&ray), BAND))
                 },
                 |r| r64::cone(r, DVec3::ZERO, 1.0, 2.0 * DVec3::Z, 0.0, false, 0.0),
                 |p| {
@@ -572,6 +575,30 @@ pub fn quadric_root_cases() -> Vec<RootCase> {
             )
         }),
     ]
+}
+
+/// Whether `ray` meets the lateral surface of the stress cone (radius `1 − z/2`,
+/// extended beyond its ends) within `band` of its base plane `z = 0` or its apex
+/// `z = 2`: there the hit is decided by the rounding of the hit's height against the
+/// end, not by the roots, and f32 and f64 may differ about hit or miss.
+fn meets_cone_near_an_end(ray: &DRay, band: f64) -> bool {
+    // |xy(t)|² = (k + m t)² with k = 1 − o.z/2, m = −d.z/2: a t² + b t + c = 0.
+    let (o, d) = (ray.org, ray.dir);
+    let (k, m) = (1.0 - 0.5 * o.z, -0.5 * d.z);
+    let a = d.x * d.x + d.y * d.y - m * m;
+    let b = 2.0 * (o.x * d.x + o.y * d.y - k * m);
+    let c = o.x * o.x + o.y * o.y - k * k;
+    let disc = b * b - 4.0 * a * c;
+    if disc < 0.0 {
+        return false;
+    }
+    // The stable pair of roots (one of them far away when a → 0).
+    let q = -0.5 * (b + disc.sqrt().copysign(b));
+    [q / a, c / q]
+        .into_iter()
+        .filter(|t| t.is_finite() && *t > 0.0)
+        .map(|t| o.z + d.z * t)
+        .any(|z| z.abs() < band || (z - 2.0).abs() < band)
 }
 
 /// A ray passing at distance `r (1 + δ)` from `center` (from the line through it along
