@@ -32,8 +32,9 @@ pub struct RayCounts {
     /// Reflection rays not cast at hits on non-reflective (`Ks = 0`) surfaces below
     /// the depth limit.
     pub skipped_reflection: u64,
-    /// Rays whose radiance overflowed f32 and was saturated (see [`saturate`]): the
-    /// scene's colours, intensities or weights are too large. 0 for sane scenes.
+    /// Rays whose radiance overflowed f32 and was saturated (an infinite channel
+    /// clamped to ±`f32::MAX`, a NaN one set to 0): the scene's colours, intensities
+    /// or weights are too large. 0 for sane scenes.
     pub saturated: u64,
 }
 
