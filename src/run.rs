@@ -318,7 +318,7 @@ pub fn render_reference(
     load_ms: f64,
 ) -> Result<(Film, Report), String> {
     if let Some(why) = render::reference::unsupported(scene) {
-        return Err(why);
+        return Err(why.to_string());
     }
     let t0 = Instant::now();
     let (film, rays) = render::reference::render(

@@ -4,20 +4,13 @@
 
 pub mod part;
 
+// The PNG writer's encodings, defined with the colour curves in `render`.
 use crate::render::Film;
+pub use crate::render::color::Encoding;
+use crate::render::color::to_rgb8;
 use std::fs;
 use std::io::{BufWriter, Write};
 use std::path::{Path, PathBuf};
-
-/// How PNG values are encoded.
-#[derive(Clone, Copy, Debug, Default, PartialEq, Eq)]
-pub enum Encoding {
-    /// Linear values through the sRGB transfer curve (what image viewers expect).
-    #[default]
-    Srgb,
-    /// Values written as they are, clamped to [0, 1] (the classic NFF renderers' way).
-    Linear,
-}
 
 /// Output file formats.
 #[derive(Clone, Copy, Debug, PartialEq, Eq)]
@@ -58,32 +51,6 @@ impl Format {
             _ => Err(OutputError::Format(path.to_path_buf())),
         }
     }
-}
-
-/// The sRGB transfer function (IEC 61966-2-1) for a linear value in [0, 1].
-#[inline]
-pub fn srgb_encode(v: f32) -> f32 {
-    if v <= 0.003_130_8 {
-        12.92 * v
-    } else {
-        1.055 * v.powf(1.0 / 2.4) - 0.055
-    }
-}
-
-/// 8-bit RGB bytes of `film`, clamped to [0, 1] and encoded.
-pub fn to_rgb8(film: &Film, encoding: Encoding) -> Vec<u8> {
-    let mut out = Vec::with_capacity(film.pixels.len() * 3);
-    for p in &film.pixels {
-        for c in p.to_array() {
-            let c = if c.is_nan() { 0.0 } else { c.clamp(0.0, 1.0) };
-            let e = match encoding {
-                Encoding::Srgb => srgb_encode(c),
-                Encoding::Linear => c,
-            };
-            out.push((e * 255.0 + 0.5) as u8);
-        }
-    }
-    out
 }
 
 /// How many pixels differ between two films of the same size once encoded as 8-bit
@@ -209,23 +176,6 @@ pub fn is_complete_image(path: &Path) -> bool {
 mod tests {
     use super::*;
     use glam::Vec3;
-
-    #[test]
-    fn srgb_curve_endpoints_and_midpoint() {
-        assert_eq!(srgb_encode(0.0), 0.0);
-        assert!((srgb_encode(1.0) - 1.0).abs() < 1e-6);
-        // 18% grey encodes to about 46%.
-        assert!((srgb_encode(0.18) - 0.4613).abs() < 1e-3);
-    }
-
-    #[test]
-    fn rgb8_clamps_and_encodes() {
-        let mut f = Film::new(2, 1);
-        f.set(0, 0, Vec3::new(-1.0, 0.5, 2.0));
-        f.set(1, 0, Vec3::new(f32::NAN, 0.0, 1.0));
-        assert_eq!(to_rgb8(&f, Encoding::Linear), vec![0, 128, 255, 0, 0, 255]);
-        assert_eq!(to_rgb8(&f, Encoding::Srgb)[1], 188);
-    }
 
     #[test]
     fn png_and_exr_round_trip() {
