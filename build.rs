@@ -2,11 +2,17 @@
 //! bindings with bindgen from the installed header into `OUT_DIR`, and tell rustc which
 //! API it got (`cfg(embree4)` or `cfg(embree3)`). Without the feature it does nothing.
 //!
-//! Search order (DESIGN.md §2):
+//! Search order:
 //! 1. `EMBREE_DIR` (`include/` and `lib/` under it), `EMBREE_INCLUDE_DIR`, `EMBREE_LIB_DIR`;
-//! 2. pkg-config `embree4`, then `embree3` (the `pkg-config` binary, if installed);
+//! 2. pkg-config `embree4`, then `embree3` (through the `pkg-config` crate, which runs
+//!    the `pkg-config` program when it is installed and honours `PKG_CONFIG_PATH`);
 //! 3. the compiler's default include directories, for `embree4/rtcore.h` then
 //!    `embree3/rtcore.h`.
+//!
+//! Whichever route found it, a library directory the dynamic loader does not search by
+//! default (anything but `/lib`, `/usr/lib` and their `lib64` and multiarch
+//! subdirectories) is also written into the binaries' run path, so that they start
+//! without `LD_LIBRARY_PATH`.
 
 fn main() {
     println!("cargo::rerun-if-changed=build.rs");
@@ -25,7 +31,6 @@ mod embree {
     use std::env;
     use std::fmt::Write as _;
     use std::path::{Path, PathBuf};
-    use std::process::Command;
 
     /// Environment variables that steer the search.
     const ENV_VARS: [&str; 3] = ["EMBREE_DIR", "EMBREE_INCLUDE_DIR", "EMBREE_LIB_DIR"];
@@ -56,8 +61,6 @@ mod embree {
         include_dir: PathBuf,
         /// Where the library is, when known (system locations need none).
         lib_dir: Option<PathBuf>,
-        /// The lib dir came from the user: also set an rpath so tests and binaries run.
-        explicit_lib_dir: bool,
         /// How it was found, for messages.
         how: String,
     }
@@ -90,7 +93,7 @@ mod embree {
         if let Some(lib) = &found.lib_dir {
             println!("cargo::rustc-link-search=native={}", lib.display());
             let unix = env::var("CARGO_CFG_TARGET_FAMILY").is_ok_and(|f| f == "unix");
-            if found.explicit_lib_dir && unix {
+            if unix && !is_loader_default(lib) {
                 println!("cargo::rustc-link-arg=-Wl,-rpath,{}", lib.display());
             }
         }
@@ -156,7 +159,6 @@ mod embree {
             return Some(Found {
                 api,
                 include_dir: include,
-                explicit_lib_dir: lib.is_some(),
                 lib_dir: lib,
                 how: "EMBREE_DIR / EMBREE_INCLUDE_DIR".into(),
             });
@@ -173,7 +175,6 @@ mod embree {
                         return Some(Found {
                             api,
                             include_dir: dir,
-                            explicit_lib_dir: lib.is_some(),
                             lib_dir: lib.clone().or_else(|| libs.into_iter().next()),
                             how: format!("pkg-config {}", api.name()),
                         });
@@ -191,7 +192,6 @@ mod embree {
                     return Some(Found {
                         api,
                         include_dir: dir,
-                        explicit_lib_dir: lib.is_some(),
                         lib_dir,
                         how: "default include path".into(),
                     });
@@ -201,25 +201,35 @@ mod embree {
         None
     }
 
-    /// `-I` and `-L` directories from `pkg-config`, or `None` when it does not know `name`
-    /// (or is not installed).
+    /// Include and library directories pkg-config gives for `name`, or `None` when it
+    /// does not know `name` (or is not installed). The link lines are written by
+    /// [`run`], the same way for every route.
     fn pkg_config(name: &str) -> Option<(Vec<PathBuf>, Vec<PathBuf>)> {
-        let exe = env::var_os("PKG_CONFIG").unwrap_or_else(|| "pkg-config".into());
-        let run = |args: &[&str]| -> Option<String> {
-            let out = Command::new(&exe).args(args).arg(name).output().ok()?;
-            out.status
-                .success()
-                .then(|| String::from_utf8_lossy(&out.stdout).into_owned())
-        };
-        let cflags = run(&["--cflags-only-I"])?;
-        let libs = run(&["--libs-only-L"]).unwrap_or_default();
-        let dirs = |s: &str, flag: &str| -> Vec<PathBuf> {
-            s.split_whitespace()
-                .filter_map(|t| t.strip_prefix(flag))
-                .map(PathBuf::from)
-                .collect()
-        };
-        Some((dirs(&cflags, "-I"), dirs(&libs, "-L")))
+        let lib = pkg_config::Config::new()
+            .cargo_metadata(false)
+            .env_metadata(false)
+            .probe(name)
+            .ok()?;
+        Some((lib.include_paths, lib.link_paths))
+    }
+
+    /// Whether the dynamic loader searches `dir` without being told: the system library
+    /// directories (glibc's built-in list, with Debian's multiarch ones).
+    fn is_loader_default(dir: &Path) -> bool {
+        let mut defaults = vec![
+            PathBuf::from("/lib"),
+            PathBuf::from("/lib64"),
+            PathBuf::from("/usr/lib"),
+            PathBuf::from("/usr/lib64"),
+        ];
+        if let Some(triple) = multiarch() {
+            defaults.push(PathBuf::from(format!("/lib/{triple}")));
+            defaults.push(PathBuf::from(format!("/usr/lib/{triple}")));
+        }
+        let dir = dir.canonicalize().unwrap_or_else(|_| dir.to_path_buf());
+        defaults
+            .iter()
+            .any(|d| d.canonicalize().is_ok_and(|d| d == dir) || *d == dir)
     }
 
     /// The usual compiler include directories, including the Debian multiarch one.

@@ -9,24 +9,26 @@ use emray::geometry::{
     AaBox, CappedCone, Cone, Csg, CsgOp, CsgTree, Kind, OBox, Plane, Polyhedron, Quadric, Shape,
     Sphere, Torus, Triangle,
 };
-use emray::math::{Ray, Vec3};
+use emray::math::{Ray, Rng, Vec3};
 use emray::scene::{Camera, Material, Scene};
 use glam::Quat;
 use std::hint::black_box;
 use std::sync::Arc;
 
-struct Lcg(u64);
+/// The draws the scenes and rays are made of.
+trait Draws {
+    /// Uniform in `[0, 1)`.
+    fn f(&mut self) -> f32;
+    /// A point uniform in the cube of edge `s` about the origin.
+    fn v(&mut self, s: f32) -> Vec3;
+}
 
-impl Lcg {
+impl Draws for Rng {
     fn f(&mut self) -> f32 {
-        self.0 = self
-            .0
-            .wrapping_mul(6364136223846793005)
-            .wrapping_add(1442695040888963407);
-        (self.0 >> 40) as f32 / (1u64 << 24) as f32
+        self.next_f32()
     }
     fn v(&mut self, s: f32) -> Vec3 {
-        Vec3::new(self.f() - 0.5, self.f() - 0.5, self.f() - 0.5) * s
+        self.vec3_in(-0.5 * s, 0.5 * s)
     }
 }
 
@@ -42,7 +44,7 @@ fn scene(kind: Kind, n: usize) -> Scene {
     };
     let mut s = Scene::new(cam);
     s.materials.push(Material::default());
-    let mut r = Lcg(42);
+    let mut r = Rng::new(42);
     for _ in 0..n {
         let c = r.v(20.0);
         match kind {
@@ -106,7 +108,7 @@ fn scene(kind: Kind, n: usize) -> Scene {
 }
 
 fn rays(n: usize) -> Vec<Ray> {
-    let mut r = Lcg(7);
+    let mut r = Rng::new(7);
     (0..n)
         .map(|_| {
             let org = r.v(60.0);

@@ -2,8 +2,8 @@
 //! sheet): `cargo run --release --example contact_sheet -- docs/spd.png [TILE]`.
 
 use emray::accel::Backend;
-use emray::output::{Encoding, to_rgb8};
 use emray::render::RenderSettings;
+use emray::render::color::{Encoding, to_rgb8};
 use emray::spd::Database;
 use std::path::Path;
 

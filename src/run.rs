@@ -343,11 +343,6 @@ pub fn render_two_pass(
     accel::build(scene, &backend.into(), work)?
 }
 
-/// What the f64 reference renderer does not model, found in a scene.
-#[derive(Clone, Debug, PartialEq, Eq, thiserror::Error)]
-#[error("{0}")]
-pub struct ReferenceUnsupported(pub String);
-
 /// Render `scene` with the f64 reference renderer ([`render::reference`]) using
 /// `strata × strata` samples per pixel; `Err` names what the reference does not model.
 pub fn render_reference(
@@ -356,9 +351,9 @@ pub fn render_reference(
     settings: &RenderSettings,
     strata: u32,
     load_ms: f64,
-) -> Result<(Film, Report), ReferenceUnsupported> {
+) -> Result<(Film, Report), render::reference::Unsupported> {
     if let Some(why) = render::reference::unsupported(scene) {
-        return Err(ReferenceUnsupported(why));
+        return Err(why);
     }
     let t0 = Instant::now();
     let (film, rays) = render::reference::render(

@@ -8,7 +8,7 @@ use emray::accel::Accel;
 use emray::accel::bvh::Bvh;
 use emray::accel::embree::EmbreeAccel;
 use emray::geometry::{Cone, Kind, Sphere, Triangle};
-use emray::math::{Ray, Vec3};
+use emray::math::{Ray, Rng, Vec3};
 use emray::scene::{Camera, Material, Scene};
 use proptest::prelude::*;
 
@@ -27,30 +27,33 @@ fn scene(seed: u64) -> Scene {
         height: 8,
     });
     s.materials.push(Material::default());
-    let mut x = seed;
-    let mut f = move || {
-        x = x
-            .wrapping_mul(6364136223846793005)
-            .wrapping_add(1442695040888963407);
-        (x >> 40) as f32 / (1u64 << 24) as f32
-    };
-    let v = |f: &mut dyn FnMut() -> f32, s: f32| Vec3::new(f() - 0.5, f() - 0.5, f() - 0.5) * s;
+    let mut rng = Rng::new(seed);
+    // A point uniform in the cube of edge `s` about the origin.
+    let v = |rng: &mut Rng, s: f32| rng.vec3_in(-0.5 * s, 0.5 * s);
     for i in 0..600 {
-        let c = v(&mut f, 20.0);
+        let c = v(&mut rng, 20.0);
         match i % 3 {
             0 => {
-                let p = [c + v(&mut f, 2.0), c + v(&mut f, 2.0), c + v(&mut f, 2.0)];
+                let p = [
+                    c + v(&mut rng, 2.0),
+                    c + v(&mut rng, 2.0),
+                    c + v(&mut rng, 2.0),
+                ];
                 s.triangles.push(Triangle { p }, 0);
                 s.triangle_normals.push(u32::MAX);
             }
             1 => {
-                let r = 0.1 + f();
+                let r = rng.range(0.1, 1.1);
+                let inside_only = rng.next_f32() < 0.2;
                 s.spheres
-                    .push(Sphere::new(c, if f() < 0.2 { -r } else { r }), 0);
+                    .push(Sphere::new(c, if inside_only { -r } else { r }), 0);
             }
             _ => {
-                let apex = c + v(&mut f, 3.0);
-                s.cones.push(Cone::new(c, f() * 0.6, apex, f() * 0.6), 0);
+                let apex = c + v(&mut rng, 3.0);
+                s.cones.push(
+                    Cone::new(c, rng.range(0.0, 0.6), apex, rng.range(0.0, 0.6)),
+                    0,
+                );
             }
         }
     }

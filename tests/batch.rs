@@ -101,7 +101,7 @@ fn a_killed_batch_resumes_to_a_clean_runs_outputs() {
     let done_before = files(&d.join("out")).len();
     // Leftovers a kill can leave: a stale temporary file, and (from some other tool)
     // a truncated image under an output name, which a resume must not trust.
-    std::fs::write(d.join("out/.s03.png.4242.tmp"), b"partial").unwrap();
+    std::fs::write(d.join("out/.s03.png.k3Xq9ZpA.tmp"), b"partial").unwrap();
     std::fs::write(d.join("out/s05.png"), b"\x89PNG\r\n\x1a\n").unwrap();
     let o = emray(
         d,

@@ -6,7 +6,7 @@
 use emray::Scene;
 use emray::accel::Backend;
 use emray::geometry::{Csg, CsgOp, CsgTree, Shape, Solid, Sphere, Triangle};
-use emray::math::{Ray, Vec3, Xform};
+use emray::math::{Ray, Rng, Vec3, Xform};
 use emray::output::differing_pixels;
 use emray::render::{Film, RenderSettings};
 use emray::run::render_scene;
@@ -189,14 +189,6 @@ fn csg(tree: &CsgTree) -> Arc<Csg> {
     Arc::new(Csg::new(tree).unwrap())
 }
 
-/// A tiny deterministic generator.
-fn rng(seed: &mut u64) -> f32 {
-    *seed = seed
-        .wrapping_mul(6364136223846793005)
-        .wrapping_add(1442695040888963407);
-    ((*seed >> 40) as f32) / (1u64 << 24) as f32
-}
-
 #[test]
 fn spans_classify_points_like_the_set_expression() {
     // ((A ∪ B) − C) ∩ D, with a transformed operand; membership computed independently
@@ -223,12 +215,12 @@ fn spans_classify_points_like_the_set_expression() {
     let solid = csg(&tree);
     let inside = |p: Vec3, (c, r): (Vec3, f32)| (p - c).length() < r;
     let expr = |p: Vec3| (inside(p, a) || inside(p, b)) && !inside(p, c) && inside(p, d);
-    let mut seed = 11u64;
+    let mut rng = Rng::new(11);
     let mut checked = 0;
     let mut inside_count = 0;
     for _ in 0..20000 {
-        let p = Vec3::new(rng(&mut seed), rng(&mut seed), rng(&mut seed)) * 4.0 - 2.0;
-        let dir = Vec3::new(rng(&mut seed), rng(&mut seed), rng(&mut seed)) - 0.5;
+        let p = rng.vec3_in(-2.0, 2.0);
+        let dir = rng.vec3_in(-0.5, 0.5);
         if dir.length() < 0.1 {
             continue;
         }

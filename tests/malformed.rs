@@ -7,17 +7,10 @@ use std::process::{Command, Output};
 
 const CAMERA: &str = "v\nfrom 0 0 5\nat 0 0 0\nup 0 1 0\nangle 40\nhither 1\nresolution 8 8\n";
 
-/// Deterministic bytes that are no text format (xorshift).
+/// Deterministic random bytes: no text format.
 fn garbage(n: usize, seed: u64) -> Vec<u8> {
-    let mut x = seed | 1;
-    (0..n)
-        .map(|_| {
-            x ^= x << 13;
-            x ^= x >> 7;
-            x ^= x << 17;
-            (x >> 24) as u8
-        })
-        .collect()
+    let mut rng = emray::math::Rng::new(seed);
+    (0..n).map(|_| (rng.next_u32() >> 24) as u8).collect()
 }
 
 fn nested_csg(depth: usize) -> String {

@@ -1209,13 +1209,8 @@ fn torus_contains_agrees_with_spans() {
         0.4,
     )
     .unwrap();
-    let mut state = 0x2545F4914F6CDD1Du64;
-    let mut rnd = move || {
-        state ^= state << 13;
-        state ^= state >> 7;
-        state ^= state << 17;
-        (state >> 11) as f32 / (1u64 << 53) as f32 * 2.0 - 1.0
-    };
+    let mut rng = emray::math::Rng::new(0x2545_F491_4F6C_DD1D);
+    let mut rnd = move || rng.range(-1.0, 1.0);
     let mut checked = 0;
     for _ in 0..2000 {
         let o = Vec3::new(rnd(), rnd(), rnd()) * 3.0;

@@ -201,13 +201,8 @@ fn form_factors_are_reciprocal_on_random_pairs() {
     let mesh = Mesh::build(&scene, 0.45).unwrap();
     let n = mesh.elements.len();
     let s = Sampling::new(3, 1);
-    let mut state = 0x1234_5678u32;
-    let mut next = || {
-        state ^= state << 13;
-        state ^= state >> 17;
-        state ^= state << 5;
-        state as usize % n
-    };
+    let mut rng = emray::math::Rng::new(0x1234_5678);
+    let mut next = || rng.below(n as u32) as usize;
     let mut checked = 0;
     while checked < 40 {
         let (i, j) = (next(), next());
@@ -460,7 +455,7 @@ fn the_view_shows_the_interpolated_solution() {
 
 #[test]
 fn area_light_sampling_matches_the_form_factor_and_softens_shadows() {
-    use emray::radiosity::area;
+    use emray::render::area;
     // A 1 × 1 emitter facing down, 1 above the origin of a floor facing up.
     let mut s = Scene::new(camera());
     s.materials.push(Material::DEFAULT);

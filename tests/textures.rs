@@ -124,13 +124,8 @@ fn checker_and_marble() {
 
 #[test]
 fn inverse_bilinear_recovers_random_points_in_random_convex_quads() {
-    let mut x = 0x1234_5678_9abc_def0u64;
-    let mut rnd = move || {
-        x = x
-            .wrapping_mul(6364136223846793005)
-            .wrapping_add(1442695040888963407);
-        (x >> 40) as f32 / (1u64 << 24) as f32
-    };
+    let mut rng = emray::math::Rng::new(0x1234_5678_9abc_def0);
+    let mut rnd = move || rng.next_f32();
     let mut tested = 0;
     while tested < 2000 {
         // A convex quad: four points at increasing angles around a centre, in a

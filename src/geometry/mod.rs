@@ -33,6 +33,9 @@ pub use sphere::Sphere;
 pub use torus::Torus;
 pub use triangle::{Triangle, WatertightRay};
 
+// A hit point with its error bound: defined in `math`, whose transforms map it.
+pub use crate::math::SurfacePoint;
+
 use crate::math::{Aabb, Ray, Vec3};
 use std::sync::Arc;
 
@@ -47,17 +50,6 @@ pub struct ShapeHit {
     /// Second surface parameter (triangles: barycentric weight of vertex 2).
     pub v: f32,
     /// Geometric normal, not normalised.
-    pub ng: Vec3,
-}
-
-/// A hit point with the bound of its rounding error, for robust ray spawning.
-#[derive(Clone, Copy, Debug, PartialEq)]
-pub struct SurfacePoint {
-    /// The point, computed as accurately as the shape allows (not `o + t·d`).
-    pub p: Vec3,
-    /// Per-axis absolute error bound of `p`.
-    pub err: Vec3,
-    /// Unit geometric normal (outwards for closed shapes, by winding for triangles).
     pub ng: Vec3,
 }
 
@@ -438,14 +430,10 @@ mod tests {
         assert_ne!(naive, 1.0);
         assert_eq!(diff_of_products(4097.0, 4097.0, 4096.0, 4098.0), 1.0);
         // Within half an ulp of the exact value, checked in exact integer arithmetic.
-        let mut seed = 0x2545_f491u32;
+        let mut rng = crate::math::Rng::new(0x2545_f491);
         for _ in 0..10_000 {
-            let mut next = || {
-                seed ^= seed << 13;
-                seed ^= seed >> 17;
-                seed ^= seed << 5;
-                (seed >> 8) as i64 - (1 << 23)
-            };
+            // Integers of up to 24 bits, exact in f32.
+            let mut next = || i64::from(rng.next_u32() >> 8) - (1 << 23);
             let (a, b, c, d) = (next(), next(), next(), next());
             let exact = i128::from(a) * i128::from(b) - i128::from(c) * i128::from(d);
             let got = diff_of_products(a as f32, b as f32, c as f32, d as f32);

@@ -1,14 +1,19 @@
-//! Rays, boxes, orthonormal frames and the floating-point error tools used for robust
-//! ray spawning.
+//! The bottom layer: rays, boxes, transforms, orthonormal frames, surface points with
+//! their error bounds and the floating-point error tools used for robust ray spawning,
+//! the coordinate hashes that drive sampling, and the one seeded random number
+//! generator ([`Rng`]) for tests, benches and stress rays. It imports nothing from the
+//! rest of the crate.
 
 mod aabb;
+mod rng;
 mod robust;
 mod xform;
 
 pub use aabb::Aabb;
 pub use glam::{DVec3, Vec3};
+pub use rng::Rng;
 pub use robust::{RayOrigins, gamma, next_float_down, next_float_up, offset_ray_origin};
-pub use xform::Xform;
+pub use xform::{Xform, XformError};
 
 /// A ray with its valid parameter interval `[tmin, tmax]`.
 ///
@@ -78,6 +83,17 @@ impl From<&Ray> for DRay {
             dir: r.dir.as_dvec3(),
         }
     }
+}
+
+/// A hit point with the bound of its rounding error, for robust ray spawning.
+#[derive(Clone, Copy, Debug, PartialEq)]
+pub struct SurfacePoint {
+    /// The point, computed as accurately as the shape allows (not `o + t·d`).
+    pub p: Vec3,
+    /// Per-axis absolute error bound of `p`.
+    pub err: Vec3,
+    /// Unit geometric normal (outwards for closed shapes, by winding for triangles).
+    pub ng: Vec3,
 }
 
 /// A right-handed orthonormal frame.

@@ -121,13 +121,8 @@ mod tests {
 
     #[test]
     fn cached_origins_equal_the_offset_for_every_direction() {
-        let mut seed = 0x9e37_79b9u32;
-        let mut r = || {
-            seed ^= seed << 13;
-            seed ^= seed >> 17;
-            seed ^= seed << 5;
-            seed as f32 / u32::MAX as f32 * 2.0 - 1.0
-        };
+        let mut rng = crate::math::Rng::new(0x9e37_79b9);
+        let mut r = || rng.range(-1.0, 1.0);
         for _ in 0..200 {
             let p = Vec3::new(r(), r(), r()) * 1e3;
             let err = Vec3::new(r().abs(), r().abs(), r().abs()) * 1e-4;

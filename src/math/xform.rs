@@ -1,9 +1,25 @@
 //! Affine transforms of rays, points and normals, with the rounding-error bounds that
 //! robust ray spawning needs (pbrt, 3rd ed., §3.9).
 
-use super::{Aabb, Ray, Vec3, gamma};
-use crate::geometry::SurfacePoint;
+use super::{Aabb, Ray, SurfacePoint, Vec3, gamma};
 use glam::{Affine3A, Mat3};
+
+/// Why a matrix is not a usable transform.
+#[derive(Clone, Debug, PartialEq, thiserror::Error)]
+pub enum XformError {
+    /// An entry is NaN or infinite.
+    #[error("the transform has a non-finite entry")]
+    NonFinite,
+    /// The determinant is zero, not finite, or tiny relative to the scale.
+    #[error("the transform is singular or nearly so (determinant {determinant:e})")]
+    Singular {
+        /// The determinant of the linear part.
+        determinant: f32,
+    },
+    /// The inverse overflows single precision.
+    #[error("the transform cannot be inverted in single precision")]
+    NotInvertible,
+}
 
 /// An invertible affine transform with its inverse, from object space to world space.
 ///
@@ -27,18 +43,16 @@ impl Xform {
 
     /// `m` (object to world) and its inverse; `Err` when `m` is singular, nearly so
     /// (condition number beyond 1e6) or not finite.
-    pub fn new(m: Affine3A) -> Result<Xform, String> {
+    pub fn new(m: Affine3A) -> Result<Xform, XformError> {
         let l = m.matrix3;
         let cols = [l.x_axis, l.y_axis, l.z_axis];
         if !cols.iter().all(|c| c.is_finite()) || !m.translation.is_finite() {
-            return Err("the transform has a non-finite entry".into());
+            return Err(XformError::NonFinite);
         }
         let det = Mat3::from(l).determinant();
         let scale = cols.iter().map(|c| c.length()).fold(0.0f32, f32::max);
         if det == 0.0 || !det.is_finite() || (det.abs() / scale.powi(3)) < 1e-6 {
-            return Err(format!(
-                "the transform is singular or nearly so (determinant {det:e})"
-            ));
+            return Err(XformError::Singular { determinant: det });
         }
         let inv = m.inverse();
         if !inv.matrix3.x_axis.is_finite()
@@ -46,7 +60,7 @@ impl Xform {
             || !inv.matrix3.z_axis.is_finite()
             || !inv.translation.is_finite()
         {
-            return Err("the transform cannot be inverted in single precision".into());
+            return Err(XformError::NotInvertible);
         }
         Ok(Xform {
             to_world: m,
@@ -186,9 +200,21 @@ mod tests {
 
     #[test]
     fn singular_and_non_finite_transforms_are_refused() {
-        assert!(Xform::new(Affine3A::from_scale(Vec3::new(1.0, 0.0, 1.0))).is_err());
-        assert!(Xform::new(Affine3A::from_scale(Vec3::new(1.0, 1e-9, 1.0))).is_err());
-        assert!(Xform::new(Affine3A::from_translation(Vec3::new(f32::NAN, 0.0, 0.0))).is_err());
+        let singular = Xform::new(Affine3A::from_scale(Vec3::new(1.0, 0.0, 1.0))).unwrap_err();
+        assert_eq!(singular, XformError::Singular { determinant: 0.0 });
+        assert_eq!(
+            singular.to_string(),
+            "the transform is singular or nearly so (determinant 0e0)"
+        );
+        assert!(matches!(
+            Xform::new(Affine3A::from_scale(Vec3::new(1.0, 1e-9, 1.0))),
+            Err(XformError::Singular { .. })
+        ));
+        let nan = Xform::new(Affine3A::from_translation(Vec3::new(f32::NAN, 0.0, 0.0)));
+        assert_eq!(
+            nan.unwrap_err().to_string(),
+            "the transform has a non-finite entry"
+        );
         assert!(Xform::new(Affine3A::IDENTITY).is_ok());
     }
 

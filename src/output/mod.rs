@@ -4,20 +4,13 @@
 
 pub mod part;
 
+// The PNG writer's encodings, defined with the colour curves in `render`.
 use crate::render::Film;
+pub use crate::render::color::Encoding;
+use crate::render::color::to_rgb8;
 use std::fs;
 use std::io::{BufWriter, Write};
 use std::path::{Path, PathBuf};
-
-/// How PNG values are encoded.
-#[derive(Clone, Copy, Debug, Default, PartialEq, Eq)]
-pub enum Encoding {
-    /// Linear values through the sRGB transfer curve (what image viewers expect).
-    #[default]
-    Srgb,
-    /// Values written as they are, clamped to [0, 1] (the classic NFF renderers' way).
-    Linear,
-}
 
 /// Output file formats.
 #[derive(Clone, Copy, Debug, PartialEq, Eq)]
@@ -60,32 +53,6 @@ impl Format {
     }
 }
 
-/// The sRGB transfer function (IEC 61966-2-1) for a linear value in [0, 1].
-#[inline]
-pub fn srgb_encode(v: f32) -> f32 {
-    if v <= 0.003_130_8 {
-        12.92 * v
-    } else {
-        1.055 * v.powf(1.0 / 2.4) - 0.055
-    }
-}
-
-/// 8-bit RGB bytes of `film`, clamped to [0, 1] and encoded.
-pub fn to_rgb8(film: &Film, encoding: Encoding) -> Vec<u8> {
-    let mut out = Vec::with_capacity(film.pixels.len() * 3);
-    for p in &film.pixels {
-        for c in p.to_array() {
-            let c = if c.is_nan() { 0.0 } else { c.clamp(0.0, 1.0) };
-            let e = match encoding {
-                Encoding::Srgb => srgb_encode(c),
-                Encoding::Linear => c,
-            };
-            out.push((e * 255.0 + 0.5) as u8);
-        }
-    }
-    out
-}
-
 /// How many pixels differ between two films of the same size once encoded as 8-bit
 /// sRGB (what a viewer of the PNGs would see).
 pub fn differing_pixels(a: &Film, b: &Film) -> usize {
@@ -122,8 +89,9 @@ pub fn write_image(path: &Path, film: &Film, encoding: Encoding) -> Result<(), O
     }
 }
 
-/// Write `path` through a temporary file beside it that `write` fills, then a rename;
-/// on failure the temporary file is removed and the target left as it was.
+/// Write `path` through a temporary file beside it (`.NAME.XXXXXX.tmp`, so that the
+/// rename is atomic) that `write` fills, then a rename; on failure the temporary file is
+/// removed and the target left as it was.
 pub(crate) fn write_atomic(
     path: &Path,
     write: impl FnOnce(fs::File) -> Result<(), String>,
@@ -132,17 +100,31 @@ pub(crate) fn write_atomic(
         path: path.to_path_buf(),
         message,
     };
-    let tmp = temp_name(path);
-    let result = fs::File::create(&tmp)
-        .map_err(|e| e.to_string())
-        .and_then(write)
-        .and_then(|()| fs::rename(&tmp, path).map_err(|e| e.to_string()))
-        .map_err(err);
-    if result.is_err() {
-        let _ = fs::remove_file(&tmp);
-    }
-    result
+    let dir = match path.parent() {
+        Some(d) if !d.as_os_str().is_empty() => d,
+        _ => Path::new("."),
+    };
+    let name = path
+        .file_name()
+        .map(|n| n.to_string_lossy().into_owned())
+        .unwrap_or_default();
+    // Dropping an unpersisted temporary file deletes it.
+    let tmp = tempfile::Builder::new()
+        .prefix(&format!(".{name}."))
+        .suffix(TEMP_SUFFIX)
+        .rand_bytes(TEMP_RAND)
+        .tempfile_in(dir)
+        .map_err(|e| err(e.to_string()))?;
+    let file = tmp.reopen().map_err(|e| err(e.to_string()))?;
+    write(file).map_err(err)?;
+    tmp.persist(path).map_err(|e| err(e.error.to_string()))?;
+    Ok(())
 }
+
+/// Temporary files end in this.
+const TEMP_SUFFIX: &str = ".tmp";
+/// Random characters in a temporary file's name.
+const TEMP_RAND: usize = 8;
 
 /// Write a text file through a temporary file and a rename.
 pub fn write_text(path: &Path, text: &str) -> Result<(), OutputError> {
@@ -152,7 +134,8 @@ pub fn write_text(path: &Path, text: &str) -> Result<(), OutputError> {
 }
 
 /// Remove temporary files that an earlier, killed process left for `path` (their
-/// names are `.NAME.PID.tmp`); returns how many went.
+/// names are `.NAME.XXXXXXXX.tmp`, see [`write_atomic`]; older versions put their
+/// process id there); returns how many went.
 pub fn remove_stale_temps(path: &Path) -> usize {
     let (Some(dir), Some(name)) = (path.parent(), path.file_name()) else {
         return 0;
@@ -171,8 +154,8 @@ pub fn remove_stale_temps(path: &Path) -> usize {
         let n = e.file_name().to_string_lossy().into_owned();
         let stale = n
             .strip_prefix(&prefix)
-            .and_then(|rest| rest.strip_suffix(".tmp"))
-            .is_some_and(|pid| !pid.is_empty() && pid.bytes().all(|b| b.is_ascii_digit()));
+            .and_then(|rest| rest.strip_suffix(TEMP_SUFFIX))
+            .is_some_and(|r| !r.is_empty() && r.bytes().all(|b| b.is_ascii_alphanumeric()));
         if stale && fs::remove_file(e.path()).is_ok() {
             removed += 1;
         }
@@ -189,36 +172,10 @@ pub fn is_complete_image(path: &Path) -> bool {
     }
 }
 
-/// A hidden temporary name in the same directory (so the rename is atomic).
-fn temp_name(path: &Path) -> PathBuf {
-    let name = path
-        .file_name()
-        .map(|n| n.to_string_lossy().into_owned())
-        .unwrap_or_default();
-    path.with_file_name(format!(".{name}.{}.tmp", std::process::id()))
-}
-
 #[cfg(test)]
 mod tests {
     use super::*;
     use glam::Vec3;
-
-    #[test]
-    fn srgb_curve_endpoints_and_midpoint() {
-        assert_eq!(srgb_encode(0.0), 0.0);
-        assert!((srgb_encode(1.0) - 1.0).abs() < 1e-6);
-        // 18% grey encodes to about 46%.
-        assert!((srgb_encode(0.18) - 0.4613).abs() < 1e-3);
-    }
-
-    #[test]
-    fn rgb8_clamps_and_encodes() {
-        let mut f = Film::new(2, 1);
-        f.set(0, 0, Vec3::new(-1.0, 0.5, 2.0));
-        f.set(1, 0, Vec3::new(f32::NAN, 0.0, 1.0));
-        assert_eq!(to_rgb8(&f, Encoding::Linear), vec![0, 128, 255, 0, 0, 255]);
-        assert_eq!(to_rgb8(&f, Encoding::Srgb)[1], 188);
-    }
 
     #[test]
     fn png_and_exr_round_trip() {

@@ -3,8 +3,8 @@
 //! FLIP (NVIDIA's perceptual difference, on the 8-bit sRGB images: LDR only), plus a
 //! heat-map picture of where they differ. Used by `emray compare` and `emray study`.
 
-use crate::output::{Encoding, to_rgb8};
 use crate::render::Film;
+use crate::render::color::{Encoding, srgb_decode, to_rgb8};
 use glam::Vec3;
 use serde::Serialize;
 use std::path::{Path, PathBuf};
@@ -61,16 +61,6 @@ pub enum MetricsError {
         /// Its height.
         bh: u32,
     },
-}
-
-/// The sRGB decoding curve (IEC 61966-2-1) for a value in [0, 1].
-#[inline]
-pub fn srgb_decode(v: f32) -> f32 {
-    if v <= 0.040_45 {
-        v / 12.92
-    } else {
-        ((v + 0.055) / 1.055).powf(2.4)
-    }
 }
 
 /// Read a PNG (decoded to linear with `encoding`) or an EXR (its R, G and B channels,
@@ -234,7 +224,7 @@ pub fn magma(x: f32) -> Vec3 {
 #[cfg(test)]
 mod tests {
     use super::*;
-    use crate::output::srgb_encode;
+    use crate::render::color::srgb_encode;
 
     fn flat(w: u32, h: u32, v: Vec3) -> Film {
         let mut f = Film::new(w, h);

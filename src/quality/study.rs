@@ -7,8 +7,9 @@ use super::metrics::{Metrics, compare};
 use crate::Scene;
 use crate::accel::{AccelError, Backend};
 use crate::output::OutputError;
+use crate::render::reference::Unsupported;
 use crate::render::{Aa, RenderSettings};
-use crate::run::{ReferenceUnsupported, render_reference, render_scene};
+use crate::run::{render_reference, render_scene};
 use std::fmt::Write as _;
 use std::path::{Path, PathBuf};
 
@@ -17,7 +18,7 @@ use std::path::{Path, PathBuf};
 pub enum StudyError {
     /// The f64 reference does not model something in the scene.
     #[error(transparent)]
-    Reference(#[from] ReferenceUnsupported),
+    Reference(#[from] Unsupported),
     /// A backend could not be built.
     #[error(transparent)]
     Accel(#[from] AccelError),

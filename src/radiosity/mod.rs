@@ -14,7 +14,6 @@
 //! Elements are one-sided: they emit and receive on the side their triangle's winding
 //! makes the front (counterclockwise seen from the front); the back side shows black.
 
-pub mod area;
 pub mod formfactor;
 pub mod hemicube;
 pub mod mesh;
@@ -24,11 +23,11 @@ pub mod tessellate;
 use crate::accel::{Accel, AccelError, BackendOptions, Hit, WithAccel};
 use crate::geometry::Kind;
 use crate::math::Vec3;
-use crate::render::{Film, RayGen};
+use crate::render::color::srgb_encode;
+use crate::render::{Film, GlobalIllumination, gi};
 use crate::scene::Scene;
 use formfactor::Sampling;
 use mesh::Mesh;
-use rayon::prelude::*;
 use serde::Serialize;
 use solver::Solve;
 use std::time::Instant;
@@ -225,7 +224,7 @@ impl Solution {
             m.vertices.len(),
             m.elements.len()
         );
-        let byte = |x: f32| (crate::output::srgb_encode(x * exposure) * 255.0).round() as u8;
+        let byte = |x: f32| (srgb_encode(x * exposure) * 255.0).round() as u8;
         for (p, c) in m.vertices.iter().zip(&self.vertex_radiosity) {
             let _ = writeln!(
                 s,
@@ -242,6 +241,14 @@ impl Solution {
             let _ = writeln!(s, "3 {} {} {}", e.verts[0], e.verts[1], e.verts[2]);
         }
         s
+    }
+}
+
+/// What the renderer takes from a solution: its Gouraud radiosity where the mesh
+/// covers the surface ([`Solution::radiosity_at`]).
+impl GlobalIllumination for Solution {
+    fn radiosity_at(&self, hit: &Hit, p: Vec3, dir: Vec3) -> Option<Vec3> {
+        Solution::radiosity_at(self, hit, p, dir)
     }
 }
 
@@ -403,44 +410,7 @@ pub fn render_view<A: Accel>(
     height: u32,
     spp: u32,
 ) -> Film {
-    let raygen = RayGen::new(&scene.camera, width, height);
-    let n = spp.max(1);
-    let rows: Vec<Vec<Vec3>> = (0..height)
-        .into_par_iter()
-        .map(|j| {
-            (0..width)
-                .map(|i| {
-                    let mut sum = Vec3::ZERO;
-                    for sy in 0..n {
-                        for sx in 0..n {
-                            let ray = raygen.ray(
-                                i as f32 + (sx as f32 + 0.5) / n as f32,
-                                j as f32 + (sy as f32 + 0.5) / n as f32,
-                            );
-                            sum += match accel.intersect(&ray) {
-                                None => scene.background,
-                                Some(hit) => sol
-                                    .radiosity_at(&hit, ray.at(hit.t), ray.dir)
-                                    .unwrap_or_else(|| {
-                                        let surf = scene.surface(&hit, &ray);
-                                        scene.materials[surf.material as usize].color
-                                            * scene.ambient
-                                    }),
-                            };
-                        }
-                    }
-                    sum / (n * n) as f32
-                })
-                .collect()
-        })
-        .collect();
-    let mut film = Film::new(width, height);
-    for (j, row) in rows.into_iter().enumerate() {
-        for (i, v) in row.into_iter().enumerate() {
-            film.set(i as u32, j as u32, v);
-        }
-    }
-    film
+    gi::view(scene, accel, sol, width, height, spp)
 }
 
 /// What a radiosity run reports (`--stats`, `--stats-json`).

@@ -1,14 +1,20 @@
-//! The Whitted renderer: eye rays, local Phong light with shadow rays, mirror
-//! reflection, Snell refraction with total internal reflection, a depth limit; tiles
-//! rendered in parallel, deterministic whatever the thread count.
+//! The Whitted renderer: eye rays, local Phong light with shadow rays, area lights
+//! ([`area`]), mirror reflection, Snell refraction with total internal reflection, a
+//! depth limit; tiles rendered in parallel, deterministic whatever the thread count.
+//! Global illumination comes in through [`GlobalIllumination`] (a radiosity solution
+//! implements it); [`color`] turns the film's linear values into encoded 8-bit ones.
 
+pub mod area;
 mod camera;
+pub mod color;
 mod film;
+pub mod gi;
 pub mod reference;
 mod whitted;
 
 pub use camera::RayGen;
 pub use film::Film;
+pub use gi::GlobalIllumination;
 pub use whitted::RayCounts;
 
 use crate::accel::Accel;
@@ -28,7 +34,7 @@ pub struct RenderSettings {
     /// Maximum ray-tree depth, counting the eye ray as depth 1.
     pub max_depth: u32,
     /// SPD testing mode: `(w+1) × (h+1)` corner rays, each pixel the mean of its four
-    /// corners (DESIGN.md §3).
+    /// corners; the corner grid's outer rows span the camera's angle.
     pub spd: bool,
     /// Tile edge in pixels.
     pub tile: u32,
@@ -194,13 +200,14 @@ pub fn render<A: Accel>(
     render_with_gi(scene, accel, settings, None, progress)
 }
 
-/// [`render`], two-pass when `gi` is given: the diffuse term of the meshed surfaces
-/// comes from the radiosity solution, the Whitted recursion adds the specular paths.
+/// [`render`], two-pass when `gi` is given: the diffuse term of the surfaces it covers
+/// (a radiosity solution's meshed surfaces) comes from it, the Whitted recursion adds
+/// the specular paths.
 pub fn render_with_gi<A: Accel>(
     scene: &Scene,
     accel: &A,
     settings: &RenderSettings,
-    gi: Option<&crate::radiosity::Solution>,
+    gi: Option<&dyn GlobalIllumination>,
     progress: Option<Progress<'_>>,
 ) -> (Film, RenderStats) {
     let start = std::time::Instant::now();

@@ -19,25 +19,43 @@ use crate::scene::{Camera, Scene};
 use glam::{DVec3, Vec3};
 use rayon::prelude::*;
 
-/// Why a scene cannot be rendered by the reference.
-pub fn unsupported(scene: &Scene) -> Option<String> {
-    let kinds: Vec<&str> = scene.shapes.items.iter().map(|s| s.kind().name()).collect();
-    if let Some(k) = kinds.first() {
-        return Some(format!(
-            "the reference renderer models spheres, cones and triangles only; the scene has {k}"
-        ));
+/// What the reference renderer does not model, so cannot render.
+#[derive(Clone, Copy, Debug, PartialEq, Eq, thiserror::Error)]
+pub enum Unsupported {
+    /// A primitive other than spheres, cones and triangles (its kind's plural name).
+    #[error("the reference renderer models spheres, cones and triangles only; the scene has {0}")]
+    Shape(&'static str),
+    /// Instances of objects.
+    #[error("the reference renderer does not support instances")]
+    Instances,
+    /// Spot lights.
+    #[error("the reference renderer does not support spot lights")]
+    SpotLights,
+    /// Nested-dielectric priorities.
+    #[error("the reference renderer does not support medium priorities")]
+    MediumPriorities,
+    /// Texture, bump or normal maps, or an environment map.
+    #[error("the reference renderer does not support textures or environment maps")]
+    Textures,
+}
+
+/// Why a scene cannot be rendered by the reference (the first reason found), or
+/// `None` when it can.
+pub fn unsupported(scene: &Scene) -> Option<Unsupported> {
+    if let Some(shape) = scene.shapes.items.first() {
+        return Some(Unsupported::Shape(shape.kind().name()));
     }
     if !scene.instances.is_empty() {
-        return Some("the reference renderer does not support instances".into());
+        return Some(Unsupported::Instances);
     }
     if scene.lights.iter().any(|l| l.spot.is_some()) {
-        return Some("the reference renderer does not support spot lights".into());
+        return Some(Unsupported::SpotLights);
     }
     if scene.materials.iter().any(|m| m.t > 0.0 && m.priority != 0) {
-        return Some("the reference renderer does not support medium priorities".into());
+        return Some(Unsupported::MediumPriorities);
     }
     if scene.materials.iter().any(|m| m.maps.any()) || scene.environment.is_some() {
-        return Some("the reference renderer does not support textures or environment maps".into());
+        return Some(Unsupported::Textures);
     }
     None
 }

@@ -1,11 +1,12 @@
-//! Whitted shading (DESIGN.md §4).
+//! Whitted shading: ambient, Phong light from point lights with shadow rays, emission
+//! and area lights, mirror reflection and Snell refraction through nested media. The
+//! README's "NFF conventions" state the shading formula.
 
-use super::{RayGen, Region, RenderSettings};
+use super::{GlobalIllumination, RayGen, Region, RenderSettings, area};
 use crate::accel::{Accel, Hit};
 use crate::math::{
     Ray, RayOrigins, Vec3, hash, hash_unit as unit, next_float_down, offset_ray_origin,
 };
-use crate::radiosity::{Solution, area};
 use crate::scene::{Light, Material, Scene, Surface};
 
 /// Rays cast, by type.
@@ -31,8 +32,9 @@ pub struct RayCounts {
     /// Reflection rays not cast at hits on non-reflective (`Ks = 0`) surfaces below
     /// the depth limit.
     pub skipped_reflection: u64,
-    /// Rays whose radiance overflowed f32 and was saturated (see [`saturate`]): the
-    /// scene's colours, intensities or weights are too large. 0 for sane scenes.
+    /// Rays whose radiance overflowed f32 and was saturated (an infinite channel
+    /// clamped to ±`f32::MAX`, a NaN one set to 0): the scene's colours, intensities
+    /// or weights are too large. 0 for sane scenes.
     pub saturated: u64,
 }
 
@@ -67,8 +69,8 @@ pub(super) struct Tracer<'a, A: Accel> {
     area_lights: Vec<area::AreaLight>,
     /// Shadow rays per area light: `area_samples²`.
     area_samples: u32,
-    /// Two-pass mode: the diffuse term of meshed surfaces from this solution.
-    gi: Option<&'a Solution>,
+    /// Two-pass mode: the diffuse term of the surfaces this solution covers.
+    gi: Option<&'a dyn GlobalIllumination>,
     /// Hall & Greenberg's adaptive tree depth: no secondary ray whose weight (largest
     /// channel) is below this; 0 = off.
     bailout: f32,
@@ -149,8 +151,8 @@ impl<'a, A: Accel> Tracer<'a, A> {
         }
     }
 
-    /// Take the diffuse term of meshed surfaces from a radiosity solution (two-pass).
-    pub(super) fn with_gi(mut self, gi: Option<&'a Solution>) -> Self {
+    /// Take the diffuse term of the surfaces `gi` covers from it (two-pass).
+    pub(super) fn with_gi(mut self, gi: Option<&'a dyn GlobalIllumination>) -> Self {
         self.gi = gi;
         self
     }

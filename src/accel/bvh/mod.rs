@@ -345,21 +345,15 @@ mod agreement {
     use super::wide::LEAF;
     use super::*;
     use crate::geometry::{Cone, Sphere};
-    use crate::math::Vec3;
+    use crate::math::{Rng, Vec3};
     use crate::scene::{Camera, Material};
 
-    fn rng(seed: &mut u64) -> f32 {
-        *seed = seed
-            .wrapping_mul(6364136223846793005)
-            .wrapping_add(1442695040888963407);
-        ((*seed >> 40) as f32) / (1u64 << 24) as f32
+    /// A point uniform in the cube of edge `s` about the origin.
+    fn v(rng: &mut Rng, s: f32) -> Vec3 {
+        rng.vec3_in(-0.5 * s, 0.5 * s)
     }
 
-    fn v(seed: &mut u64, s: f32) -> Vec3 {
-        Vec3::new(rng(seed) - 0.5, rng(seed) - 0.5, rng(seed) - 0.5) * s
-    }
-
-    pub(crate) fn random_scene(n: usize, seed: &mut u64) -> Scene {
+    pub(crate) fn random_scene(n: usize, rng: &mut Rng) -> Scene {
         let cam = Camera {
             from: Vec3::Z * 10.0,
             at: Vec3::ZERO,
@@ -372,20 +366,20 @@ mod agreement {
         let mut s = Scene::new(cam);
         s.materials.push(Material::default());
         for _ in 0..n {
-            let c = v(seed, 10.0);
-            match (rng(seed) * 3.0) as u32 {
+            let c = v(rng, 10.0);
+            match rng.below(3) {
                 0 => {
                     s.triangles.push(
                         Triangle {
-                            p: [c + v(seed, 1.0), c + v(seed, 1.0), c + v(seed, 1.0)],
+                            p: [c + v(rng, 1.0), c + v(rng, 1.0), c + v(rng, 1.0)],
                         },
                         0,
                     );
                     s.triangle_normals.push(u32::MAX);
                 }
-                1 => s.spheres.push(Sphere::new(c, 0.05 + rng(seed) * 0.5), 0),
+                1 => s.spheres.push(Sphere::new(c, rng.range(0.05, 0.55)), 0),
                 _ => s.cones.push(
-                    Cone::new(c, rng(seed) * 0.5, c + v(seed, 2.0), rng(seed) * 0.5),
+                    Cone::new(c, rng.range(0.0, 0.5), c + v(rng, 2.0), rng.range(0.0, 0.5)),
                     0,
                 ),
             }
@@ -415,17 +409,17 @@ mod agreement {
 
     #[test]
     fn bvh_equals_brute_force() {
-        let mut seed = 7u64;
+        let mut rng = Rng::new(7);
         for n in [0usize, 1, 5, 100, 2000] {
-            let scene = random_scene(n, &mut seed);
+            let scene = random_scene(n, &mut rng);
             let bvh = Bvh::build(&scene);
             let mut hits = 0;
             for _ in 0..3000 {
-                let org = v(&mut seed, 30.0);
-                let dir = (v(&mut seed, 10.0) - org).normalize();
+                let org = v(&mut rng, 30.0);
+                let dir = (v(&mut rng, 10.0) - org).normalize();
                 let mut ray = Ray::new(org, dir);
-                if rng(&mut seed) < 0.3 {
-                    ray.tmax = rng(&mut seed) * 30.0;
+                if rng.next_f32() < 0.3 {
+                    ray.tmax = rng.range(0.0, 30.0);
                 }
                 let want = brute(&scene, &ray);
                 let got = bvh.intersect(&ray);
@@ -447,8 +441,7 @@ mod agreement {
 
     #[test]
     fn tree_is_well_formed() {
-        let mut seed = 3u64;
-        let scene = random_scene(5000, &mut seed);
+        let scene = random_scene(5000, &mut Rng::new(3));
         let bvh = Bvh::build(&scene);
         // Every primitive in exactly one leaf, every child inside its parent's slot.
         let mut seen = vec![0u32; bvh.prims.len()];
@@ -496,7 +489,7 @@ mod agreement {
     #[test]
     fn coincident_primitives_still_build() {
         // 10 000 identical spheres: no split separates them; median splits must.
-        let mut s = random_scene(0, &mut 1);
+        let mut s = random_scene(0, &mut Rng::new(1));
         for _ in 0..10_000 {
             s.spheres.push(Sphere::new(Vec3::ZERO, 1.0), 0);
         }
