@@ -1,4 +1,4 @@
-use super::{ShapeHit, SurfacePoint, diff_of_products, quadratic_roots};
+use super::{Intersect, ShapeHit, SurfacePoint, diff_of_products, quadratic_roots};
 use crate::math::{Aabb, Ray, Vec3, gamma};
 
 /// NFF's open cone or cylinder: the lateral surface between a base disk and an apex
@@ -196,5 +196,22 @@ impl Cone {
             err: Vec3::splat(scale * gamma(32)),
             ng,
         }
+    }
+}
+
+impl Intersect for Cone {
+    fn bounds(&self) -> Aabb {
+        Cone::bounds(self)
+    }
+    #[inline]
+    fn intersect(&self, ray: &Ray) -> Option<ShapeHit> {
+        Cone::intersect(self, ray)
+    }
+    #[inline]
+    fn occluded(&self, ray: &Ray) -> bool {
+        Cone::occluded(self, ray)
+    }
+    fn surface(&self, ray: &Ray, hit: &ShapeHit) -> SurfacePoint {
+        Cone::surface(self, ray, hit.t)
     }
 }

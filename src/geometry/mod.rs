@@ -373,59 +373,6 @@ pub(crate) fn quadratic_roots(a: f32, b: f32, c: f32, disc: f32) -> (f32, f32) {
     }
 }
 
-impl Intersect for Sphere {
-    fn bounds(&self) -> Aabb {
-        Sphere::bounds(self)
-    }
-    #[inline]
-    fn intersect(&self, ray: &Ray) -> Option<ShapeHit> {
-        Sphere::intersect(self, ray)
-    }
-    #[inline]
-    fn occluded(&self, ray: &Ray) -> bool {
-        Sphere::occluded(self, ray)
-    }
-    fn surface(&self, ray: &Ray, hit: &ShapeHit) -> SurfacePoint {
-        Sphere::surface(self, ray, hit.t)
-    }
-}
-
-impl Intersect for Cone {
-    fn bounds(&self) -> Aabb {
-        Cone::bounds(self)
-    }
-    #[inline]
-    fn intersect(&self, ray: &Ray) -> Option<ShapeHit> {
-        Cone::intersect(self, ray)
-    }
-    #[inline]
-    fn occluded(&self, ray: &Ray) -> bool {
-        Cone::occluded(self, ray)
-    }
-    fn surface(&self, ray: &Ray, hit: &ShapeHit) -> SurfacePoint {
-        Cone::surface(self, ray, hit.t)
-    }
-}
-
-impl Solid for Sphere {
-    fn spans(&self, ray: &Ray, out: &mut Spans) {
-        if let Some((t0, t1)) = self.roots(ray) {
-            if t0 <= t1 {
-                out.push(Span {
-                    t_in: t0,
-                    n_in: ray.at(t0) - self.center,
-                    t_out: t1,
-                    n_out: ray.at(t1) - self.center,
-                });
-            }
-        }
-    }
-
-    fn contains(&self, p: Vec3) -> bool {
-        (p - self.center).length_squared() <= self.radius * self.radius
-    }
-}
-
 #[cfg(test)]
 mod tests {
     use super::diff_of_products;

@@ -1,4 +1,6 @@
-use super::{ShapeHit, SurfacePoint, diff_of_products, quadratic_roots};
+use super::{
+    Intersect, ShapeHit, Solid, Span, Spans, SurfacePoint, diff_of_products, quadratic_roots,
+};
 use crate::math::{Aabb, Ray, Vec3, gamma};
 
 /// A sphere. With `inside_only` (NFF's negative radius) only hits where the ray leaves
@@ -100,5 +102,41 @@ impl Sphere {
             -ray.dir.normalize()
         };
         SurfacePoint { p, err, ng }
+    }
+}
+
+impl Intersect for Sphere {
+    fn bounds(&self) -> Aabb {
+        Sphere::bounds(self)
+    }
+    #[inline]
+    fn intersect(&self, ray: &Ray) -> Option<ShapeHit> {
+        Sphere::intersect(self, ray)
+    }
+    #[inline]
+    fn occluded(&self, ray: &Ray) -> bool {
+        Sphere::occluded(self, ray)
+    }
+    fn surface(&self, ray: &Ray, hit: &ShapeHit) -> SurfacePoint {
+        Sphere::surface(self, ray, hit.t)
+    }
+}
+
+impl Solid for Sphere {
+    fn spans(&self, ray: &Ray, out: &mut Spans) {
+        if let Some((t0, t1)) = self.roots(ray) {
+            if t0 <= t1 {
+                out.push(Span {
+                    t_in: t0,
+                    n_in: ray.at(t0) - self.center,
+                    t_out: t1,
+                    n_out: ray.at(t1) - self.center,
+                });
+            }
+        }
+    }
+
+    fn contains(&self, p: Vec3) -> bool {
+        (p - self.center).length_squared() <= self.radius * self.radius
     }
 }
