@@ -40,17 +40,17 @@ fn scene(seed: u64) -> Scene {
         match i % 3 {
             0 => {
                 let p = [c + v(&mut f, 2.0), c + v(&mut f, 2.0), c + v(&mut f, 2.0)];
-                s.triangles.push(Triangle { p }, 0);
-                s.triangle_normals.push(u32::MAX);
+                s.geometry.triangles.push(Triangle { p }, 0);
+                s.geometry.triangle_normals.push(u32::MAX);
             }
             1 => {
                 let r = 0.1 + f();
-                s.spheres
+                s.geometry
                     .push(Sphere::new(c, if f() < 0.2 { -r } else { r }), 0);
             }
             _ => {
                 let apex = c + v(&mut f, 3.0);
-                s.cones.push(Cone::new(c, f() * 0.6, apex, f() * 0.6), 0);
+                s.geometry.push(Cone::new(c, f() * 0.6, apex, f() * 0.6), 0);
             }
         }
     }
@@ -82,7 +82,7 @@ proptest! {
             // triangle tests may decide differently.
             let edgy = |h: &emray::Hit| {
                 h.kind() == Kind::Triangle && {
-                    let t = &s.triangles.items[h.prim_id as usize];
+                    let t = &s.geometry.triangles.items[h.prim_id as usize];
                     let w = 1.0 - h.u - h.v;
                     h.u.min(h.v).min(w) < 1e-4 || t.normal().normalize().dot(ray.dir).abs() < 1e-3
                 }

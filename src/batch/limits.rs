@@ -17,7 +17,7 @@ pub fn estimate_bytes(scene: &Scene, settings: &RenderSettings) -> u64 {
         .unwrap_or(Region::full(settings.width, settings.height));
     let extra = u64::from(settings.spd);
     let samples = (r.width() as u64 + extra) * (r.height() as u64 + extra);
-    let prims = scene.prim_count() as u64
+    let prims = scene.prim_count_with_instances() as u64
         + scene
             .objects
             .iter()
@@ -92,7 +92,7 @@ pub fn check(
             scene_path.display(),
             settings.width,
             settings.height,
-            scene.prim_count(),
+            scene.prim_count_with_instances(),
             format_bytes(need),
             format_bytes(max)
         ));

@@ -191,7 +191,7 @@ pub fn run_child(spec: &RunSpec) -> Result<RunResult, String> {
         _ => accel,
     };
     Ok(RunResult {
-        prims: scene.prim_count(),
+        prims: scene.prim_count_with_instances(),
         load_ms,
         build_ms,
         ms,
@@ -575,7 +575,9 @@ mod tests {
         assert!(r.rays.reflection > 0 && r.rays.shadow > 0);
         assert_eq!(
             r.prims,
-            load_scene("spd:balls?size=1").unwrap().prim_count()
+            load_scene("spd:balls?size=1")
+                .unwrap()
+                .prim_count_with_instances()
         );
         let raw = run_child(&RunSpec {
             mode: Mode::Raw,

@@ -10,7 +10,8 @@
 //! The oriented box takes the ray into its own frame (a rotation, so `t` is unchanged)
 //! and runs the same test against `[−h, h]`.
 
-use super::{Intersect, ShapeHit, Solid, Span, Spans, SurfacePoint};
+use super::param::box_param;
+use super::{Intersect, Param, Primitive, ShapeHit, Solid, Span, Spans, SurfacePoint};
 use crate::math::{Aabb, Ray, Vec3, gamma};
 use glam::{DMat3, DQuat, Mat3, Quat};
 
@@ -443,6 +444,43 @@ impl Solid for OBox {
     fn contains(&self, p: Vec3) -> bool {
         let y = Self::to_local(&self.matrix(), p - self.center);
         y.abs().cmple(self.half).all()
+    }
+}
+
+impl Primitive for AaBox {
+    fn is_solid(&self) -> bool {
+        true
+    }
+    fn spans(&self, ray: &Ray, out: &mut Spans) {
+        Solid::spans(self, ray, out)
+    }
+    fn contains(&self, p: Vec3) -> bool {
+        Solid::contains(self, p)
+    }
+    fn param(&self, p: Vec3, ng: Vec3) -> Param {
+        let (min, max) = (self.min(), self.max());
+        box_param(
+            p,
+            ng,
+            (min + max) * 0.5,
+            (max - min) * 0.5,
+            [Vec3::X, Vec3::Y, Vec3::Z],
+        )
+    }
+}
+
+impl Primitive for OBox {
+    fn is_solid(&self) -> bool {
+        true
+    }
+    fn spans(&self, ray: &Ray, out: &mut Spans) {
+        Solid::spans(self, ray, out)
+    }
+    fn contains(&self, p: Vec3) -> bool {
+        Solid::contains(self, p)
+    }
+    fn param(&self, p: Vec3, ng: Vec3) -> Param {
+        box_param(p, ng, self.center(), self.half_extents(), self.axes())
     }
 }
 

@@ -16,10 +16,13 @@
 //! `a → 0` (a ray along a cylinder's axis, or parallel to a cone's side) degenerates to a
 //! linear or constant equation instead of dividing by zero.
 
+use super::param::{axis_frame, cylindrical};
 use super::{
-    Intersect, ShapeHit, Solid, Span, Spans, SurfacePoint, diff_of_products, quadratic_roots,
+    Intersect, Param, Primitive, ShapeHit, Solid, Span, Spans, SurfacePoint, diff_of_products,
+    quadratic_roots,
 };
 use crate::math::{Aabb, DVec3, Frame, Ray, Vec3, gamma};
+use glam::Vec2;
 use std::f32::consts::TAU;
 
 /// Which part of the surface an end of the line's stretch lies on.
@@ -626,6 +629,55 @@ impl Solid for CappedCone {
         }
         let r = self.base_radius + self.slope * s;
         (q - self.axis * s).length_squared() <= r * r
+    }
+}
+
+impl CappedCone {
+    /// The cylindrical parameterisation on the side, a disk onto `[0, 1]²` on the caps
+    /// (`ng` the unit outward normal tells them apart).
+    pub fn param(&self, p: Vec3, ng: Vec3) -> Param {
+        let axis = self.axis();
+        let h = (p - self.base()).dot(axis);
+        let on_cap = ng.dot(axis).abs() > 0.999
+            && (h.abs() < 1e-3 * self.height() || (h - self.height()).abs() < 1e-3 * self.height());
+        if !on_cap {
+            let slope = (self.top_radius() - self.base_radius()) / self.height();
+            return cylindrical(p, self.base(), axis, self.height(), slope);
+        }
+        let (e1, e2) = axis_frame(axis);
+        let top = h > 0.5 * self.height();
+        let (centre, r) = if top {
+            (self.top(), self.top_radius())
+        } else {
+            (self.base(), self.base_radius())
+        };
+        let r = r.max(f32::MIN_POSITIVE);
+        let q = p - centre;
+        // The base cap faces −axis: mirror u there so that ∂p/∂u × ∂p/∂v = −axis.
+        let su = if top { 1.0 } else { -1.0 };
+        Param {
+            uv: Vec2::new(
+                0.5 + su * q.dot(e1) / (2.0 * r),
+                0.5 + q.dot(e2) / (2.0 * r),
+            ),
+            dpdu: e1 * (su * 2.0 * r),
+            dpdv: e2 * (2.0 * r),
+        }
+    }
+}
+
+impl Primitive for CappedCone {
+    fn is_solid(&self) -> bool {
+        true
+    }
+    fn spans(&self, ray: &Ray, out: &mut Spans) {
+        Solid::spans(self, ray, out)
+    }
+    fn contains(&self, p: Vec3) -> bool {
+        Solid::contains(self, p)
+    }
+    fn param(&self, p: Vec3, ng: Vec3) -> Param {
+        CappedCone::param(self, p, ng)
     }
 }
 

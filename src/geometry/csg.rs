@@ -8,7 +8,7 @@
 //! flip travel in the hit's `u`/`v` so that [`Csg::surface`] can ask the leaf for the
 //! accurate point.
 
-use super::{Intersect, Shape, ShapeHit, Solid, Span, Spans, SurfacePoint};
+use super::{Intersect, Param, Primitive, Shape, ShapeHit, Solid, Span, Spans, SurfacePoint};
 use crate::math::{Aabb, Ray, Vec3, Xform};
 use smallvec::SmallVec;
 
@@ -423,5 +423,26 @@ impl Solid for Csg {
             }
         }
         stack.pop().unwrap_or(false)
+    }
+}
+
+impl Primitive for Csg {
+    fn is_solid(&self) -> bool {
+        true
+    }
+    fn spans(&self, ray: &Ray, out: &mut Spans) {
+        Solid::spans(self, ray, out)
+    }
+    fn contains(&self, p: Vec3) -> bool {
+        Solid::contains(self, p)
+    }
+    /// Planar (see [`super::param`]).
+    fn param(&self, p: Vec3, ng: Vec3) -> Param {
+        Param::planar(p, ng)
+    }
+    /// The material of the leaf hit, if it has its own.
+    fn material(&self, hit: &ShapeHit, own: u32) -> u32 {
+        let (leaf, _) = Csg::hit_leaf(hit);
+        self.leaf_material(leaf).unwrap_or(own)
     }
 }

@@ -5,7 +5,7 @@
 //! the surface point are rounded to f32.
 
 use super::quadric::{check_finite, gamma64, rounding_err, unit_axis};
-use super::{Intersect, ShapeHit, Solid, Span, Spans, SurfacePoint};
+use super::{Intersect, Param, Primitive, ShapeHit, Solid, Span, Spans, SurfacePoint};
 use crate::math::{Aabb, DVec3, Ray, Vec3};
 
 /// An infinite plane `n·x = d` (unit `n`); as a solid, the half-space `n·x ≤ d`, so the
@@ -155,6 +155,23 @@ impl Solid for Plane {
     }
     fn contains(&self, p: Vec3) -> bool {
         Plane::contains(self, p)
+    }
+}
+
+impl Primitive for Plane {
+    /// The half-space: unbounded, but usable to cut bounded solids.
+    fn is_solid(&self) -> bool {
+        true
+    }
+    fn spans(&self, ray: &Ray, out: &mut Spans) {
+        Solid::spans(self, ray, out)
+    }
+    fn contains(&self, p: Vec3) -> bool {
+        Solid::contains(self, p)
+    }
+    /// Planar (see [`super::param`]).
+    fn param(&self, p: Vec3, ng: Vec3) -> Param {
+        Param::planar(p, ng)
     }
 }
 

@@ -32,7 +32,7 @@
 //!
 //! Only the results (`t`, normals, points) are rounded to f32.
 
-use super::{Intersect, ShapeHit, Solid, Span, Spans, SurfacePoint};
+use super::{Intersect, Param, Primitive, ShapeHit, Solid, Span, Spans, SurfacePoint};
 use crate::math::{Aabb, DVec3, Ray, Vec3, next_float_down, next_float_up};
 use glam::DMat3;
 
@@ -982,6 +982,23 @@ impl Solid for Quadric {
     }
     fn contains(&self, p: Vec3) -> bool {
         Quadric::contains(self, p)
+    }
+}
+
+impl Primitive for Quadric {
+    /// A solid where `{F ≤ 0}` is bounded (clipped, or an ellipsoid).
+    fn is_solid(&self) -> bool {
+        self.is_bounded()
+    }
+    fn spans(&self, ray: &Ray, out: &mut Spans) {
+        Solid::spans(self, ray, out)
+    }
+    fn contains(&self, p: Vec3) -> bool {
+        Solid::contains(self, p)
+    }
+    /// Planar (see [`super::param`]).
+    fn param(&self, p: Vec3, ng: Vec3) -> Param {
+        Param::planar(p, ng)
     }
 }
 

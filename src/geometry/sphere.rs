@@ -1,7 +1,11 @@
+use super::param::{MIN_SIN, turn};
 use super::{
-    Intersect, ShapeHit, Solid, Span, Spans, SurfacePoint, diff_of_products, quadratic_roots,
+    Intersect, Param, Primitive, ShapeHit, Solid, Span, Spans, SurfacePoint, diff_of_products,
+    quadratic_roots,
 };
 use crate::math::{Aabb, Ray, Vec3, gamma};
+use glam::Vec2;
+use std::f32::consts::{PI, TAU};
 
 /// A sphere. With `inside_only` (NFF's negative radius) only hits where the ray leaves
 /// the sphere count, so the inside is visible and the outside is not.
@@ -138,5 +142,42 @@ impl Solid for Sphere {
 
     fn contains(&self, p: Vec3) -> bool {
         (p - self.center).length_squared() <= self.radius * self.radius
+    }
+}
+
+impl Sphere {
+    /// The spherical parameterisation at `p` (see [`super::param`]).
+    pub fn param(&self, p: Vec3) -> Param {
+        let q = ((p - self.center) / self.radius).clamp(Vec3::splat(-1.0), Vec3::splat(1.0));
+        let phi = q.x.atan2(q.z);
+        let u = turn(q.x, q.z);
+        let theta = q.y.clamp(-1.0, 1.0).acos();
+        let (sin_t, cos_t) = theta.sin_cos();
+        let (sin_p, cos_p) = phi.sin_cos();
+        let r = self.radius;
+        let dpdu = Vec3::new(cos_p, 0.0, -sin_p) * (TAU * r * sin_t.max(MIN_SIN));
+        // v = 1 − θ/π, so ∂p/∂v = −π ∂p/∂θ.
+        let dpdv = Vec3::new(cos_t * sin_p, -sin_t, cos_t * cos_p) * (-PI * r);
+        Param {
+            uv: Vec2::new(u, 1.0 - theta / PI),
+            dpdu,
+            dpdv,
+        }
+    }
+}
+
+impl Primitive for Sphere {
+    /// A sphere is a solid unless only its inside is visible.
+    fn is_solid(&self) -> bool {
+        !self.inside_only
+    }
+    fn spans(&self, ray: &Ray, out: &mut Spans) {
+        Solid::spans(self, ray, out)
+    }
+    fn contains(&self, p: Vec3) -> bool {
+        Solid::contains(self, p)
+    }
+    fn param(&self, p: Vec3, _ng: Vec3) -> Param {
+        Sphere::param(self, p)
     }
 }

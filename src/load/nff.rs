@@ -515,7 +515,7 @@ impl<'a> Parser<'a, '_> {
         let sphere = Sphere::new(center, r);
         self.in_range(&r_tok, range::check_bounds("the sphere", &sphere.bounds()))?;
         let m = self.material_index();
-        self.scene.spheres.push(sphere, m);
+        self.scene.geometry.push(sphere, m);
         Ok(())
     }
 
@@ -543,7 +543,7 @@ impl<'a> Parser<'a, '_> {
         let cone = Cone::new(base, rb, apex, ra);
         self.in_range(&ra_tok, range::check_bounds("the cone", &cone.bounds()))?;
         let m = self.material_index();
-        self.scene.cones.push(cone, m);
+        self.scene.geometry.push(cone, m);
         Ok(())
     }
 
@@ -601,25 +601,27 @@ impl<'a> Parser<'a, '_> {
             Ok(()) => {
                 let m = self.material_index();
                 for &[a, b, c] in &self.tris {
-                    self.scene.triangles.push(
+                    self.scene.geometry.triangles.push(
                         Triangle {
                             p: [self.pts[a], self.pts[b], self.pts[c]],
                         },
                         m,
                     );
                     let k = if with_normals {
-                        let k = self.scene.vertex_normals.len();
+                        let k = self.scene.geometry.vertex_normals.len();
                         if k >= u32::MAX as usize {
                             return Err(self.err(&n_tok, "too many smooth triangles".into()));
                         }
-                        self.scene
-                            .vertex_normals
-                            .push([self.nrm[a], self.nrm[b], self.nrm[c]]);
+                        self.scene.geometry.vertex_normals.push([
+                            self.nrm[a],
+                            self.nrm[b],
+                            self.nrm[c],
+                        ]);
                         k as u32
                     } else {
                         u32::MAX
                     };
-                    self.scene.triangle_normals.push(k);
+                    self.scene.geometry.triangle_normals.push(k);
                 }
             }
             Err(_) => {

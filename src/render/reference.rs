@@ -13,6 +13,7 @@
 
 use super::film::Film;
 use super::whitted::RayCounts;
+use crate::geometry::Kind;
 use crate::geometry::reference as r64;
 use crate::math::DRay;
 use crate::scene::{Camera, Scene};
@@ -21,10 +22,14 @@ use rayon::prelude::*;
 
 /// Why a scene cannot be rendered by the reference.
 pub fn unsupported(scene: &Scene) -> Option<String> {
-    let kinds: Vec<&str> = scene.shapes.items.iter().map(|s| s.kind().name()).collect();
-    if let Some(k) = kinds.first() {
+    let modelled = [Kind::Triangle, Kind::Sphere, Kind::Cone];
+    let other = Kind::ALL
+        .into_iter()
+        .find(|&k| !modelled.contains(&k) && scene.geometry.count(k) > 0);
+    if let Some(k) = other {
         return Some(format!(
-            "the reference renderer models spheres, cones and triangles only; the scene has {k}"
+            "the reference renderer models spheres, cones and triangles only; the scene has {}",
+            k.name()
         ));
     }
     if !scene.instances.is_empty() {
@@ -108,7 +113,7 @@ impl<'a> Reference<'a> {
                 }
             }
         }
-        for (k, s) in g.spheres.items.iter().enumerate() {
+        for (k, s) in g.spheres().items.iter().enumerate() {
             let c = d(s.center);
             let r = s.radius as f64;
             if let Some(t) = r64::sphere(ray, c, r, s.inside_only, 0.0) {
@@ -119,12 +124,12 @@ impl<'a> Reference<'a> {
                         t,
                         ng: n,
                         ns: n,
-                        material: g.spheres.material[k],
+                        material: g.spheres().material[k],
                     });
                 }
             }
         }
-        for (k, c) in g.cones.items.iter().enumerate() {
+        for (k, c) in g.cones().items.iter().enumerate() {
             let (base, apex) = (d(c.base), d(c.apex));
             let (rb, ra) = (c.base_radius as f64, c.apex_radius as f64);
             if let Some(t) = r64::cone(ray, base, rb, apex, ra, c.inside_only, 0.0) {
@@ -140,7 +145,7 @@ impl<'a> Reference<'a> {
                         t,
                         ng: n,
                         ns: n,
-                        material: g.cones.material[k],
+                        material: g.cones().material[k],
                     });
                 }
             }

@@ -8,9 +8,9 @@ mod build;
 mod wide;
 
 use crate::accel::{Accel, AccelStats, Hit, NO_INSTANCE};
-use crate::geometry::{Intersect, Kind, Shape, Triangle, WatertightRay};
+use crate::geometry::{Analytic, Intersect, Kind, Shape, Triangle, WatertightRay};
 use crate::math::{Aabb, Ray, Xform};
-use crate::scene::{Geometry, Scene};
+use crate::scene::{Geometry, KindVisitor, Prims, Scene};
 use std::sync::Arc;
 use wide::{Node4, Visit};
 
@@ -44,6 +44,23 @@ impl Prim {
             Prim::Triangle(t) => t.bounds(),
             Prim::Shape(s) => s.bounds(),
             Prim::Instance(i) => instances[*i as usize].bounds,
+        }
+    }
+}
+
+/// Appends every analytic primitive of the lists it visits to `prims`, with its
+/// `(geom_id, prim_id)` in `ids`.
+struct Gather<'a> {
+    prims: &'a mut Vec<Prim>,
+    ids: &'a mut Vec<(u32, u32)>,
+}
+
+impl KindVisitor for Gather<'_> {
+    type Output = ();
+    fn visit<P: Analytic>(&mut self, list: &Prims<P>) {
+        for (i, prim, _) in list.iter() {
+            self.prims.push(Prim::Shape(prim.clone().into()));
+            self.ids.push((P::KIND as u32, i));
         }
     }
 }
@@ -111,10 +128,10 @@ impl Bvh {
             prims.push(Prim::Triangle(*t));
             ids.push((Kind::Triangle as u32, i as u32));
         }
-        for (kind, i, shape) in geometry.analytic() {
-            prims.push(Prim::Shape(shape));
-            ids.push((kind as u32, i));
-        }
+        geometry.visit_all(&mut Gather {
+            prims: &mut prims,
+            ids: &mut ids,
+        });
         for i in 0..instances.len() {
             prims.push(Prim::Instance(i as u32));
             ids.push((u32::MAX, i as u32));
@@ -375,16 +392,16 @@ mod agreement {
             let c = v(seed, 10.0);
             match (rng(seed) * 3.0) as u32 {
                 0 => {
-                    s.triangles.push(
+                    s.geometry.triangles.push(
                         Triangle {
                             p: [c + v(seed, 1.0), c + v(seed, 1.0), c + v(seed, 1.0)],
                         },
                         0,
                     );
-                    s.triangle_normals.push(u32::MAX);
+                    s.geometry.triangle_normals.push(u32::MAX);
                 }
-                1 => s.spheres.push(Sphere::new(c, 0.05 + rng(seed) * 0.5), 0),
-                _ => s.cones.push(
+                1 => s.geometry.push(Sphere::new(c, 0.05 + rng(seed) * 0.5), 0),
+                _ => s.geometry.push(
                     Cone::new(c, rng(seed) * 0.5, c + v(seed, 2.0), rng(seed) * 0.5),
                     0,
                 ),
@@ -396,15 +413,15 @@ mod agreement {
     fn brute(scene: &Scene, ray: &Ray) -> Option<(f32, u32, u32)> {
         let mut best: Option<(f32, u32, u32)> = None;
         let mut r = *ray;
-        for (i, t) in scene.triangles.items.iter().enumerate() {
+        for (i, t) in scene.geometry.triangles.items.iter().enumerate() {
             if let Some(h) = t.intersect(&r) {
                 r.tmax = h.t;
                 best = Some((h.t, 0, i as u32));
             }
         }
         for kind in [Kind::Sphere, Kind::Cone] {
-            for i in 0..scene.count(kind) {
-                if let Some(h) = scene.shape(kind, i as u32).unwrap().intersect(&r) {
+            for i in 0..scene.geometry.count(kind) {
+                if let Some(h) = scene.geometry.shape(kind, i as u32).unwrap().intersect(&r) {
                     r.tmax = h.t;
                     best = Some((h.t, kind as u32, i as u32));
                 }
@@ -498,7 +515,7 @@ mod agreement {
         // 10 000 identical spheres: no split separates them; median splits must.
         let mut s = random_scene(0, &mut 1);
         for _ in 0..10_000 {
-            s.spheres.push(Sphere::new(Vec3::ZERO, 1.0), 0);
+            s.geometry.push(Sphere::new(Vec3::ZERO, 1.0), 0);
         }
         let bvh = Bvh::build(&s);
         let h = bvh

@@ -85,7 +85,7 @@ impl EmbreeAccel {
             bytes: device.allocated_bytes(),
             scene: committed,
             device,
-            prims: scene.prim_count(),
+            prims: scene.prim_count_with_instances(),
             detail,
             packet_width: crate::accel::DEFAULT_PACKET_WIDTH,
         })

@@ -6,9 +6,9 @@ use super::error::EmbreeError;
 use super::sys;
 use super::user::{self, UserPrims, UserShape};
 use crate::accel::{Hit, NO_INSTANCE, add_kind};
-use crate::geometry::{Cone, Intersect, Kind, Shape, Sphere, Triangle};
+use crate::geometry::{Analytic, Intersect, Kind, Shape, Triangle};
 use crate::math::{Ray, Vec3, Xform};
-use crate::scene::Geometry as SceneGeometry;
+use crate::scene::{Geometry as SceneGeometry, KindVisitor, Prims};
 
 /// An owned geometry handle during the build; released once attached (the scene keeps
 /// its own reference).
@@ -81,15 +81,12 @@ impl Drop for Level {
     }
 }
 
-/// The user data of the analytic geometries (boxed: Embree holds their addresses).
-/// Never read from Rust, only kept alive for the callbacks.
+/// The user data of the analytic geometries, one `UserPrims<P>` per kind attached
+/// (boxed: Embree holds their addresses). Never read from Rust, only kept alive for the
+/// callbacks.
 #[derive(Debug, Default)]
 struct UserData {
-    _spheres: Option<Box<UserPrims<Sphere>>>,
-    _cones: Option<Box<UserPrims<Cone>>>,
-    // Boxed: Embree holds each one's address, which a growing Vec would move.
-    #[allow(clippy::vec_box)]
-    _shapes: Vec<Box<UserPrims<Shape>>>,
+    _kinds: Vec<Box<dyn std::any::Any + Send + Sync>>,
 }
 
 /// A primitive Embree cannot hold (infinite bounds), intersected in Rust before each
@@ -167,43 +164,18 @@ impl Level {
             attach_triangles(device, self, &geometry.triangles.items)?;
             add_kind(kinds, Kind::Triangle, geometry.triangles.len());
         }
-        add_kind(kinds, Kind::Sphere, geometry.spheres.len());
-        add_kind(kinds, Kind::Cone, geometry.cones.len());
-        let all = |n: usize| (0..n as u32).collect::<Vec<u32>>();
-        self.user._spheres = attach_user(
+        let mut attach = AttachUser {
             device,
-            self,
-            Kind::Sphere,
-            &geometry.spheres.items,
-            all(geometry.spheres.len()),
-        )?;
-        self.user._cones = attach_user(
-            device,
-            self,
-            Kind::Cone,
-            &geometry.cones.items,
-            all(geometry.cones.len()),
-        )?;
-        let mut unbounded = Vec::new();
-        for kind in Kind::ALL.into_iter().filter(|k| *k > Kind::Cone) {
-            let mut items = Vec::new();
-            let mut ids = Vec::new();
-            for (i, shape) in (0u32..).zip(&geometry.shapes.items) {
-                if shape.kind() != kind {
-                    continue;
-                }
-                add_kind(kinds, kind, 1);
-                if shape.bounds().is_finite() {
-                    items.push(shape.clone());
-                    ids.push(i);
-                } else {
-                    unbounded.push((kind, i, shape.clone()));
-                }
-            }
-            if let Some(data) = attach_user(device, self, kind, &items, ids)? {
-                self.user._shapes.push(data);
-            }
-        }
+            level: self,
+            kinds,
+            unbounded: Vec::new(),
+            user: Vec::new(),
+        };
+        geometry.try_visit_all(&mut attach)?;
+        let AttachUser {
+            unbounded, user, ..
+        } = attach;
+        self.user._kinds = user;
         Ok(unbounded)
     }
 
@@ -217,6 +189,38 @@ impl Level {
         // scene.
         unsafe { sys::rtcCommitScene(self.raw) };
         device.check("rtcCommitScene")
+    }
+}
+
+/// Attaches one user geometry per kind visited (the bounded primitives of the list),
+/// keeping its user data in `user` and listing the unbounded primitives in `unbounded`.
+struct AttachUser<'a> {
+    device: &'a Device,
+    level: &'a Level,
+    kinds: &'a mut Vec<(Kind, usize)>,
+    unbounded: Vec<(Kind, u32, Shape)>,
+    user: Vec<Box<dyn std::any::Any + Send + Sync>>,
+}
+
+impl KindVisitor for AttachUser<'_> {
+    type Output = Result<(), EmbreeError>;
+
+    fn visit<P: Analytic>(&mut self, list: &Prims<P>) -> Result<(), EmbreeError> {
+        add_kind(self.kinds, P::KIND, list.len());
+        let mut items = Vec::new();
+        let mut ids = Vec::new();
+        for (i, prim, _) in list.iter() {
+            if prim.bounds().is_finite() {
+                items.push(prim.clone());
+                ids.push(i);
+            } else {
+                self.unbounded.push((P::KIND, i, prim.clone().into()));
+            }
+        }
+        if let Some(data) = attach_user(self.device, self.level, P::KIND, items, ids)? {
+            self.user.push(data);
+        }
+        Ok(())
     }
 }
 
@@ -736,7 +740,7 @@ fn attach_user<T: UserShape>(
     device: &Device,
     scene: &Level,
     kind: Kind,
-    prims: &[T],
+    prims: Vec<T>,
     ids: Vec<u32>,
 ) -> Result<Option<Box<UserPrims<T>>>, EmbreeError> {
     if prims.is_empty() {
@@ -752,7 +756,7 @@ fn attach_user<T: UserShape>(
         )
     })?;
     let data = Box::new(UserPrims {
-        items: prims.to_vec().into_boxed_slice(),
+        items: prims.into_boxed_slice(),
         ids: ids.into_boxed_slice(),
     });
     let geometry = Geometry::new(

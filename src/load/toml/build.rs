@@ -23,8 +23,8 @@ use super::{MAX_SIDE, SceneSettings, Source, suggest};
 use crate::geometry::bezier::{BezierPatch, teapot_patches, tessellate};
 use crate::geometry::polygon::Triangulator;
 use crate::geometry::{
-    AaBox, CappedCone, Cone, Csg, CsgOp, CsgTree, OBox, Plane, Polyhedron, QuadUv, Quadric, Shape,
-    Sphere, Torus, Triangle,
+    AaBox, CappedCone, Cone, Csg, CsgOp, CsgTree, OBox, Plane, Polyhedron, Primitive, QuadUv,
+    Quadric, Shape, Sphere, Torus, Triangle,
 };
 use crate::load::{LoadError, nff, obj};
 use crate::math::{Aabb, Vec3, Xform};
@@ -2225,17 +2225,9 @@ impl<'a, 's> Builder<'a, 's> {
             }
         }
         let span = o.ty.span();
-        for (i, sphere) in s.spheres.items.iter().enumerate() {
-            let m = mat(s.spheres.material[i]);
-            self.place_shape(Shape::Sphere(*sphere), &x, m, span.clone(), sink)?;
-        }
-        for (i, cone) in s.cones.items.iter().enumerate() {
-            let m = mat(s.cones.material[i]);
-            self.place_shape(Shape::Cone(*cone), &x, m, span.clone(), sink)?;
-        }
-        for (i, shape) in s.shapes.items.iter().enumerate() {
-            let m = mat(s.shapes.material[i]);
-            self.place_shape(shape.clone(), &x, m, span.clone(), sink)?;
+        for entry in s.shapes() {
+            let m = mat(entry.material);
+            self.place_shape(entry.shape, &x, m, span.clone(), sink)?;
         }
         Ok(())
     }
