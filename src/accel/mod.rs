@@ -5,6 +5,7 @@
 pub mod bvh;
 #[cfg(feature = "embree")]
 pub mod embree;
+pub mod unbounded;
 
 use crate::geometry::Kind;
 use crate::math::Ray;

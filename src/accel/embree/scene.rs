@@ -1,12 +1,13 @@
-//! Scene building (triangles natively, spheres and cones as user geometry) and the
+//! Scene building (triangles natively, one user geometry per analytic kind) and the
 //! committed, immutable scene the ray queries run on.
 
 use super::device::Device;
 use super::error::EmbreeError;
 use super::sys;
 use super::user::{self, UserPrims, UserShape};
+use crate::accel::unbounded::{Unbounded, is_unbounded};
 use crate::accel::{Hit, NO_INSTANCE, add_kind};
-use crate::geometry::{Analytic, Intersect, Kind, Shape, Triangle};
+use crate::geometry::{Analytic, Kind, Triangle};
 use crate::math::{Ray, Vec3, Xform};
 use crate::scene::{Geometry as SceneGeometry, KindVisitor, Prims};
 
@@ -89,17 +90,6 @@ struct UserData {
     _kinds: Vec<Box<dyn std::any::Any + Send + Sync>>,
 }
 
-/// A primitive Embree cannot hold (infinite bounds), intersected in Rust before each
-/// query: a plane, an unbounded quadric, possibly inside an instance.
-#[derive(Debug)]
-struct Unbounded {
-    shape: Shape,
-    kind: Kind,
-    prim: u32,
-    /// `(instance index, its transform)` for instanced ones.
-    inst: Option<(u32, Xform)>,
-}
-
 /// A committed Embree scene: the top level (with one instance geometry per instance),
 /// the objects' scenes, and the unbounded primitives. Immutable after
 /// [`CommittedScene::build`]; queried from any number of threads.
@@ -109,7 +99,8 @@ pub(super) struct CommittedScene {
     // geometries let go of the objects' scenes before those are released.
     top: Level,
     _objects: Vec<Level>,
-    unbounded: Vec<Unbounded>,
+    /// What Embree cannot hold (infinite bounds), intersected in Rust before each query.
+    unbounded: Unbounded,
     /// The kinds attached, with counts (see [`crate::accel::AccelStats::kinds`]).
     pub(super) kinds: Vec<(Kind, usize)>,
 }
@@ -152,14 +143,14 @@ impl Level {
     }
 
     /// Attach every bounded primitive of `geometry`, one geometry per kind present,
-    /// adding what it attaches to `kinds`; returns the unbounded ones (also counted) as
-    /// `(kind, prim_id, shape)`.
+    /// adding to `kinds` the count of each kind (the unbounded ones included: the
+    /// [`Unbounded`] list holds them).
     fn attach_geometry(
         &mut self,
         device: &Device,
         geometry: &SceneGeometry,
         kinds: &mut Vec<(Kind, usize)>,
-    ) -> Result<Vec<(Kind, u32, Shape)>, EmbreeError> {
+    ) -> Result<(), EmbreeError> {
         if !geometry.triangles.is_empty() {
             attach_triangles(device, self, &geometry.triangles.items)?;
             add_kind(kinds, Kind::Triangle, geometry.triangles.len());
@@ -168,15 +159,11 @@ impl Level {
             device,
             level: self,
             kinds,
-            unbounded: Vec::new(),
             user: Vec::new(),
         };
         geometry.try_visit_all(&mut attach)?;
-        let AttachUser {
-            unbounded, user, ..
-        } = attach;
-        self.user._kinds = user;
-        Ok(unbounded)
+        self.user._kinds = attach.user;
+        Ok(())
     }
 
     /// Commit after every geometry is attached, building at `quality`.
@@ -193,12 +180,11 @@ impl Level {
 }
 
 /// Attaches one user geometry per kind visited (the bounded primitives of the list),
-/// keeping its user data in `user` and listing the unbounded primitives in `unbounded`.
+/// keeping its user data in `user`.
 struct AttachUser<'a> {
     device: &'a Device,
     level: &'a Level,
     kinds: &'a mut Vec<(Kind, usize)>,
-    unbounded: Vec<(Kind, u32, Shape)>,
     user: Vec<Box<dyn std::any::Any + Send + Sync>>,
 }
 
@@ -210,11 +196,9 @@ impl KindVisitor for AttachUser<'_> {
         let mut items = Vec::new();
         let mut ids = Vec::new();
         for (i, prim, _) in list.iter() {
-            if prim.bounds().is_finite() {
+            if !is_unbounded(&prim.bounds()) {
                 items.push(prim.clone());
                 ids.push(i);
-            } else {
-                self.unbounded.push((P::KIND, i, prim.clone().into()));
             }
         }
         if let Some(data) = attach_user(self.device, self.level, P::KIND, items, ids)? {
@@ -241,34 +225,16 @@ impl CommittedScene {
         };
         let mut kinds = Vec::new();
         let mut objects = Vec::with_capacity(scene.objects.len());
-        let mut object_unbounded = Vec::with_capacity(scene.objects.len());
         for object in &scene.objects {
             let mut level = Level::new(device, robust)?;
-            object_unbounded.push(level.attach_geometry(device, object, &mut kinds)?);
+            level.attach_geometry(device, object, &mut kinds)?;
             level.commit(device, quality)?;
             objects.push(level);
         }
         let mut top = Level::new(device, robust)?;
-        let mut unbounded: Vec<Unbounded> = top
-            .attach_geometry(device, &scene.geometry, &mut kinds)?
-            .into_iter()
-            .map(|(kind, prim, shape)| Unbounded {
-                shape,
-                kind,
-                prim,
-                inst: None,
-            })
-            .collect();
+        top.attach_geometry(device, &scene.geometry, &mut kinds)?;
         for (i, inst) in (0u32..).zip(&scene.instances) {
             let object = inst.object as usize;
-            for (kind, prim, shape) in &object_unbounded[object] {
-                unbounded.push(Unbounded {
-                    shape: shape.clone(),
-                    kind: *kind,
-                    prim: *prim,
-                    inst: Some((i, inst.xform)),
-                });
-            }
             let id = INSTANCE_BASE.checked_add(i).ok_or_else(|| {
                 EmbreeError::emray("building the instances", "too many instances")
             })?;
@@ -278,41 +244,8 @@ impl CommittedScene {
         Ok(CommittedScene {
             top,
             _objects: objects,
-            unbounded,
+            unbounded: Unbounded::new(scene),
             kinds,
-        })
-    }
-
-    /// The nearest unbounded primitive hit in `(ray.tmin, ray.tmax)`.
-    #[inline]
-    fn nearest_unbounded(&self, ray: &Ray) -> Option<Hit> {
-        let mut best: Option<Hit> = None;
-        let mut r = *ray;
-        for u in &self.unbounded {
-            let h = match &u.inst {
-                None => u.shape.intersect(&r),
-                Some((_, x)) => u.shape.intersect(&x.ray_to_object(&r)),
-            };
-            if let Some(h) = h {
-                r.tmax = h.t;
-                best = Some(Hit {
-                    t: h.t,
-                    geom_id: u.kind as u32,
-                    prim_id: u.prim,
-                    u: h.u,
-                    v: h.v,
-                    ng: h.ng,
-                    inst_id: u.inst.map_or(NO_INSTANCE, |(i, _)| i),
-                });
-            }
-        }
-        best
-    }
-
-    fn any_unbounded(&self, ray: &Ray) -> bool {
-        self.unbounded.iter().any(|u| match &u.inst {
-            None => u.shape.occluded(ray),
-            Some((_, x)) => u.shape.occluded(&x.ray_to_object(ray)),
         })
     }
 
@@ -326,8 +259,10 @@ impl CommittedScene {
         if self.unbounded.is_empty() {
             return self.intersect_embree(ray);
         }
+        // The unbounded primitives first, from `tnear` as Embree would, then Embree up
+        // to the nearest of them.
         let tnear = ray.tmin.max(0.0);
-        let near = self.nearest_unbounded(&Ray {
+        let near = self.unbounded.nearest(&Ray {
             tmin: tnear,
             ..*ray
         });
@@ -347,7 +282,7 @@ impl CommittedScene {
         }
         if !self.unbounded.is_empty() {
             let tnear = ray.tmin.max(0.0);
-            if self.any_unbounded(&Ray {
+            if self.unbounded.any(&Ray {
                 tmin: tnear,
                 ..*ray
             }) {

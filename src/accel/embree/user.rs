@@ -1,6 +1,6 @@
 //! User geometry: one Embree geometry per analytic shape kind, holding all primitives of
 //! that kind. Its callbacks call the same `geometry::` intersectors as the pure-Rust BVH,
-//! so both backends give the same hits for spheres and cones, bit for bit.
+//! so both backends give the same hits for every analytic kind, bit for bit.
 //!
 //! The callbacks are panic-free by construction (a panic across `extern "C"` aborts):
 //! no indexing that can fail (`get`), no allocation, no locks, only float arithmetic in
