@@ -4,7 +4,7 @@
 use super::device::Device;
 use super::error::EmbreeError;
 use super::sys;
-use super::user::{self, UserPrims, UserShape};
+use super::user::{self, UserGeometry, UserPrims, rethrow_caught};
 use crate::accel::unbounded::{Unbounded, is_unbounded};
 use crate::accel::{Hit, NO_INSTANCE, add_kind};
 use crate::geometry::{Analytic, Kind, Triangle};
@@ -83,11 +83,11 @@ impl Drop for Level {
 }
 
 /// The user data of the analytic geometries, one `UserPrims<P>` per kind attached
-/// (boxed: Embree holds their addresses). Never read from Rust, only kept alive for the
-/// callbacks.
+/// (boxed: Embree holds their addresses). Kept alive for the callbacks; read from Rust
+/// only for a panic caught in a bounds callback.
 #[derive(Debug, Default)]
 struct UserData {
-    _kinds: Vec<Box<dyn std::any::Any + Send + Sync>>,
+    kinds: Vec<Box<dyn UserGeometry>>,
 }
 
 /// A committed Embree scene: the top level (with one instance geometry per instance),
@@ -162,7 +162,7 @@ impl Level {
             user: Vec::new(),
         };
         geometry.try_visit_all(&mut attach)?;
-        self.user._kinds = attach.user;
+        self.user.kinds = attach.user;
         Ok(())
     }
 
@@ -175,6 +175,9 @@ impl Level {
         // is boxed in `self.user` (or an object level's), which lives as long as the
         // scene.
         unsafe { sys::rtcCommitScene(self.raw) };
+        if let Some(message) = self.user.kinds.iter().find_map(|u| u.bounds_panic()) {
+            panic!("{message}");
+        }
         device.check("rtcCommitScene")
     }
 }
@@ -185,7 +188,7 @@ struct AttachUser<'a> {
     device: &'a Device,
     level: &'a Level,
     kinds: &'a mut Vec<(Kind, usize)>,
-    user: Vec<Box<dyn std::any::Any + Send + Sync>>,
+    user: Vec<Box<dyn UserGeometry>>,
 }
 
 impl KindVisitor for AttachUser<'_> {
@@ -302,6 +305,7 @@ impl CommittedScene {
             hit: empty_hit(),
         };
         query::intersect(self.top.raw, &mut rayhit);
+        rethrow_caught();
         let hit = &rayhit.hit;
         if hit.geomID == sys::INVALID_GEOMETRY_ID {
             return None;
@@ -327,6 +331,7 @@ impl CommittedScene {
         };
         let mut r = rtc_ray(ray, tnear);
         query::occluded(self.top.raw, &mut r);
+        rethrow_caught();
         r.tfar == f32::NEG_INFINITY
     }
 }
@@ -394,6 +399,7 @@ macro_rules! packet_query {
                 }
             }
             query::$query(&valid, scene, &mut p);
+            rethrow_caught();
             for (i, out) in hits.iter_mut().enumerate().take($n) {
                 let h = &p.hit;
                 *out = (valid[i] != 0 && h.geomID[i] != sys::INVALID_GEOMETRY_ID).then(|| Hit {
@@ -671,7 +677,7 @@ fn attach_triangles(device: &Device, scene: &Level, tris: &[Triangle]) -> Result
 
 /// One user geometry holding all `prims` of `kind` (none when there are none). Returns
 /// the boxed user data Embree's callbacks read, which must outlive `scene`'s handle.
-fn attach_user<T: UserShape>(
+fn attach_user<T: Analytic>(
     device: &Device,
     scene: &Level,
     kind: Kind,
@@ -690,10 +696,10 @@ fn attach_user<T: UserShape>(
             ),
         )
     })?;
-    let data = Box::new(UserPrims {
-        items: prims.into_boxed_slice(),
-        ids: ids.into_boxed_slice(),
-    });
+    let data = Box::new(UserPrims::new(
+        prims.into_boxed_slice(),
+        ids.into_boxed_slice(),
+    ));
     let geometry = Geometry::new(
         device,
         sys::RTCGeometryType::RTC_GEOMETRY_TYPE_USER,

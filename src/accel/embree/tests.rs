@@ -638,3 +638,59 @@ fn packet_width_does_not_change_a_render_of_spheres() {
         );
     }
 }
+
+/// The text of a caught panic.
+fn panic_text(payload: Box<dyn std::any::Any + Send>) -> String {
+    match payload.downcast::<String>() {
+        Ok(s) => *s,
+        Err(payload) => payload
+            .downcast_ref::<&str>()
+            .map_or_else(|| "(no message)".into(), |s| s.to_string()),
+    }
+}
+
+#[test]
+fn a_panic_in_a_callback_comes_back_after_the_query_instead_of_aborting() {
+    use super::user::{Callback, inject};
+    use std::panic::{AssertUnwindSafe, catch_unwind};
+    let mut s = scene();
+    s.geometry
+        .push(Sphere::new(Vec3::new(0.0, 0.0, 5.0), 1.0), 0);
+    let accel = build(&s).with_packet_width(8);
+    let r = ray(Vec3::ZERO, Vec3::Z);
+    let rays = vec![r; 8];
+    let mut hits = vec![None; 8];
+    let cases: [(Callback, &str, &dyn Fn()); 3] = [
+        (Callback::Intersect, "intersect", &|| {
+            accel.intersect(&r);
+        }),
+        (Callback::Occluded, "occluded", &|| {
+            accel.occluded(&r);
+        }),
+        (Callback::Intersect, "intersect", &|| {
+            accel.intersect_coherent(&rays, &mut vec![None; 8]);
+        }),
+    ];
+    for (callback, name, query) in cases {
+        inject::panic_next(callback);
+        let caught = catch_unwind(AssertUnwindSafe(query)).expect_err("the query panics");
+        assert_eq!(
+            panic_text(caught),
+            format!("the Embree {name} callback of the spheres panicked: injected panic")
+        );
+        // Nothing is left over: the next queries on this thread are as usual.
+        assert_eq!(accel.intersect(&r).map(|h| h.t), Some(4.0));
+        assert!(accel.occluded(&r));
+        accel.intersect_coherent(&rays, &mut hits);
+        assert!(hits.iter().all(|h| h.is_some_and(|h| h.t == 4.0)));
+    }
+    // The bounds callback runs on Embree's build threads: its panic comes back from
+    // the build.
+    inject::panic_next(Callback::Bounds);
+    let caught = catch_unwind(|| EmbreeAccel::build(&s)).expect_err("the build panics");
+    assert_eq!(
+        panic_text(caught),
+        "the Embree bounds callback of the spheres panicked: injected panic"
+    );
+    assert!(build(&s).intersect(&r).is_some());
+}
