@@ -346,7 +346,12 @@ fn subtracted_surfaces_face_out_of_the_result() {
         Vec3::Y,
         1.0,
     )));
-    assert!(Csg::new(&open).unwrap_err().contains("not a closed solid"));
+    assert!(
+        Csg::new(&open)
+            .unwrap_err()
+            .to_string()
+            .contains("not a closed solid")
+    );
 }
 
 #[test]

@@ -18,8 +18,8 @@
 
 use super::param::{axis_frame, cylindrical};
 use super::{
-    Intersect, Param, Primitive, ShapeHit, Solid, Span, Spans, SurfacePoint, diff_of_products,
-    quadratic_roots,
+    Intersect, Param, Primitive, ShapeError, ShapeHit, Solid, Span, Spans, SurfacePoint,
+    diff_of_products, quadratic_roots,
 };
 use crate::math::{Aabb, DVec3, Frame, Ray, Vec3, gamma};
 use glam::Vec2;
@@ -107,41 +107,61 @@ impl CappedCone {
         height: f32,
         base_radius: f32,
         top_radius: f32,
-    ) -> Result<Self, String> {
+    ) -> Result<Self, ShapeError> {
+        Self::build(
+            "capped cone",
+            base_center,
+            axis_dir,
+            height,
+            base_radius,
+            top_radius,
+        )
+    }
+
+    /// [`CappedCone::new`], with `shape` naming the shape in errors.
+    fn build(
+        shape: &'static str,
+        base_center: Vec3,
+        axis_dir: Vec3,
+        height: f32,
+        base_radius: f32,
+        top_radius: f32,
+    ) -> Result<Self, ShapeError> {
         if !base_center.is_finite() {
-            return Err(format!(
-                "capped cone: base centre {base_center} is not finite"
+            return Err(ShapeError::parameter_not_finite(
+                shape,
+                "base centre",
+                base_center,
             ));
         }
         if !axis_dir.is_finite() {
-            return Err(format!("capped cone: axis {axis_dir} is not finite"));
+            return Err(ShapeError::parameter_not_finite(shape, "axis", axis_dir));
         }
         let a = axis_dir.as_dvec3();
         let len = a.length();
         if !(len.is_finite() && len > 0.0) {
-            return Err("capped cone: the axis direction is zero".to_string());
+            return Err(ShapeError::ZeroAxis { shape });
         }
         let axis = (a / len).as_vec3();
         if !(height > 0.0 && height.is_finite()) {
-            return Err(format!(
-                "capped cone: height {height} must be positive and finite"
-            ));
+            return Err(ShapeError::parameter_not_positive(shape, "height", height));
         }
-        for (name, r) in [("base", base_radius), ("top", top_radius)] {
-            if !(r >= 0.0 && r.is_finite()) {
-                return Err(format!(
-                    "capped cone: {name} radius {r} must be zero or positive and finite"
-                ));
+        for (end, radius) in [("base", base_radius), ("top", top_radius)] {
+            if !(radius >= 0.0 && radius.is_finite()) {
+                return Err(ShapeError::EndRadius { shape, end, radius });
             }
         }
         if base_radius == 0.0 && top_radius == 0.0 {
-            return Err("capped cone: both radii are zero (no volume)".to_string());
+            return Err(ShapeError::NoRadius { shape });
         }
         let slope = ((top_radius as f64 - base_radius as f64) / height as f64) as f32;
         if !slope.is_finite() {
-            return Err(format!(
-                "capped cone: height {height} is too small for radii {base_radius} and {top_radius}"
-            ));
+            return Err(ShapeError::TooFlat {
+                shape,
+                height,
+                base_radius,
+                top_radius,
+            });
         }
         let c = CappedCone {
             base: base_center,
@@ -152,9 +172,11 @@ impl CappedCone {
             slope,
         };
         if !c.bounds().is_finite() {
-            return Err(format!(
-                "capped cone: base {base_center}, height {height} and radii overflow"
-            ));
+            return Err(ShapeError::CappedOverflow {
+                shape,
+                base: base_center,
+                height,
+            });
         }
         Ok(c)
     }
@@ -169,14 +191,13 @@ impl CappedCone {
         axis_dir: Vec3,
         height: f32,
         radius: f32,
-    ) -> Result<Self, String> {
+    ) -> Result<Self, ShapeError> {
         if !(radius > 0.0 && radius.is_finite()) {
-            return Err(format!(
-                "cylinder: radius {radius} must be positive and finite"
+            return Err(ShapeError::parameter_not_positive(
+                "cylinder", "radius", radius,
             ));
         }
-        Self::new(base_center, axis_dir, height, radius, radius)
-            .map_err(|e| e.replacen("capped cone", "cylinder", 1))
+        Self::build("cylinder", base_center, axis_dir, height, radius, radius)
     }
 
     /// Centre of the base disk.

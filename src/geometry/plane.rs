@@ -5,7 +5,7 @@
 //! the surface point are rounded to f32.
 
 use super::quadric::{check_finite, gamma64, rounding_err, unit_axis};
-use super::{Intersect, Param, Primitive, ShapeHit, Solid, Span, Spans, SurfacePoint};
+use super::{Intersect, Param, Primitive, ShapeError, ShapeHit, Solid, Span, Spans, SurfacePoint};
 use crate::math::{Aabb, DVec3, Ray, Vec3};
 
 /// An infinite plane `n·x = d` (unit `n`); as a solid, the half-space `n·x ≤ d`, so the
@@ -23,18 +23,18 @@ pub struct Plane {
 impl Plane {
     /// The plane `normal·x = offset` (any non-zero length of `normal`; both are divided
     /// by it in f64).
-    pub fn new(normal: Vec3, offset: f32) -> Result<Self, String> {
+    pub fn new(normal: Vec3, offset: f32) -> Result<Self, ShapeError> {
         let len = normal.as_dvec3().length();
         let n = unit_axis("plane normal", normal)?;
         if !offset.is_finite() {
-            return Err(format!("plane offset is not finite ({offset})"));
+            return Err(ShapeError::PlaneOffset(offset));
         }
         Ok(Self::from_unit(n, offset as f64 / len))
     }
 
     /// The plane through `point` perpendicular to `normal` (any non-zero length),
     /// with `normal` pointing out of the half-space.
-    pub fn from_point_normal(point: Vec3, normal: Vec3) -> Result<Self, String> {
+    pub fn from_point_normal(point: Vec3, normal: Vec3) -> Result<Self, ShapeError> {
         check_finite("plane point", point)?;
         let n = unit_axis("plane normal", normal)?;
         Ok(Self::from_unit(n, n.dot(point.as_dvec3())))

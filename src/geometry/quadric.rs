@@ -32,7 +32,7 @@
 //!
 //! Only the results (`t`, normals, points) are rounded to f32.
 
-use super::{Intersect, Param, Primitive, ShapeHit, Solid, Span, Spans, SurfacePoint};
+use super::{Intersect, Param, Primitive, ShapeError, ShapeHit, Solid, Span, Spans, SurfacePoint};
 use crate::math::{Aabb, DVec3, Ray, Vec3, next_float_down, next_float_up};
 use glam::DMat3;
 
@@ -96,32 +96,38 @@ pub(super) fn rounding_err(p: Vec3, delta: f64) -> Vec3 {
 }
 
 /// Checks that a vector is finite, for constructors.
-pub(super) fn check_finite(what: &str, v: Vec3) -> Result<(), String> {
+pub(super) fn check_finite(what: &str, v: Vec3) -> Result<(), ShapeError> {
     if v.is_finite() {
         Ok(())
     } else {
-        Err(format!("{what} ({}, {}, {}) is not finite", v.x, v.y, v.z))
+        Err(ShapeError::NotFinite {
+            what: what.into(),
+            value: v,
+        })
     }
 }
 
 /// Checks that a size is finite and positive, for constructors.
-pub(super) fn check_positive(what: &str, x: f32) -> Result<(), String> {
+pub(super) fn check_positive(what: &str, x: f32) -> Result<(), ShapeError> {
     if x.is_finite() && x > 0.0 {
         Ok(())
     } else {
-        Err(format!("{what} must be finite and positive, got {x}"))
+        Err(ShapeError::NotPositive {
+            what: what.into(),
+            value: x,
+        })
     }
 }
 
 /// A unit axis from a finite non-zero vector, normalised in f64.
-pub(super) fn unit_axis(what: &str, axis: Vec3) -> Result<DVec3, String> {
+pub(super) fn unit_axis(what: &str, axis: Vec3) -> Result<DVec3, ShapeError> {
     check_finite(what, axis)?;
     let a = axis.as_dvec3();
     let len = a.length();
     if len > 0.0 {
         Ok(a / len)
     } else {
-        Err(format!("{what} must not be zero"))
+        Err(ShapeError::Zero { what: what.into() })
     }
 }
 
@@ -299,20 +305,20 @@ impl Quadric {
     /// a quadric with no real surface (`x² + y² + z² + 1`), one that fills all space or
     /// is a single point or line, an invalid clip box, or a clip box that misses an
     /// ellipsoid.
-    pub fn new(coeffs: [f64; 10], clip: Option<Aabb>) -> Result<Self, String> {
+    pub fn new(coeffs: [f64; 10], clip: Option<Aabb>) -> Result<Self, ShapeError> {
         Self::build(DVec3::ZERO, coeffs, clip, true)
     }
 
     /// A quadric whose coefficients (same order as [`Quadric::new`]) describe
     /// `F(p − origin)`: the precise way to give a small quadric far from the world
     /// origin.
-    pub fn about(origin: Vec3, coeffs: [f64; 10], clip: Option<Aabb>) -> Result<Self, String> {
+    pub fn about(origin: Vec3, coeffs: [f64; 10], clip: Option<Aabb>) -> Result<Self, ShapeError> {
         check_finite("quadric origin", origin)?;
         Self::build(origin.as_dvec3(), coeffs, clip, false)
     }
 
     /// The sphere `|p − center|² = radius²`.
-    pub fn sphere(center: Vec3, radius: f32) -> Result<Self, String> {
+    pub fn sphere(center: Vec3, radius: f32) -> Result<Self, ShapeError> {
         check_positive("sphere radius", radius)?;
         let r = radius as f64;
         Self::about(
@@ -323,7 +329,7 @@ impl Quadric {
     }
 
     /// The axis-aligned ellipsoid `Σ ((p − center)ᵢ / radiiᵢ)² = 1`.
-    pub fn ellipsoid(center: Vec3, radii: Vec3) -> Result<Self, String> {
+    pub fn ellipsoid(center: Vec3, radii: Vec3) -> Result<Self, ShapeError> {
         for (k, r) in radii.to_array().into_iter().enumerate() {
             check_positive(&format!("ellipsoid radius {}", ["x", "y", "z"][k]), r)?;
         }
@@ -337,7 +343,7 @@ impl Quadric {
     }
 
     /// The infinite cylinder of `radius` around the line through `point` along `axis`.
-    pub fn cylinder(point: Vec3, axis: Vec3, radius: f32) -> Result<Self, String> {
+    pub fn cylinder(point: Vec3, axis: Vec3, radius: f32) -> Result<Self, ShapeError> {
         check_positive("cylinder radius", radius)?;
         let w = unit_axis("cylinder axis", axis)?;
         let r = radius as f64;
@@ -346,7 +352,7 @@ impl Quadric {
 
     /// The infinite double cone with its apex at `apex`, around `axis`, whose radius
     /// grows by `slope` per unit of height (`slope = tan` of the half-angle).
-    pub fn cone(apex: Vec3, axis: Vec3, slope: f32) -> Result<Self, String> {
+    pub fn cone(apex: Vec3, axis: Vec3, slope: f32) -> Result<Self, ShapeError> {
         check_positive("cone slope", slope)?;
         let w = unit_axis("cone axis", axis)?;
         let k = slope as f64;
@@ -355,7 +361,7 @@ impl Quadric {
 
     /// The paraboloid of revolution with its vertex at `vertex`, opening along `axis`,
     /// with focal length `focal`: `|p⊥|² = 4·focal·h` (`h` the height along the axis).
-    pub fn paraboloid(vertex: Vec3, axis: Vec3, focal: f32) -> Result<Self, String> {
+    pub fn paraboloid(vertex: Vec3, axis: Vec3, focal: f32) -> Result<Self, ShapeError> {
         check_positive("paraboloid focal length", focal)?;
         let w = unit_axis("paraboloid axis", axis)?;
         Self::about(vertex, axial(w, 1.0, 0.0, -2.0 * focal as f64, 0.0), None)
@@ -369,7 +375,7 @@ impl Quadric {
         axis: Vec3,
         waist: f32,
         slope: f32,
-    ) -> Result<Self, String> {
+    ) -> Result<Self, ShapeError> {
         check_positive("hyperboloid waist radius", waist)?;
         check_positive("hyperboloid slope", slope)?;
         let w = unit_axis("hyperboloid axis", axis)?;
@@ -385,7 +391,7 @@ impl Quadric {
         axis: Vec3,
         vertex: f32,
         slope: f32,
-    ) -> Result<Self, String> {
+    ) -> Result<Self, ShapeError> {
         check_positive("hyperboloid vertex distance", vertex)?;
         check_positive("hyperboloid slope", slope)?;
         let w = unit_axis("hyperboloid axis", axis)?;
@@ -394,7 +400,7 @@ impl Quadric {
     }
 
     /// The same quadric clipped by `clip` (replacing any previous clip box).
-    pub fn with_clip(self, clip: Aabb) -> Result<Self, String> {
+    pub fn with_clip(self, clip: Aabb) -> Result<Self, ShapeError> {
         let c = self.local_coefficients();
         Self::build(self.origin, c, Some(clip), false)
     }
@@ -441,27 +447,26 @@ impl Quadric {
         coeffs: [f64; 10],
         clip: Option<Aabb>,
         recentre: bool,
-    ) -> Result<Self, String> {
+    ) -> Result<Self, ShapeError> {
         if let Some(k) = coeffs.iter().position(|c| !c.is_finite()) {
-            return Err(format!(
-                "quadric coefficient {} is not finite ({})",
-                "abcdefghij".as_bytes()[k] as char,
-                coeffs[k]
-            ));
+            return Err(ShapeError::QuadricCoefficient {
+                name: "abcdefghij".as_bytes()[k] as char,
+                value: coeffs[k],
+            });
         }
         if let Some(b) = clip {
             if !b.is_finite() {
-                return Err("quadric clip box is not finite".into());
+                return Err(ShapeError::ClipNotFinite);
             }
             if !(b.min.cmplt(b.max).all()) {
-                return Err(format!(
-                    "quadric clip box is empty or flat: min ({}, {}, {}) must be below max ({}, {}, {})",
-                    b.min.x, b.min.y, b.min.z, b.max.x, b.max.y, b.max.z
-                ));
+                return Err(ShapeError::ClipEmpty {
+                    min: b.min,
+                    max: b.max,
+                });
             }
         }
         if coeffs[..9].iter().all(|&c| c == 0.0) {
-            return Err("quadric has no second- or first-order terms: no surface".into());
+            return Err(ShapeError::QuadricNoTerms);
         }
         // Scale exactly by a power of two so the largest coefficient is in [1, 2).
         let big = coeffs.iter().fold(0.0f64, |a, c| a.max(c.abs()));
@@ -495,17 +500,17 @@ impl Quadric {
         let linear_part = residual.length() > 1e-12 * (l.length() + lam_max * centre.length());
         if !linear_part {
             if nonzero.is_empty() {
-                return Err("quadric is constant: no surface".into());
+                return Err(ShapeError::QuadricConstant);
             }
             if nonzero.iter().all(|&x| x > 0.0) && f_centre >= 0.0 {
                 return Err(if f_centre > 0.0 {
-                    "quadric has no real points (F > 0 everywhere)".into()
+                    ShapeError::QuadricNoPoints
                 } else {
-                    "quadric is degenerate: its solid is a single point, line or plane".into()
+                    ShapeError::QuadricDegenerate
                 });
             }
             if nonzero.iter().all(|&x| x < 0.0) && f_centre <= 0.0 {
-                return Err("quadric fills all space (F ≤ 0 everywhere): no surface".into());
+                return Err(ShapeError::QuadricFillsSpace);
             }
         }
 
@@ -551,7 +556,7 @@ impl Quadric {
             };
             bounded = true;
             if bounds.is_empty() {
-                return Err("quadric clip box does not meet the ellipsoid".into());
+                return Err(ShapeError::ClipMisses);
             }
         }
         let rebase = clip.map_or(DVec3::ZERO, |b| {
@@ -1027,21 +1032,33 @@ mod tests {
     #[test]
     fn rejects_bad_input() {
         let nan = [f64::NAN, 1.0, 1.0, 0.0, 0.0, 0.0, 0.0, 0.0, 0.0, -1.0];
-        assert!(Quadric::new(nan, None).unwrap_err().contains("not finite"));
+        assert!(
+            Quadric::new(nan, None)
+                .unwrap_err()
+                .to_string()
+                .contains("not finite")
+        );
         let empty = [1.0, 1.0, 1.0, 0.0, 0.0, 0.0, 0.0, 0.0, 0.0, 1.0];
         assert!(
             Quadric::new(empty, None)
                 .unwrap_err()
+                .to_string()
                 .contains("no real points")
         );
         let point = [1.0, 1.0, 1.0, 0.0, 0.0, 0.0, 0.0, 0.0, 0.0, 0.0];
         assert!(
             Quadric::new(point, None)
                 .unwrap_err()
+                .to_string()
                 .contains("degenerate")
         );
         let all = [-1.0, -1.0, -1.0, 0.0, 0.0, 0.0, 0.0, 0.0, 0.0, -1.0];
-        assert!(Quadric::new(all, None).unwrap_err().contains("all space"));
+        assert!(
+            Quadric::new(all, None)
+                .unwrap_err()
+                .to_string()
+                .contains("all space")
+        );
         let constant = [0.0, 0.0, 0.0, 0.0, 0.0, 0.0, 0.0, 0.0, 0.0, -1.0];
         assert!(Quadric::new(constant, None).is_err());
         // An imaginary cylinder x² + y² + 1 = 0.
@@ -1059,6 +1076,7 @@ mod tests {
         assert!(
             Quadric::new(cyl, Some(flat))
                 .unwrap_err()
+                .to_string()
                 .contains("clip box")
         );
         assert!(Quadric::sphere(Vec3::ZERO, 0.0).is_err());

@@ -30,7 +30,7 @@ use super::quadric::{
     aabb_out, check_finite, check_positive, gamma64, outward_or_dir, rounding_err, unit_axis,
     unit_f32,
 };
-use super::{Intersect, Param, Primitive, ShapeHit, Solid, Span, Spans, SurfacePoint};
+use super::{Intersect, Param, Primitive, ShapeError, ShapeHit, Solid, Span, Spans, SurfacePoint};
 use crate::math::{Aabb, DVec3, Ray, Vec3};
 use glam::Vec2;
 use std::f64::consts::TAU;
@@ -81,7 +81,7 @@ struct TorusLine {
 impl Torus {
     /// A torus; `axis` need not be unit (it is normalised in f64). Errors: non-finite
     /// values, a zero axis, non-positive radii.
-    pub fn new(center: Vec3, axis: Vec3, major: f32, minor: f32) -> Result<Self, String> {
+    pub fn new(center: Vec3, axis: Vec3, major: f32, minor: f32) -> Result<Self, ShapeError> {
         check_finite("torus centre", center)?;
         let w = unit_axis("torus axis", axis)?;
         check_positive("torus major radius", major)?;

@@ -487,7 +487,8 @@ fn bake(shape: &Shape, m: &DAffine3) -> Option<Shape> {
 
 /// A primitive constructor's message, prefixed with the object type unless it names
 /// the primitive already.
-fn from_constructor(ty: Ty, e: String) -> String {
+fn from_constructor(ty: Ty, e: impl std::fmt::Display) -> String {
+    let e = e.to_string();
     const NAMES: [&str; 9] = [
         "box",
         "oriented box",
@@ -1581,7 +1582,7 @@ impl<'a, 's> Builder<'a, 's> {
                     xform,
                     child: Box::new(CsgTree::leaf(shape)),
                 };
-                let csg = Csg::new(&tree).map_err(|e| self.err(span, e))?;
+                let csg = Csg::new(&tree).map_err(|e| self.err(span, e.to_string()))?;
                 g.add_shape(Shape::Csg(Arc::new(csg)), material);
                 Ok(())
             }
@@ -1683,7 +1684,7 @@ impl<'a, 's> Builder<'a, 's> {
         let rel = if instanced { DAffine3::IDENTITY } else { x };
         let op = ty.csg_op().expect("a CSG type");
         let tree = self.csg_operands(node, ty, op, rel, None, 0)?;
-        let csg = Csg::new(&tree).map_err(|e| self.err(span.clone(), e))?;
+        let csg = Csg::new(&tree).map_err(|e| self.err(span.clone(), e.to_string()))?;
         let shape = Shape::Csg(Arc::new(csg));
         if instanced {
             self.place_shape(shape, &x, material, span, sink)
