@@ -313,8 +313,12 @@ impl<'a> Parser<'a, '_> {
     }
 
     /// A range check's verdict as an error at `tok`.
-    fn in_range(&self, tok: &Tok<'a>, verdict: Result<(), String>) -> Result<(), LoadError> {
-        verdict.map_err(|message| self.err(tok, message))
+    fn in_range(
+        &self,
+        tok: &Tok<'a>,
+        verdict: Result<(), range::RangeError>,
+    ) -> Result<(), LoadError> {
+        verdict.map_err(|e| self.err(tok, e.to_string()))
     }
 
     fn keyword(&mut self, kw: &str) -> Result<Tok<'a>, LoadError> {

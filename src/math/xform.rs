@@ -5,6 +5,23 @@ use super::{Aabb, Ray, Vec3, gamma};
 use crate::geometry::SurfacePoint;
 use glam::{Affine3A, Mat3};
 
+/// Why a matrix cannot be an [`Xform`].
+#[derive(Clone, Copy, Debug, PartialEq, thiserror::Error)]
+pub enum XformError {
+    /// An entry is infinite or NaN.
+    #[error("the transform has a non-finite entry")]
+    NotFinite,
+    /// The matrix is singular or nearly so (condition number beyond 1e6).
+    #[error("the transform is singular or nearly so (determinant {determinant:e})")]
+    Singular {
+        /// The determinant of the linear part.
+        determinant: f32,
+    },
+    /// The inverse overflows f32.
+    #[error("the transform cannot be inverted in single precision")]
+    NotInvertible,
+}
+
 /// An invertible affine transform with its inverse, from object space to world space.
 ///
 /// Rays go into object space by the inverse *without* renormalising the direction, so
@@ -27,18 +44,16 @@ impl Xform {
 
     /// `m` (object to world) and its inverse; `Err` when `m` is singular, nearly so
     /// (condition number beyond 1e6) or not finite.
-    pub fn new(m: Affine3A) -> Result<Xform, String> {
+    pub fn new(m: Affine3A) -> Result<Xform, XformError> {
         let l = m.matrix3;
         let cols = [l.x_axis, l.y_axis, l.z_axis];
         if !cols.iter().all(|c| c.is_finite()) || !m.translation.is_finite() {
-            return Err("the transform has a non-finite entry".into());
+            return Err(XformError::NotFinite);
         }
         let det = Mat3::from(l).determinant();
         let scale = cols.iter().map(|c| c.length()).fold(0.0f32, f32::max);
         if det == 0.0 || !det.is_finite() || (det.abs() / scale.powi(3)) < 1e-6 {
-            return Err(format!(
-                "the transform is singular or nearly so (determinant {det:e})"
-            ));
+            return Err(XformError::Singular { determinant: det });
         }
         let inv = m.inverse();
         if !inv.matrix3.x_axis.is_finite()
@@ -46,7 +61,7 @@ impl Xform {
             || !inv.matrix3.z_axis.is_finite()
             || !inv.translation.is_finite()
         {
-            return Err("the transform cannot be inverted in single precision".into());
+            return Err(XformError::NotInvertible);
         }
         Ok(Xform {
             to_world: m,

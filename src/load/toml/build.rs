@@ -672,8 +672,10 @@ impl<'a, 's> Builder<'a, 's> {
             (None, Some(f), Some(a)) => (f.span(), a.span()),
             _ => (cam.span(), cam.span()),
         };
-        range::check_point("the camera `from`", f32v(from)).map_err(|e| self.err(from_span, e))?;
-        range::check_point("the camera `at`", f32v(at)).map_err(|e| self.err(at_span, e))?;
+        range::check_point("the camera `from`", f32v(from))
+            .map_err(|e| self.err(from_span, e.to_string()))?;
+        range::check_point("the camera `at`", f32v(at))
+            .map_err(|e| self.err(at_span, e.to_string()))?;
         Ok(Camera {
             from: f32v(from),
             at: f32v(at),
@@ -702,7 +704,7 @@ impl<'a, 's> Builder<'a, 's> {
                     .unwrap_or(Path::new(""))
                     .join(e.get_ref());
                 self.environment =
-                    Some(Environment::load(&path).map_err(|m| self.err(e.span(), m))?);
+                    Some(Environment::load(&path).map_err(|m| self.err(e.span(), m.to_string()))?);
             }
             if let Some(a) = &r.ambient {
                 ambient = self.non_negative3(a, "`ambient`")?;
@@ -775,7 +777,8 @@ impl<'a, 's> Builder<'a, 's> {
                     .parent()
                     .unwrap_or(Path::new(""))
                     .join(file.get_ref());
-                let mut img = Image::load(&path, srgb).map_err(|e| self.err(file.span(), e))?;
+                let mut img =
+                    Image::load(&path, srgb).map_err(|e| self.err(file.span(), e.to_string()))?;
                 img.wrap = match t.wrap.as_ref().map(|w| (w.get_ref().as_str(), w.span())) {
                     None | Some(("repeat", _)) => Wrap::Repeat,
                     Some(("clamp", _)) => Wrap::Clamp,
@@ -841,7 +844,7 @@ impl<'a, 's> Builder<'a, 's> {
         let t = weight(&d.transmittance, "transmittance", 0.0)?;
         if let Err(e) = range::check_ior(t, ior) {
             let at = d.ior.as_ref().map_or(def.span(), |v| v.span());
-            return Err(self.err(at, e));
+            return Err(self.err(at, e.to_string()));
         }
         Ok(Material {
             color,
@@ -900,7 +903,7 @@ impl<'a, 's> Builder<'a, 's> {
         }
         let pos = v3(l.position.get_ref());
         range::check_point("the light `position`", f32v(pos))
-            .map_err(|e| self.err(l.position.span(), e))?;
+            .map_err(|e| self.err(l.position.span(), e.to_string()))?;
         let color = match &l.color {
             Some(c) => self.non_negative3(c, "light `color`")?,
             None => Vec3::ONE,
@@ -1203,7 +1206,9 @@ impl<'a, 's> Builder<'a, 's> {
         span: Range<usize>,
     ) -> R<()> {
         let what = format!("this {}", ty.name());
-        let check = |b: &Aabb| range::check_bounds(&what, b).map_err(|e| self.err(span.clone(), e));
+        let check = |b: &Aabb| {
+            range::check_bounds(&what, b).map_err(|e| self.err(span.clone(), e.to_string()))
+        };
         for b in self.geometry.bounds_since(mark) {
             check(&b)?;
         }
