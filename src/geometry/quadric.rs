@@ -95,6 +95,73 @@ pub(super) fn rounding_err(p: Vec3, delta: f64) -> Vec3 {
     ulp + Vec3::splat(f32_up(delta))
 }
 
+/// The quadric constructors' checks of their input: finite coefficients, not all of
+/// the second- and first-order ones zero, and a finite clip box with volume.
+fn check_input(coeffs: &[f64; 10], clip: Option<Aabb>) -> Result<(), ShapeError> {
+    if let Some(k) = coeffs.iter().position(|c| !c.is_finite()) {
+        return Err(ShapeError::QuadricCoefficient {
+            name: "abcdefghij".as_bytes()[k] as char,
+            value: coeffs[k],
+        });
+    }
+    if let Some(b) = clip {
+        if !b.is_finite() {
+            return Err(ShapeError::ClipNotFinite);
+        }
+        if !(b.min.cmplt(b.max).all()) {
+            return Err(ShapeError::ClipEmpty {
+                min: b.min,
+                max: b.max,
+            });
+        }
+    }
+    if coeffs[..9].iter().all(|&c| c == 0.0) {
+        return Err(ShapeError::QuadricNoTerms);
+    }
+    Ok(())
+}
+
+/// The bounds of an ellipsoid `pᵀMp + 2lᵀp + j ≤ 0` about `origin`, given the
+/// eigen-decomposition `lam`, `vecs` of `M` (eigenvalues below `tol` count as zero):
+/// `None` unless `M` is positive definite and the solid is not empty.
+fn ellipsoid_bounds(
+    lam: &[f64; 3],
+    vecs: &[DVec3; 3],
+    l: DVec3,
+    j: f64,
+    origin: DVec3,
+    tol: f64,
+) -> Option<Aabb> {
+    let lam_max = lam.iter().fold(0.0f64, |a, x| a.max(x.abs()));
+    let lam_min = lam.iter().fold(f64::INFINITY, |a, &x| a.min(x));
+    if lam_min <= tol {
+        return None;
+    }
+    // The tangent planes x_k = const satisfy πᵀ adj(Q) π = 0 (the dual quadric), which
+    // for F = (p − c)ᵀM(p − c) + k reduces to c_k ± √(−k·(M⁻¹)_kk). The diagonal of
+    // M⁻¹ = Σᵢ vᵢvᵢᵀ/λᵢ is a sum of positive terms, so it is formed from the
+    // eigen-decomposition instead of the adjugate: no cancellation, and an axis-aligned
+    // ellipsoid gets its exact box.
+    let mut diag = DVec3::ZERO;
+    let mut c = DVec3::ZERO;
+    for i in 0..3 {
+        diag += vecs[i] * vecs[i] / lam[i];
+        c -= vecs[i] * (vecs[i].dot(l) / lam[i]);
+    }
+    let k = j + l.dot(c);
+    if !(k < 0.0 && diag.is_finite()) {
+        return None;
+    }
+    let half = diag * -k;
+    let half = DVec3::new(half.x.sqrt(), half.y.sqrt(), half.z.sqrt());
+    // The eigenvalues' relative error (Jacobi on a definite matrix) is a small multiple
+    // of ε, degrading at worst with the condition number.
+    let rel = 1e-13 + 4.0 * f64::EPSILON * (lam_max / lam_min);
+    let slack = (half + c.abs() + origin.abs()) * rel;
+    let centre_w = origin + c;
+    Some(aabb_out(centre_w - half - slack, centre_w + half + slack))
+}
+
 /// Checks that a vector is finite, for constructors.
 pub(super) fn check_finite(what: &str, v: Vec3) -> Result<(), ShapeError> {
     if v.is_finite() {
@@ -448,26 +515,7 @@ impl Quadric {
         clip: Option<Aabb>,
         recentre: bool,
     ) -> Result<Self, ShapeError> {
-        if let Some(k) = coeffs.iter().position(|c| !c.is_finite()) {
-            return Err(ShapeError::QuadricCoefficient {
-                name: "abcdefghij".as_bytes()[k] as char,
-                value: coeffs[k],
-            });
-        }
-        if let Some(b) = clip {
-            if !b.is_finite() {
-                return Err(ShapeError::ClipNotFinite);
-            }
-            if !(b.min.cmplt(b.max).all()) {
-                return Err(ShapeError::ClipEmpty {
-                    min: b.min,
-                    max: b.max,
-                });
-            }
-        }
-        if coeffs[..9].iter().all(|&c| c == 0.0) {
-            return Err(ShapeError::QuadricNoTerms);
-        }
+        check_input(&coeffs, clip)?;
         // Scale exactly by a power of two so the largest coefficient is in [1, 2).
         let big = coeffs.iter().fold(0.0f64, |a, c| a.max(c.abs()));
         let s = pow2(-(big.log2().floor() as i32));
@@ -520,35 +568,9 @@ impl Quadric {
             (origin, l, j)
         };
 
-        // Ellipsoid: M positive definite (the checks above made its solid non-empty).
-        let mut bounds = Aabb::INFINITE;
-        let mut bounded = false;
-        let lam_min = lam.iter().fold(f64::INFINITY, |a, &x| a.min(x));
-        if lam_min > tol {
-            // The tangent planes x_k = const satisfy πᵀ adj(Q) π = 0 (the dual quadric),
-            // which for F = (p − c)ᵀM(p − c) + k reduces to c_k ± √(−k·(M⁻¹)_kk). The
-            // diagonal of M⁻¹ = Σᵢ vᵢvᵢᵀ/λᵢ is a sum of positive terms, so it is formed
-            // from the eigen-decomposition instead of the adjugate: no cancellation, and
-            // an axis-aligned ellipsoid gets its exact box.
-            let mut diag = DVec3::ZERO;
-            let mut c = DVec3::ZERO;
-            for i in 0..3 {
-                diag += vecs[i] * vecs[i] / lam[i];
-                c -= vecs[i] * (vecs[i].dot(l) / lam[i]);
-            }
-            let k = j + l.dot(c);
-            if k < 0.0 && diag.is_finite() {
-                let half = diag * -k;
-                let half = DVec3::new(half.x.sqrt(), half.y.sqrt(), half.z.sqrt());
-                // The eigenvalues' relative error (Jacobi on a definite matrix) is a
-                // small multiple of ε, degrading at worst with the condition number.
-                let rel = 1e-13 + 4.0 * f64::EPSILON * (lam_max / lam_min);
-                let slack = (half + c.abs() + origin.abs()) * rel;
-                let centre_w = origin + c;
-                bounds = aabb_out(centre_w - half - slack, centre_w + half + slack);
-                bounded = true;
-            }
-        }
+        let ellipsoid = ellipsoid_bounds(&lam, &vecs, l, j, origin, tol);
+        let mut bounded = ellipsoid.is_some();
+        let mut bounds = ellipsoid.unwrap_or(Aabb::INFINITE);
         if let Some(b) = clip {
             bounds = Aabb {
                 min: bounds.min.max(b.min),

@@ -15,7 +15,7 @@ pub use store::{Geometry, GeometryMark, KindVisitor, Prims, ShapeEntry};
 
 pub use texture::{Environment, Maps, NO_TEXTURE, Texture};
 
-/// The NFF viewpoint (`v`): see DESIGN.md §3 for the exact ray construction.
+/// The NFF viewpoint (`v`); [`crate::render::RayGen`] builds the eye rays from it.
 #[derive(Clone, Copy, Debug, PartialEq)]
 pub struct Camera {
     /// Eye position.
