@@ -63,7 +63,7 @@ pub trait Primitive: Intersect {
     /// Whether `p` is inside the solid (false for open surfaces).
     fn contains(&self, p: Vec3) -> bool;
     /// The texture coordinates and tangents at `p`, a point on the primitive with unit
-    /// outward geometric normal `ng` (see [`super::param`]).
+    /// outward geometric normal `ng` (see [`Param`]).
     fn param(&self, p: Vec3, ng: Vec3) -> Param;
     /// The material of `hit`, given `own`, the primitive's material in the store: `own`
     /// unless a part of the primitive has its own (a CSG leaf).
@@ -74,7 +74,7 @@ pub trait Primitive: Intersect {
     }
 }
 
-/// One analytic kind's stored type (a row of [`for_each_kind!`]): a [`Primitive`] with
+/// One analytic kind's stored type (a row of the kinds table): a [`Primitive`] with
 /// its [`Kind`], convertible into a [`Shape`], shareable with the backends' threads.
 pub trait Analytic:
     Primitive + Clone + std::fmt::Debug + PartialEq + Into<Shape> + Send + Sync + 'static

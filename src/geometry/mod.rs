@@ -5,6 +5,10 @@
 //! construction on everything but triangles (which Embree intersects natively).
 //! Every intersector has a double-precision reference in [`reference`] used by the
 //! tests to bound the f32 error.
+//!
+//! The primitive kinds are listed once, in the table behind [`Kind`] and [`Shape`]:
+//! adding an analytic primitive means its own file (the type and its [`Intersect`],
+//! [`Primitive`] and [`Solid`] impls) plus one row in that table.
 
 pub mod bezier;
 mod boxes;

@@ -591,7 +591,7 @@ impl Primitive for Polyhedron {
     fn contains(&self, p: Vec3) -> bool {
         Solid::contains(self, p)
     }
-    /// Planar (see [`super::param`]).
+    /// The planar parameterisation about the normal ([`Param::planar`]).
     fn param(&self, p: Vec3, ng: Vec3) -> Param {
         Param::planar(p, ng)
     }

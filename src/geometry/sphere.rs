@@ -146,7 +146,7 @@ impl Solid for Sphere {
 }
 
 impl Sphere {
-    /// The spherical parameterisation at `p` (see [`super::param`]).
+    /// The spherical parameterisation at `p` (see [`Param`]).
     pub fn param(&self, p: Vec3) -> Param {
         let q = ((p - self.center) / self.radius).clamp(Vec3::splat(-1.0), Vec3::splat(1.0));
         let phi = q.x.atan2(q.z);

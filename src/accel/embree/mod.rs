@@ -5,7 +5,7 @@
 //! - `scene`: the build (triangles natively, one user geometry per analytic kind) and
 //!   the committed scene the queries run on;
 //! - `user`: the user-geometry callbacks, which call the shared `geometry::`
-//!   intersectors.
+//!   intersectors and keep their panics from unwinding into Embree.
 //!
 //! Geometry ids are the [`Kind`](crate::geometry::Kind) discriminants and primitive ids
 //! the index within the kind, exactly as the BVH reports them. Embree 3 and 4 differ in

@@ -110,7 +110,9 @@ pub(super) struct CommittedScene {
 unsafe impl Send for CommittedScene {}
 // SAFETY: after `rtcCommitScene` the scenes are never modified, and Embree documents
 // `rtcIntersect1`/`rtcOccluded1` on a committed scene as safe to call from many threads
-// at once. The user data the callbacks read is immutable, and `Shape` is `Sync`.
+// at once. The primitives the callbacks read are immutable and `Sync` (`Analytic`
+// requires it); the only state they write is the bounds callbacks' panic slot, a
+// `OnceLock`, and only during the commit.
 unsafe impl Sync for CommittedScene {}
 
 impl Level {
