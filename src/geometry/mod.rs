@@ -3,8 +3,8 @@
 //! The pure-Rust BVH calls them from its leaves; the Embree backend calls the very same
 //! functions from its user-geometry callbacks, so the two backends agree by
 //! construction on everything but triangles (which Embree intersects natively).
-//! Every intersector has a double-precision reference in [`reference`] used by the
-//! tests to bound the f32 error.
+//! Every intersector has a double-precision reference in [`reference`](mod@reference)
+//! used by the tests to bound the f32 error.
 //!
 //! The primitive kinds are listed once, in the table behind [`Kind`] and [`Shape`]:
 //! adding an analytic primitive means its own file (the type and its [`Intersect`],
@@ -36,7 +36,7 @@ pub(crate) use kinds::for_each_kind;
 pub use kinds::{Analytic, Kind, Primitive, Shape};
 pub use param::{Param, QuadUv, inverse_bilinear};
 pub use plane::Plane;
-pub use polyhedron::Polyhedron;
+pub use polyhedron::{MAX_PLANES, Polyhedron};
 pub use quadric::Quadric;
 pub use sphere::Sphere;
 pub use torus::Torus;
