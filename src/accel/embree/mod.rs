@@ -116,7 +116,7 @@ impl Accel for EmbreeAccel {
         self.scene.intersect(ray)
     }
 
-    #[inline]
+    #[inline(always)]
     fn occluded(&self, ray: &Ray) -> bool {
         self.scene.occluded(ray)
     }

@@ -280,7 +280,9 @@ impl CommittedScene {
     }
 
     /// Whether anything lies in the ray's interval (any hit).
-    #[inline]
+    // Always inlined, as it was before the panic check after the query: shadow rays are
+    // the most frequent query, and the call costs more than the check.
+    #[inline(always)]
     pub(super) fn occluded(&self, ray: &Ray) -> bool {
         if !ray.is_traceable() {
             return false;
@@ -326,7 +328,7 @@ impl CommittedScene {
         })
     }
 
-    #[inline]
+    #[inline(always)]
     fn occluded_embree(&self, ray: &Ray) -> bool {
         let Some(tnear) = embree_tnear(ray) else {
             return false;
