@@ -49,17 +49,17 @@ fn scene(kind: Kind, n: usize) -> Scene {
         let c = r.v(20.0);
         match kind {
             Kind::Triangle => {
-                s.triangles.push(
+                s.geometry.triangles.push(
                     Triangle {
                         p: [c + r.v(0.6), c + r.v(0.6), c + r.v(0.6)],
                     },
                     0,
                 );
-                s.triangle_normals.push(u32::MAX);
+                s.geometry.triangle_normals.push(u32::MAX);
             }
-            Kind::Sphere => s.spheres.push(Sphere::new(c, 0.1 + 0.2 * r.f()), 0),
+            Kind::Sphere => s.geometry.push(Sphere::new(c, 0.1 + 0.2 * r.f()), 0),
             Kind::Cone => s
-                .cones
+                .geometry
                 .push(Cone::new(c, 0.2 * r.f(), c + r.v(1.0), 0.2 * r.f()), 0),
             Kind::Csg => {
                 // A lens: the intersection of two overlapping spheres.
@@ -70,7 +70,7 @@ fn scene(kind: Kind, n: usize) -> Scene {
                     CsgTree::leaf(Shape::Sphere(Sphere::new(c - d, rad))),
                 );
                 let csg = Csg::new(&lens).expect("valid CSG");
-                s.add_shape(Shape::Csg(Arc::new(csg)), 0);
+                s.geometry.add_shape(Shape::Csg(Arc::new(csg)), 0);
             }
             other => {
                 let size = 0.1 + 0.2 * r.f();
@@ -100,7 +100,7 @@ fn scene(kind: Kind, n: usize) -> Scene {
                     // Unbounded: one plane per scene is plenty.
                     _ => Shape::Plane(Plane::new(Vec3::Y, -25.0 - 0.01 * r.f()).unwrap()),
                 };
-                s.add_shape(shape, 0);
+                s.geometry.add_shape(shape, 0);
             }
         }
     }

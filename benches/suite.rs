@@ -27,7 +27,9 @@ fn build(c: &mut Criterion) {
     g.sample_size(10);
     for name in SCENES {
         let scene = load_scene(name).expect("suite scene");
-        g.throughput(Throughput::Elements(scene.prim_count() as u64));
+        g.throughput(Throughput::Elements(
+            scene.prim_count_with_instances() as u64
+        ));
         g.bench_function(format!("bvh/{name}"), |b| {
             b.iter(|| Bvh::build(black_box(&scene)))
         });

@@ -129,7 +129,7 @@ impl Report {
             bailout: settings.bailout,
             prims: Kind::ALL
                 .iter()
-                .map(|&k| (k.name(), scene.count(k)))
+                .map(|&k| (k.name(), scene.count_with_instances(k)))
                 .collect(),
             lights: scene.lights.len(),
             transmitters: scene.materials.iter().any(|m| m.t > 0.0),
@@ -369,13 +369,13 @@ pub fn render_reference(
     };
     let accel = AccelStats {
         backend: "reference",
-        prims: scene.prim_count(),
+        prims: scene.prim_count_with_instances(),
         nodes: 0,
         bytes: 0,
         detail: format!("f64, brute force, {strata}x{strata} stratified samples"),
         kinds: Kind::ALL
             .into_iter()
-            .map(|k| (k, scene.count(k)))
+            .map(|k| (k, scene.count_with_instances(k)))
             .filter(|&(_, n)| n > 0)
             .collect(),
     };

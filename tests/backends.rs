@@ -39,18 +39,18 @@ fn scene(seed: u64) -> Scene {
                     c + v(&mut rng, 2.0),
                     c + v(&mut rng, 2.0),
                 ];
-                s.triangles.push(Triangle { p }, 0);
-                s.triangle_normals.push(u32::MAX);
+                s.geometry.triangles.push(Triangle { p }, 0);
+                s.geometry.triangle_normals.push(u32::MAX);
             }
             1 => {
                 let r = rng.range(0.1, 1.1);
                 let inside_only = rng.next_f32() < 0.2;
-                s.spheres
+                s.geometry
                     .push(Sphere::new(c, if inside_only { -r } else { r }), 0);
             }
             _ => {
                 let apex = c + v(&mut rng, 3.0);
-                s.cones.push(
+                s.geometry.push(
                     Cone::new(c, rng.range(0.0, 0.6), apex, rng.range(0.0, 0.6)),
                     0,
                 );
@@ -85,7 +85,7 @@ proptest! {
             // triangle tests may decide differently.
             let edgy = |h: &emray::Hit| {
                 h.kind() == Kind::Triangle && {
-                    let t = &s.triangles.items[h.prim_id as usize];
+                    let t = &s.geometry.triangles.items[h.prim_id as usize];
                     let w = 1.0 - h.u - h.v;
                     h.u.min(h.v).min(w) < 1e-4 || t.normal().normalize().dot(ray.dir).abs() < 1e-3
                 }

@@ -173,7 +173,7 @@ fn gen_writes_nff_that_renders() {
     assert!(o.status.success(), "{}", stderr(&o));
     let text = String::from_utf8(o.stdout).unwrap();
     let scene = emray::load::nff::parse_str(&text, Path::new("tetra")).unwrap();
-    assert_eq!(scene.triangles.len(), 16, "4^2 triangles");
+    assert_eq!(scene.geometry.triangles.len(), 16, "4^2 triangles");
     let o = emray(&["gen", "tetra", "-s", "2", "-o", "t.nff"], dir.path());
     assert!(o.status.success(), "{}", stderr(&o));
     assert_eq!(

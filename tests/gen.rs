@@ -42,7 +42,11 @@ fn databases_parse_with_the_expected_counts() {
         let s = emray::load::nff::parse_str(&text, Path::new(db.name()))
             .unwrap_or_else(|e| panic!("{}: {e}", db.name()));
         assert_eq!(
-            (s.triangles.len(), s.spheres.len(), s.cones.len()),
+            (
+                s.geometry.triangles.len(),
+                s.geometry.spheres().len(),
+                s.geometry.cones().len()
+            ),
             (tris, spheres, cones),
             "{} size {size}",
             db.name()
@@ -87,7 +91,7 @@ fn default_sizes_stay_under_ten_thousand_primitives() {
     for db in Database::ALL {
         let s =
             emray::load::nff::parse_str(&db.generate(db.default_size()), Path::new("x")).unwrap();
-        let prims = s.spheres.len() + s.cones.len() + s.load_stats.polygons;
+        let prims = s.geometry.spheres().len() + s.geometry.cones().len() + s.load_stats.polygons;
         assert!(prims < 10_000, "{}: {prims}", db.name());
     }
 }

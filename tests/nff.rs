@@ -48,7 +48,7 @@ fn viewpoint() {
     assert_eq!(c.angle_deg, 45.0);
     assert_eq!(c.hither, 1.0);
     assert_eq!((c.width, c.height), (64, 48));
-    assert_eq!(s.prim_count(), 0);
+    assert_eq!(s.prim_count_with_instances(), 0);
     assert!(s.lights.is_empty());
     assert!(s.materials.is_empty());
 }
@@ -106,7 +106,7 @@ fn lights_with_colour_keep_it() {
         "{V}l 1 2 3 s 0 0 0 1\nl 4 5 6 0.25 0.5 1\nl 7 8 9"
     ));
     assert_eq!(s.lights.len(), 3);
-    assert_eq!(s.spheres.len(), 1);
+    assert_eq!(s.geometry.spheres().len(), 1);
     let d = default_light_intensity(3);
     assert_eq!(s.lights[0].color, Vec3::splat(d));
     assert_eq!(s.lights[1].pos, Vec3::new(4.0, 5.0, 6.0));
@@ -136,8 +136,8 @@ fn materials_and_default_material() {
         (m.ka, m.kd, m.ks, m.shine, m.t, m.ior),
         (0.7, 0.7, 0.3, 20.0, 0.1, 1.5)
     );
-    assert_eq!(s.spheres.material, vec![0, 1]);
-    assert_eq!(s.cones.material, vec![1]);
+    assert_eq!(s.geometry.spheres().material, vec![0, 1]);
+    assert_eq!(s.geometry.cones().material, vec![1]);
 }
 
 #[test]
@@ -146,19 +146,19 @@ fn no_default_material_when_f_comes_first() {
         "f 1 1 1 1 0 0 0 1\n{V}f 0 1 0 1 0 0 0 1\ns 0 0 0 1\n"
     ));
     assert_eq!(s.materials.len(), 2);
-    assert_eq!(s.spheres.material, vec![1]);
+    assert_eq!(s.geometry.spheres().material, vec![1]);
 }
 
 #[test]
 fn spheres_and_inside_only() {
     let s = ok(&format!("{V}s 1 2 3 4\ns -1 -2 -3 -0.5\n"));
-    assert_eq!(s.count(Kind::Sphere), 2);
-    let a = s.spheres.items[0];
+    assert_eq!(s.count_with_instances(Kind::Sphere), 2);
+    let a = s.geometry.spheres().items[0];
     assert_eq!(
         (a.center, a.radius, a.inside_only),
         (Vec3::new(1.0, 2.0, 3.0), 4.0, false)
     );
-    let b = s.spheres.items[1];
+    let b = s.geometry.spheres().items[1];
     assert_eq!(
         (b.center, b.radius, b.inside_only),
         (Vec3::new(-1.0, -2.0, -3.0), 0.5, true)
@@ -172,9 +172,9 @@ fn cones_on_one_line_or_three() {
     let spread = ok(&format!(
         "{V}c 0\n0 # comment inside an entity\n0 1 0\n2\n0\n0.5"
     ));
-    assert_eq!(one.cones, three.cones);
-    assert_eq!(one.cones, spread.cones);
-    let c = one.cones.items[0];
+    assert_eq!(one.geometry.cones(), three.geometry.cones());
+    assert_eq!(one.geometry.cones(), spread.geometry.cones());
+    let c = one.geometry.cones().items[0];
     assert_eq!(c.base, Vec3::ZERO);
     assert_eq!(c.apex, Vec3::new(0.0, 2.0, 0.0));
     assert_eq!(
@@ -187,10 +187,10 @@ fn cones_on_one_line_or_three() {
 #[test]
 fn cone_inside_only_and_pointed() {
     let s = ok(&format!("{V}c 0 0 0 -1 0 0 3 -1\nc 0 0 0 1 0 0 1 0\n"));
-    let c = s.cones.items[0];
+    let c = s.geometry.cones().items[0];
     assert!(c.inside_only);
     assert_eq!((c.base_radius, c.apex_radius), (1.0, 1.0));
-    let p = s.cones.items[1];
+    let p = s.geometry.cones().items[1];
     assert!(!p.inside_only);
     assert_eq!(p.apex_radius, 0.0);
 }
@@ -202,7 +202,7 @@ fn comments_everywhere() {
                angle 45\n# in the middle\nhither 1\nresolution 64 48\n\
                s 0 0 0 1 # sphere\n#\n# s 9 9 9 9\n";
     let s = ok(src);
-    assert_eq!(s.spheres.len(), 1);
+    assert_eq!(s.geometry.spheres().len(), 1);
     assert_eq!(s.camera.from, Vec3::new(0.0, 0.0, -10.0));
 }
 
@@ -210,7 +210,7 @@ fn comments_everywhere() {
 fn crlf_and_tabs() {
     let src = V.replace('\n', "\r\n").replace(' ', "\t") + "s 0 0 0\r\n\t1\r\n";
     let s = ok(&src);
-    assert_eq!(s.spheres.items[0].radius, 1.0);
+    assert_eq!(s.geometry.spheres().items[0].radius, 1.0);
     // Positions stay right with CR LF endings: the error is on line 9.
     let e = parse(&(V.replace('\n', "\r\n") + "s 0 0 0\r\n  x")).unwrap_err();
     assert_eq!((e.line, e.col), (9, 3));
@@ -222,23 +222,29 @@ fn flat_polygons_keep_their_winding() {
         "{V}p 3\n0 0 0\n1 0 0\n0 1 0\np 4 0 0 1 1 0 1 1 1 1 0 1 1\n"
     ));
     assert_eq!(s.load_stats.polygons, 2);
-    assert_eq!(s.triangles.len(), 3);
-    assert_eq!(s.triangle_normals, vec![u32::MAX; 3]);
-    assert!(s.vertex_normals.is_empty());
-    for t in &s.triangles.items {
+    assert_eq!(s.geometry.triangles.len(), 3);
+    assert_eq!(s.geometry.triangle_normals, vec![u32::MAX; 3]);
+    assert!(s.geometry.vertex_normals.is_empty());
+    for t in &s.geometry.triangles.items {
         // Counterclockwise seen from +z: the normal points to +z.
         let n = t.normal();
         assert!(n.z > 0.0 && n.x == 0.0 && n.y == 0.0, "{n:?}");
     }
-    assert_eq!(s.triangles.items[0].p, [Vec3::ZERO, Vec3::X, Vec3::Y]);
-    let area: f32 = s.triangles.items[1..].iter().map(|t| t.area()).sum();
+    assert_eq!(
+        s.geometry.triangles.items[0].p,
+        [Vec3::ZERO, Vec3::X, Vec3::Y]
+    );
+    let area: f32 = s.geometry.triangles.items[1..]
+        .iter()
+        .map(|t| t.area())
+        .sum();
     assert!((area - 1.0).abs() < 1e-6);
 }
 
 #[test]
 fn clockwise_polygon_normal_points_the_other_way() {
     let s = ok(&format!("{V}p 4 0 0 0 0 1 0 1 1 0 1 0 0\n"));
-    for t in &s.triangles.items {
+    for t in &s.geometry.triangles.items {
         assert!(t.normal().z < 0.0);
     }
 }
@@ -251,19 +257,26 @@ fn patches_store_normalised_vertex_normals() {
          pp 4\n0 0 2 0 0 1\n1 0 2 0 0 1\n1 1 2 0 1 1\n0 1 2 1 1 1\n"
     ));
     assert_eq!(s.load_stats.polygons, 3);
-    assert_eq!(s.triangles.len(), 4);
-    assert_eq!(s.vertex_normals.len(), 3);
-    assert_eq!(s.triangle_normals[0], 0);
-    assert_eq!(s.triangle_normals[1], u32::MAX);
-    assert_eq!(s.triangle_normals[2], 1);
-    assert_eq!(s.triangle_normals[3], 2);
+    assert_eq!(s.geometry.triangles.len(), 4);
+    assert_eq!(s.geometry.vertex_normals.len(), 3);
+    assert_eq!(s.geometry.triangle_normals[0], 0);
+    assert_eq!(s.geometry.triangle_normals[1], u32::MAX);
+    assert_eq!(s.geometry.triangle_normals[2], 1);
+    assert_eq!(s.geometry.triangle_normals[3], 2);
     assert_eq!(
-        s.vertex_normals[0],
+        s.geometry.vertex_normals[0],
         [Vec3::Z, Vec3::new(0.0, 0.6, 0.8), Vec3::X]
     );
     // Each normal belongs to the vertex it was given with.
-    for (t, k) in s.triangles.items.iter().zip(&s.triangle_normals).skip(2) {
-        let n = s.vertex_normals[*k as usize];
+    for (t, k) in s
+        .geometry
+        .triangles
+        .items
+        .iter()
+        .zip(&s.geometry.triangle_normals)
+        .skip(2)
+    {
+        let n = s.geometry.vertex_normals[*k as usize];
         for (p, n) in t.p.iter().zip(n) {
             assert!((n.length() - 1.0).abs() < 1e-6);
             let given = match (p.x, p.y) {
@@ -298,7 +311,7 @@ fn check_concave(poly: &[Vec3]) -> usize {
     let s = ok(&src);
     let area = 0.5 * newell_normal(poly).length();
     let mut sum = 0.0f64;
-    for t in &s.triangles.items {
+    for t in &s.geometry.triangles.items {
         let n = t.normal();
         assert!(n.z > 0.0, "reversed triangle {t:?}");
         sum += 0.5 * n.as_dvec3().length();
@@ -306,7 +319,7 @@ fn check_concave(poly: &[Vec3]) -> usize {
         assert!(inside_xy(poly, c), "triangle {t:?} outside the face");
     }
     assert!(((sum - area) / area).abs() < 1e-5, "{sum} vs {area}");
-    s.triangles.len()
+    s.geometry.triangles.len()
 }
 
 #[test]
@@ -349,9 +362,9 @@ fn degenerate_polygons_are_dropped_and_counted() {
     ));
     assert_eq!(s.load_stats.polygons, 6);
     assert_eq!(s.load_stats.degenerate_dropped, 5);
-    assert_eq!(s.triangles.len(), 1);
-    assert_eq!(s.triangle_normals.len(), 1);
-    assert!(s.vertex_normals.is_empty());
+    assert_eq!(s.geometry.triangles.len(), 1);
+    assert_eq!(s.geometry.triangle_normals.len(), 1);
+    assert!(s.geometry.vertex_normals.is_empty());
 }
 
 /// Captures log records for the tests that check warnings (records are told apart by
@@ -420,7 +433,7 @@ fn second_viewpoint_warns() {
 #[test]
 fn numbers_in_all_notations() {
     let s = ok(&format!("{V}s +1 -2. .5e1 1E-1\n"));
-    let sp = s.spheres.items[0];
+    let sp = s.geometry.spheres().items[0];
     assert_eq!(sp.center, Vec3::new(1.0, -2.0, 5.0));
     assert_eq!(sp.radius, 0.1);
     // Integral numbers are accepted for the resolution and vertex counts.
@@ -428,7 +441,7 @@ fn numbers_in_all_notations() {
         "v from 0 0 1 at 0 0 0 up 0 1 0 angle 45 hither 1 resolution 32.0 16\np 3.0 0 0 0 1 0 0 0 1 0",
     );
     assert_eq!(s.camera.width, 32);
-    assert_eq!(s.triangles.len(), 1);
+    assert_eq!(s.geometry.triangles.len(), 1);
 }
 
 #[test]
@@ -451,7 +464,7 @@ fn load_path_reads_a_file() {
     let path = dir.path().join("scene.nff");
     std::fs::write(&path, format!("{V}s 0 0 0 1\n")).unwrap();
     let s = load_path(&path).unwrap();
-    assert_eq!(s.spheres.len(), 1);
+    assert_eq!(s.geometry.spheres().len(), 1);
     // Errors name the file.
     std::fs::write(&path, format!("{V}s 0 0 0 0\n")).unwrap();
     let e = load_path(&path).unwrap_err();
@@ -470,7 +483,7 @@ fn bytes_that_are_not_utf8_in_comments_are_harmless() {
     bytes.extend_from_slice(V.as_bytes());
     bytes.extend_from_slice(b"s 0 0 0 1\n");
     std::fs::write(&path, bytes).unwrap();
-    assert_eq!(load_path(&path).unwrap().spheres.len(), 1);
+    assert_eq!(load_path(&path).unwrap().geometry.spheres().len(), 1);
 }
 
 // ---------------------------------------------------------------------------------
@@ -657,7 +670,7 @@ fn error_polygon_counts() {
     );
     // The bound is tight enough not to refuse a compact but valid polygon.
     let s = ok(&format!("{V}p 3 0 0 0 1 0 0 0 1 0"));
-    assert_eq!(s.triangles.len(), 1);
+    assert_eq!(s.geometry.triangles.len(), 1);
 }
 
 #[test]
@@ -696,7 +709,7 @@ fn error_cone_radii_and_axis() {
     );
     // A pointed inside-only cone: one radius negative, the other zero.
     let s = parse_str(&format!("{V}c 0 0 0 -1 0 0 1 0\n"), Path::new("t.nff")).unwrap();
-    assert!(s.cones.items[0].inside_only);
+    assert!(s.geometry.cones().items[0].inside_only);
     fails(
         &format!("{V}c 0 0 0 0 0 0 1 0\n"),
         8,
@@ -945,18 +958,22 @@ fn spd_files_load_with_the_published_counts() {
         }
         let s = scene.unwrap();
         assert_eq!(load_path(&path).unwrap(), s);
-        assert_eq!(s.spheres.len(), spheres, "{name} spheres");
-        assert_eq!(s.cones.len(), cones, "{name} cones");
+        assert_eq!(s.geometry.spheres().len(), spheres, "{name} spheres");
+        assert_eq!(s.geometry.cones().len(), cones, "{name} cones");
         assert_eq!(s.load_stats.polygons, polys, "{name} polygons");
         assert_eq!(s.lights.len(), lights, "{name} lights");
-        assert_eq!(s.triangle_normals.len(), s.triangles.len());
-        for t in &s.triangles.items {
+        assert_eq!(
+            s.geometry.triangle_normals.len(),
+            s.geometry.triangles.len()
+        );
+        for t in &s.geometry.triangles.items {
             assert!(
                 t.normal().length() > 0.0,
                 "{name}: zero-normal triangle {t:?}"
             );
         }
         let tri_area: f64 = s
+            .geometry
             .triangles
             .items
             .iter()
@@ -970,10 +987,10 @@ fn spd_files_load_with_the_published_counts() {
         };
         println!(
             "{name:<16} {bytes:>8} {:>8} {:>7} {:>7} {:>9} {:>6} {:>6} {best:>9.2} {rel:>10.2e}",
-            s.spheres.len(),
-            s.cones.len(),
+            s.geometry.spheres().len(),
+            s.geometry.cones().len(),
             s.load_stats.polygons,
-            s.triangles.len(),
+            s.geometry.triangles.len(),
             s.load_stats.degenerate_dropped,
             s.lights.len(),
         );

@@ -619,7 +619,7 @@ fn a_model_without_faces_has_nothing_to_frame() {
 fn load_path_dispatches_on_the_obj_extension_in_any_case() {
     let dir = dir_with(&[("Cube.OBJ", CUBE_OBJ), ("cube.mtl", CUBE_MTL)]);
     let scene = load_path(&dir.path().join("Cube.OBJ")).unwrap();
-    assert_eq!(scene.triangles.len(), 12);
+    assert_eq!(scene.geometry.triangles.len(), 12);
     assert_eq!(scene.materials.len(), 3);
     assert_eq!(scene.lights.len(), 1);
     assert_eq!(scene.camera.width, AUTO_RESOLUTION);

@@ -107,10 +107,11 @@ fn scene(with: &[Shape], plane: bool) -> Scene {
         ..Default::default()
     });
     for shape in with {
-        s.add_shape(shape.clone(), 0);
+        s.geometry.add_shape(shape.clone(), 0);
     }
     if plane {
-        s.add_shape(Shape::Plane(Plane::new(Vec3::Y, -0.6).unwrap()), 1);
+        s.geometry
+            .add_shape(Shape::Plane(Plane::new(Vec3::Y, -0.6).unwrap()), 1);
     }
     s
 }
@@ -148,7 +149,7 @@ fn backends_agree_on_all_kinds_with_a_reflecting_plane() {
         Kind::Csg,
         Kind::Polyhedron,
     ] {
-        assert!(s.count(k) >= 1, "{k:?} present");
+        assert!(s.count_with_instances(k) >= 1, "{k:?} present");
     }
     let films: Vec<Film> = backends().into_iter().map(|b| render(&s, b)).collect();
     // The plane fills the lower half and receives shadows: some floor pixels are

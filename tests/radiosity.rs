@@ -28,13 +28,13 @@ fn camera() -> Camera {
 
 /// A quad `a b c d` (counterclockwise seen from its front) as two triangles.
 fn quad(s: &mut Scene, q: [Vec3; 4], material: u32) {
-    s.add_triangle(
+    s.geometry.add_triangle(
         Triangle {
             p: [q[0], q[1], q[2]],
         },
         material,
     );
-    s.add_triangle(
+    s.geometry.add_triangle(
         Triangle {
             p: [q[0], q[2], q[3]],
         },
@@ -85,8 +85,8 @@ fn closed_box(s: &mut Scene, lo: Vec3, hi: Vec3, material: u32, ceiling: u32) {
 fn solid_box(s: &mut Scene, lo: Vec3, hi: Vec3, material: u32) {
     let mut inner = Scene::new(camera());
     closed_box(&mut inner, lo, hi, material, material);
-    for t in &inner.triangles.items {
-        s.add_triangle(
+    for t in &inner.geometry.triangles.items {
+        s.geometry.add_triangle(
             Triangle {
                 p: [t.p[0], t.p[2], t.p[1]],
             },
@@ -131,10 +131,10 @@ fn cornellish() -> Scene {
     closed_box(&mut s, Vec3::ZERO, Vec3::ONE, 0, 0);
     // Recolour the side walls (triangles 8..12 are left and right).
     for k in 8..10 {
-        s.triangles.material[k] = 1;
+        s.geometry.triangles.material[k] = 1;
     }
     for k in 10..12 {
-        s.triangles.material[k] = 2;
+        s.geometry.triangles.material[k] = 2;
     }
     // The light, facing down, just under the ceiling.
     let y = 0.999;
@@ -873,12 +873,12 @@ fn classroom_ceiling_and_desk_undersides_are_lit_only_indirectly_but_lit() {
 fn sphere_in_box(rho: f32) -> Scene {
     use emray::geometry::{AaBox, Shape, Sphere};
     let mut s = white_box(rho);
-    s.add_shape(
+    s.geometry.add_shape(
         Shape::Sphere(Sphere::new(Vec3::new(0.5, 0.2, 0.5), 0.15)),
         0,
     );
     let b = AaBox::new(Vec3::new(0.75, 0.05, 0.1), Vec3::new(0.9, 0.2, 0.25)).unwrap();
-    s.add_shape(Shape::Box(b), 0);
+    s.geometry.add_shape(Shape::Box(b), 0);
     s
 }
 

@@ -3,11 +3,11 @@
 //! points, NFF files are included, and every malformed file is reported at the right
 //! line. Errors are checked against a `# HERE` marker on the line they must name.
 
-use emray::geometry::{Intersect, Kind, Shape};
+use emray::geometry::{Intersect, Kind, Primitive, Shape};
 use emray::load::LoadError;
 use emray::load::toml::{self as scene_toml, SceneSettings, format::SceneFile};
 use emray::math::Vec3;
-use emray::scene::{INHERIT, Scene};
+use emray::scene::{Geometry, INHERIT, Scene};
 use std::path::{Path, PathBuf};
 
 const CAMERA: &str = "[camera]\nfrom = [0, 0, 10]\nat = [0, 0, 0]\n";
@@ -17,6 +17,12 @@ fn parse(src: &str) -> Result<Scene, LoadError> {
 }
 
 /// A scene made of `CAMERA` followed by `body`.
+/// The `i`-th analytic primitive of `g` (kinds in geometry-id order, then each list in
+/// order).
+fn shape_at(g: &Geometry, i: usize) -> Shape {
+    g.shapes().nth(i).expect("no such shape").shape
+}
+
 fn build(body: &str) -> Scene {
     let src = format!("{CAMERA}{body}");
     match parse(&src) {
@@ -322,7 +328,10 @@ fn every_key_file_builds_and_its_rewrite_builds_the_same() {
     let sb = scene_toml::load(&b).unwrap();
     assert_eq!(sa, sb);
     for kind in Kind::ALL {
-        assert!(sa.count(kind) > 0, "no {kind:?} in the every-key scene");
+        assert!(
+            sa.count_with_instances(kind) > 0,
+            "no {kind:?} in the every-key scene"
+        );
     }
 }
 
@@ -356,14 +365,14 @@ center = [0, 0, 0]
 radius = 2
 "#,
     );
-    assert_eq!(s.count(Kind::Sphere), 2);
-    assert_eq!(s.prim_count(), 2);
-    let sp = &s.spheres.items[0];
+    assert_eq!(s.count_with_instances(Kind::Sphere), 2);
+    assert_eq!(s.prim_count_with_instances(), 2);
+    let sp = &s.geometry.spheres().items[0];
     assert_eq!(
         (sp.center, sp.radius, sp.inside_only),
         (Vec3::new(1.0, 2.0, 3.0), 0.5, false)
     );
-    let glass = s.materials[s.spheres.material[0] as usize];
+    let glass = s.materials[s.geometry.spheres().material[0] as usize];
     assert_eq!(glass.color, Vec3::new(0.9, 0.95, 1.0));
     assert_eq!(glass.filter, Vec3::new(0.5, 0.75, 1.0));
     assert_eq!(
@@ -382,7 +391,7 @@ radius = 2
     // An empty material takes every default; a primitive without one gets the default
     // material, which is the same.
     let plain = s.materials[1];
-    let fallback = s.materials[s.spheres.material[1] as usize];
+    let fallback = s.materials[s.geometry.spheres().material[1] as usize];
     assert_eq!(s.materials.len(), 3);
     for m in [plain, fallback] {
         assert_eq!((m.color, m.filter), (Vec3::ONE, Vec3::ONE));
@@ -475,7 +484,7 @@ exponent = 4
     assert_eq!((s.camera.width, s.camera.height), (640, 480));
     assert_eq!((s.background, s.ambient), (Vec3::ZERO, Vec3::splat(0.1)));
     assert_eq!(settings, SceneSettings::default());
-    assert_eq!(s.prim_count(), 0);
+    assert_eq!(s.prim_count_with_instances(), 0);
 }
 
 #[test]
@@ -510,23 +519,23 @@ base_radius = 1
 apex = [0, 0, 3]
 "#,
     );
-    assert_eq!(s.count(Kind::Cone), 2);
-    let c = &s.cones.items[0];
+    assert_eq!(s.count_with_instances(Kind::Cone), 2);
+    let c = &s.geometry.cones().items[0];
     assert_eq!(
         (c.base, c.base_radius, c.apex, c.apex_radius),
         (Vec3::ZERO, 1.0, Vec3::new(0.0, 2.0, 0.0), 0.5)
     );
-    assert_eq!(s.cones.items[1].apex_radius, 0.0);
+    assert_eq!(s.geometry.cones().items[1].apex_radius, 0.0);
 }
 
 /// The only analytic shape of a scene, with its transform to world if it is an
 /// instance's.
 fn only_shape(s: &Scene) -> (Shape, Option<emray::math::Xform>) {
     let mut all: Vec<(Shape, Option<emray::math::Xform>)> =
-        s.analytic().map(|(_, _, sh)| (sh, None)).collect();
+        s.geometry.shapes().map(|e| (e.shape, None)).collect();
     for inst in &s.instances {
-        for (_, _, sh) in s.objects[inst.object as usize].analytic() {
-            all.push((sh, Some(inst.xform)));
+        for e in s.objects[inst.object as usize].shapes() {
+            all.push((e.shape, Some(inst.xform)));
         }
     }
     assert_eq!(all.len(), 1, "{all:?}");
@@ -556,8 +565,8 @@ fn closed_solids() {
     let s = build(
         "[[objects]]\ntype = \"cylinder\"\nbase = [1, 0, 0]\naxis = [0, 2, 0]\nheight = 3\nradius = 0.5\n",
     );
-    assert_eq!(s.count(Kind::CappedCone), 1);
-    let Shape::CappedCone(c) = &s.shapes.items[0] else {
+    assert_eq!(s.count_with_instances(Kind::CappedCone), 1);
+    let Shape::CappedCone(c) = &shape_at(&s.geometry, 0) else {
         panic!()
     };
     assert_eq!(
@@ -579,7 +588,7 @@ fn closed_solids() {
     let s = build(
         "[[objects]]\ntype = \"capped_cone\"\nbase = [0, 0, 0]\naxis = [0, 0, 1]\nheight = 2\nbase_radius = 1\ntop_radius = 0\n",
     );
-    let Shape::CappedCone(c) = &s.shapes.items[0] else {
+    let Shape::CappedCone(c) = &shape_at(&s.geometry, 0) else {
         panic!()
     };
     assert_eq!(
@@ -593,8 +602,8 @@ fn closed_solids() {
     );
 
     let s = build("[[objects]]\ntype = \"box\"\nmin = [-1, 0, 2]\nmax = [1, 1, 5]\n");
-    assert_eq!(s.count(Kind::Box), 1);
-    let Shape::Box(b) = &s.shapes.items[0] else {
+    assert_eq!(s.count_with_instances(Kind::Box), 1);
+    let Shape::Box(b) = &shape_at(&s.geometry, 0) else {
         panic!()
     };
     assert_eq!(
@@ -607,8 +616,8 @@ fn closed_solids() {
     let s = build(
         "[[objects]]\ntype = \"obox\"\ncenter = [0, 0, 0]\nsize = [4, 2, 2]\nrotation = [{ rotate = [0, 0, 1], angle = 90 }]\n",
     );
-    assert_eq!(s.count(Kind::OBox), 1);
-    let Shape::OBox(b) = &s.shapes.items[0] else {
+    assert_eq!(s.count_with_instances(Kind::OBox), 1);
+    let Shape::OBox(b) = &shape_at(&s.geometry, 0) else {
         panic!()
     };
     assert_close(b.half_extents(), Vec3::new(2.0, 1.0, 1.0));
@@ -628,12 +637,12 @@ fn closed_solids() {
     let s = build(
         "[[objects]]\ntype = \"polyhedron\"\nplanes = [[1, 0, 0, 1], [-1, 0, 0, 1], [0, 1, 0, 2], [0, -1, 0, 2], [0, 0, 1, 1], [0, 0, -1, 1]]\n",
     );
-    assert_eq!(s.count(Kind::Polyhedron), 1);
+    assert_eq!(s.count_with_instances(Kind::Polyhedron), 1);
     check_inside(&s, &[[0.9, 1.9, -0.9]], &[[1.1, 0.0, 0.0], [0.0, 2.1, 0.0]]);
     let s = build(
         "[[objects]]\ntype = \"polyhedron\"\npreset = \"octahedron\"\ncenter = [0, 1, 0]\nradius = 2\n",
     );
-    let Shape::Polyhedron(p) = &s.shapes.items[0] else {
+    let Shape::Polyhedron(p) = &shape_at(&s.geometry, 0) else {
         panic!()
     };
     assert_eq!(p.face_count(), 8);
@@ -643,7 +652,7 @@ fn closed_solids() {
         &[[1.1, 2.0, 0.0], [0.0, -1.1, 0.0]],
     );
     let s = build("[[objects]]\ntype = \"polyhedron\"\nsides = 6\nradius = 1\nheight = 4\n");
-    let Shape::Polyhedron(p) = &s.shapes.items[0] else {
+    let Shape::Polyhedron(p) = &shape_at(&s.geometry, 0) else {
         panic!()
     };
     assert_eq!(p.face_count(), 8);
@@ -660,7 +669,7 @@ fn quadrics_planes_and_tori() {
     let s = build(
         "[[objects]]\ntype = \"quadric\"\ncoefficients = [1, 1, 1, 0, 0, 0, 0, 0, 0, -1]\nclip = { min = [-2, -2, 0], max = [2, 2, 2] }\n",
     );
-    assert_eq!(s.count(Kind::Quadric), 1);
+    assert_eq!(s.count_with_instances(Kind::Quadric), 1);
     check_inside(
         &s,
         &[[0.0, 0.0, 0.9], [0.6, 0.6, 0.1]],
@@ -669,12 +678,12 @@ fn quadrics_planes_and_tori() {
     // An unclipped cylinder x² + y² = 1 along z: unbounded, not a solid.
     let s =
         build("[[objects]]\ntype = \"quadric\"\ncoefficients = [1, 1, 0, 0, 0, 0, 0, 0, 0, -1]\n");
-    assert!(!s.shapes.items[0].is_solid());
-    assert!(!s.shapes.items[0].bounds().is_finite());
+    assert!(!shape_at(&s.geometry, 0).is_solid());
+    assert!(!shape_at(&s.geometry, 0).bounds().is_finite());
 
     let s = build("[[objects]]\ntype = \"plane\"\npoint = [0, -1, 0]\nnormal = [0, 2, 0]\n");
-    assert_eq!(s.count(Kind::Plane), 1);
-    let Shape::Plane(p) = &s.shapes.items[0] else {
+    assert_eq!(s.count_with_instances(Kind::Plane), 1);
+    let Shape::Plane(p) = &shape_at(&s.geometry, 0) else {
         panic!()
     };
     assert_eq!((p.normal(), p.offset()), (Vec3::Y, -1.0));
@@ -683,8 +692,8 @@ fn quadrics_planes_and_tori() {
     let s = build(
         "[[objects]]\ntype = \"torus\"\ncenter = [0, 0, 0]\naxis = [0, 1, 0]\nmajor_radius = 2\nminor_radius = 0.5\n",
     );
-    assert_eq!(s.count(Kind::Torus), 1);
-    let Shape::Torus(t) = &s.shapes.items[0] else {
+    assert_eq!(s.count_with_instances(Kind::Torus), 1);
+    let Shape::Torus(t) = &shape_at(&s.geometry, 0) else {
         panic!()
     };
     assert_eq!(
@@ -920,21 +929,24 @@ type = "polygon"
 vertices = [[0, 0, 0], [1, 0, 0], [2, 0, 0]]
 "#,
     );
-    assert_eq!(s.count(Kind::Triangle), 1 + 1 + 4 + 12);
+    assert_eq!(s.count_with_instances(Kind::Triangle), 1 + 1 + 4 + 12);
     assert_eq!(s.load_stats.polygons, 1 + 1 + 1 + 6 + 1);
     assert_eq!(s.load_stats.degenerate_dropped, 1);
     // Flat, then smooth with unit normals.
-    assert_eq!(s.triangle_normals[0], u32::MAX);
-    let k = s.triangle_normals[1] as usize;
-    assert_close(s.vertex_normals[k][1], Vec3::Z);
-    assert_close(s.vertex_normals[k][2], Vec3::new(1.0, 0.0, 1.0).normalize());
+    assert_eq!(s.geometry.triangle_normals[0], u32::MAX);
+    let k = s.geometry.triangle_normals[1] as usize;
+    assert_close(s.geometry.vertex_normals[k][1], Vec3::Z);
+    assert_close(
+        s.geometry.vertex_normals[k][2],
+        Vec3::new(1.0, 0.0, 1.0).normalize(),
+    );
     // The L's area is 3 and its triangles face +z as its winding says.
-    let l = &s.triangles.items[2..6];
+    let l = &s.geometry.triangles.items[2..6];
     let area: f32 = l.iter().map(|t| t.area()).sum();
     assert!((area - 3.0).abs() < 1e-5, "{area}");
     assert!(l.iter().all(|t| t.normal().z > 0.0));
     // The cube's faces point outwards.
-    for t in &s.triangles.items[6..18] {
+    for t in &s.geometry.triangles.items[6..18] {
         let c = (t.p[0] + t.p[1] + t.p[2]) / 3.0;
         assert!(t.normal().dot(c - Vec3::splat(0.5)) > 0.0, "{t:?}");
     }
@@ -979,16 +991,22 @@ transform = [
 ]
 "#,
     );
-    let centers: Vec<Vec3> = s.spheres.items.iter().map(|s| s.center).collect();
+    let centers: Vec<Vec3> = s
+        .geometry
+        .spheres()
+        .items
+        .iter()
+        .map(|s| s.center)
+        .collect();
     assert_close(centers[0], Vec3::new(2.0, 5.0, 0.0));
     assert_close(centers[1], Vec3::new(2.0, 10.0, 0.0));
     assert_close(centers[2], Vec3::new(10.0, 1.0, 0.0));
     assert_close(centers[3], Vec3::new(0.0, 2.0, 0.0));
-    assert_eq!(s.spheres.items[0].radius, 2.0);
-    assert_eq!(s.spheres.items[2].radius, 1.0);
+    assert_eq!(s.geometry.spheres().items[0].radius, 2.0);
+    assert_eq!(s.geometry.spheres().items[2].radius, 1.0);
     assert!(s.instances.is_empty(), "similarities are baked");
     // (1,0,0) → (4,0,0) → rotated 90° about y: (0,0,−4).
-    let t = &s.triangles.items[0];
+    let t = &s.geometry.triangles.items[0];
     assert_close(t.p[0], Vec3::new(0.0, 0.0, -4.0));
     assert_close(t.p[1], Vec3::new(0.0, 1.0, -3.0));
     assert_close(t.p[2], Vec3::new(1.0, 0.0, -3.0));
@@ -1009,10 +1027,10 @@ transform = [{ scale = [2, 1, 1] }, { translate = [0, 3, 0] }]
     );
     assert_eq!(s.geometry.prim_count(), 0);
     assert_eq!((s.objects.len(), s.instances.len()), (1, 1));
-    assert_eq!(s.count(Kind::Sphere), 1);
+    assert_eq!(s.count_with_instances(Kind::Sphere), 1);
     let inst = &s.instances[0];
     assert_eq!(inst.material, 0);
-    assert_eq!(s.objects[0].spheres.material[0], 0);
+    assert_eq!(s.objects[0].spheres().material[0], 0);
     let p = inst.xform.to_world.transform_point3(Vec3::X);
     assert_close(p, Vec3::new(2.0, 3.0, 0.0));
 }
@@ -1028,7 +1046,13 @@ transform = [{ scale = [1, 1, -1] }]
 "#,
     );
     // The square faced +z; mirrored in z it faces −z, and its winding must say so.
-    assert!(s.triangles.items.iter().all(|t| t.normal().z < 0.0));
+    assert!(
+        s.geometry
+            .triangles
+            .items
+            .iter()
+            .all(|t| t.normal().z < 0.0)
+    );
 }
 
 #[test]
@@ -1071,10 +1095,10 @@ children = [{ type = "instance", of = "thing", transform = [{ translate = [1, 0,
     assert_eq!(s.objects.len(), 1);
     assert_eq!(s.instances.len(), 3);
     assert!(s.instances.iter().all(|i| i.object == 0));
-    assert_eq!(s.count(Kind::Sphere), 6);
-    assert_eq!(s.count(Kind::Triangle), 3);
+    assert_eq!(s.count_with_instances(Kind::Sphere), 6);
+    assert_eq!(s.count_with_instances(Kind::Triangle), 3);
     let obj = &s.objects[0];
-    assert_eq!(obj.spheres.material, vec![INHERIT, 2]);
+    assert_eq!(obj.spheres().material, vec![INHERIT, 2]);
     // The triangle's own transform is baked into the object.
     assert_close(obj.triangles.items[0].p[0], Vec3::new(0.0, 7.0, 0.0));
     assert_eq!(s.instances[0].material, 0);
@@ -1118,8 +1142,8 @@ of = "pair"
     // The stretched spheres became one-leaf CSG solids.
     assert_eq!(obj.count(Kind::Csg), 2);
     assert_eq!(obj.count(Kind::Sphere), 0);
-    let a = &obj.shapes.items[0];
-    let b = &obj.shapes.items[1];
+    let a = &shape_at(obj, 0);
+    let b = &shape_at(obj, 1);
     assert!(a.contains(Vec3::new(2.9, 0.0, 0.0)));
     assert!(!a.contains(Vec3::new(0.0, 1.1, 0.0)));
     assert!(b.contains(Vec3::new(-2.9, 10.0, 0.0)));
@@ -1158,14 +1182,17 @@ of = "d"
         (1, 1, 1)
     );
     let torus = obj
-        .shapes
-        .items
-        .iter()
+        .shapes()
+        .map(|e| e.shape)
         .find(|s| s.kind() == Kind::Csg)
         .unwrap();
     assert!(torus.contains(Vec3::new(2.0, 1.4, 0.0)) && !torus.contains(Vec3::new(2.0, 1.6, 0.0)));
-    assert_close(obj.cones.items[0].apex, Vec3::new(0.0, 0.0, 2.0));
-    let Some(Shape::Plane(p)) = obj.shapes.items.iter().find(|s| s.kind() == Kind::Plane) else {
+    assert_close(obj.cones().items[0].apex, Vec3::new(0.0, 0.0, 2.0));
+    let Some(Shape::Plane(p)) = obj
+        .shapes()
+        .map(|e| e.shape)
+        .find(|s| s.kind() == Kind::Plane)
+    else {
         panic!()
     };
     assert_eq!((p.normal(), p.offset()), (Vec3::Y, -5.0));
@@ -1198,14 +1225,14 @@ children = [{ type = "difference", material = "outer", children = [
 "#,
     );
     // Transformed at the top level: an object of its own, placed by an instance.
-    assert_eq!(s.count(Kind::Csg), 1);
+    assert_eq!(s.count_with_instances(Kind::Csg), 1);
     assert_eq!((s.objects.len(), s.instances.len()), (1, 1));
     let inst = &s.instances[0];
-    let shape = &s.objects[0].shapes.items[0];
+    let shape = &shape_at(&s.objects[0], 0);
     let Shape::Csg(csg) = shape else { panic!() };
     assert_eq!(csg.leaf_count(), 5);
     assert_eq!(inst.material, 0); // outer
-    assert_eq!(s.objects[0].shapes.material[0], 0);
+    assert_eq!(s.objects[0].shapes().next().unwrap().material, 0);
     assert_eq!(csg.leaf_material(0), Some(2)); // inner, from the union
     assert_eq!(csg.leaf_material(2), Some(1)); // cut, its own
     assert_eq!(csg.leaf_material(3), None); // the root's (outer)
@@ -1238,7 +1265,7 @@ children = [{ type = "difference", material = "outer", children = [
         "type = \"difference\"\nchildren = [\n  { type = \"sphere\", center = [0, 0, 0], radius = 1 },\n  { type = \"sphere\", center = [0, 0, 0], radius = 0.5, transform = [{ scale = [1, 1, 4] }] },\n]"
     ));
     assert_eq!((s.objects.len(), s.instances.len()), (1, 1));
-    let shape = &s.objects[0].shapes.items[0];
+    let shape = &shape_at(&s.objects[0], 0);
     assert!(shape.contains(Vec3::new(100.0, 0.8, 0.0)));
     assert!(!shape.contains(Vec3::new(100.0, 0.0, 0.8)));
     assert!(!shape.contains(Vec3::new(0.0, 0.8, 0.0)));
@@ -1274,29 +1301,37 @@ patches = [[
 fn bezier_patches_tessellate_in_final_coordinates() {
     // A flat patch, rows along x stacked along y: front +z, two triangles.
     let s = build(FLAT_PATCH);
-    assert_eq!(s.count(Kind::Triangle), 2);
-    for (i, t) in s.triangles.items.iter().enumerate() {
+    assert_eq!(s.count_with_instances(Kind::Triangle), 2);
+    for (i, t) in s.geometry.triangles.items.iter().enumerate() {
         assert!(t.normal().z > 0.0);
-        let k = s.triangle_normals[i] as usize;
-        assert!(s.vertex_normals[k].iter().all(|n| close(*n, Vec3::Z)));
+        let k = s.geometry.triangle_normals[i] as usize;
+        assert!(
+            s.geometry.vertex_normals[k]
+                .iter()
+                .all(|n| close(*n, Vec3::Z))
+        );
     }
-    let area: f32 = s.triangles.items.iter().map(|t| t.area()).sum();
+    let area: f32 = s.geometry.triangles.items.iter().map(|t| t.area()).sum();
     assert!((area - 9.0).abs() < 1e-4);
     // Mirrored, it faces the other way, geometry and shading alike.
     let s = build(&format!(
         "{FLAT_PATCH}transform = [{{ scale = [1, 1, -1] }}, {{ translate = [0, 0, 2] }}]\n"
     ));
-    for (i, t) in s.triangles.items.iter().enumerate() {
+    for (i, t) in s.geometry.triangles.items.iter().enumerate() {
         assert!(t.normal().z < 0.0 && t.p.iter().all(|p| p.z == 2.0));
-        let k = s.triangle_normals[i] as usize;
-        assert!(s.vertex_normals[k].iter().all(|n| close(*n, Vec3::NEG_Z)));
+        let k = s.geometry.triangle_normals[i] as usize;
+        assert!(
+            s.geometry.vertex_normals[k]
+                .iter()
+                .all(|n| close(*n, Vec3::NEG_Z))
+        );
     }
 
     // The teapot: z up in its data; a finer tolerance gives more triangles.
     let coarse = build("[[objects]]\ntype = \"bezier\"\nbuiltin = \"teapot\"\ntolerance = 0.05\n");
     let fine = build("[[objects]]\ntype = \"bezier\"\nbuiltin = \"teapot\"\ntolerance = 0.005\n");
     let default = build("[[objects]]\ntype = \"bezier\"\nbuiltin = \"teapot\"\n");
-    let n = |s: &Scene| s.count(Kind::Triangle);
+    let n = |s: &Scene| s.count_with_instances(Kind::Triangle);
     assert!(
         n(&coarse) > 100 && n(&fine) > n(&coarse),
         "{} {}",
@@ -1304,15 +1339,15 @@ fn bezier_patches_tessellate_in_final_coordinates() {
         n(&fine)
     );
     assert!(n(&default) >= n(&coarse));
-    assert_eq!(coarse.vertex_normals.len(), n(&coarse));
-    let b = coarse.bounds();
+    assert_eq!(coarse.geometry.vertex_normals.len(), n(&coarse));
+    let b = coarse.geometry.bounds();
     assert!(b.max.z > 3.0 && b.min.z > -0.01 && b.min.z < 0.01, "{b:?}");
     // Turned to y up and scaled: the tessellation is of the transformed patches.
     let turned = build(
         "[[objects]]\ntype = \"bezier\"\nbuiltin = \"teapot\"\ntolerance = 0.05\n\
          transform = [{ rotate = [1, 0, 0], angle = -90 }, { scale = 0.5 }]\n",
     );
-    let bt = turned.bounds();
+    let bt = turned.geometry.bounds();
     assert!((bt.max.y - b.max.z * 0.5).abs() < 1e-3, "{bt:?} vs {b:?}");
     assert!(
         n(&turned) < n(&coarse),
@@ -1455,21 +1490,21 @@ material = "mine"
     assert_eq!(s.materials.len(), 3);
     assert_eq!(s.materials[1].color, Vec3::X);
     assert_eq!(s.materials[2].color, Vec3::Y);
-    assert_eq!(s.count(Kind::Sphere), 2);
-    assert_eq!(s.count(Kind::Triangle), 2);
-    assert_eq!(s.count(Kind::Cone), 2);
-    let sp = &s.spheres.items[0];
+    assert_eq!(s.count_with_instances(Kind::Sphere), 2);
+    assert_eq!(s.count_with_instances(Kind::Triangle), 2);
+    assert_eq!(s.count_with_instances(Kind::Cone), 2);
+    let sp = &s.geometry.spheres().items[0];
     assert_close(sp.center, Vec3::new(2.0, 0.0, 5.0));
     assert_eq!(sp.radius, 1.0);
-    assert_eq!(s.spheres.material[0], 1);
-    assert_eq!(s.triangles.material[0], 2);
-    assert_close(s.triangles.items[0].p[1], Vec3::new(2.0, 0.0, 5.0));
-    assert_close(s.cones.items[0].apex, Vec3::new(0.0, 2.0, 5.0));
-    assert_eq!(s.cones.items[0].base_radius, 1.0);
+    assert_eq!(s.geometry.spheres().material[0], 1);
+    assert_eq!(s.geometry.triangles.material[0], 2);
+    assert_close(s.geometry.triangles.items[0].p[1], Vec3::new(2.0, 0.0, 5.0));
+    assert_close(s.geometry.cones().items[0].apex, Vec3::new(0.0, 2.0, 5.0));
+    assert_eq!(s.geometry.cones().items[0].base_radius, 1.0);
     // The second copy, untransformed, in our material.
-    assert_eq!(s.spheres.items[1].center, Vec3::X);
-    assert_eq!(s.spheres.material[1], 0);
-    assert_eq!(s.triangles.material[1], 0);
+    assert_eq!(s.geometry.spheres().items[1].center, Vec3::X);
+    assert_eq!(s.geometry.spheres().material[1], 0);
+    assert_eq!(s.geometry.triangles.material[1], 0);
     // The light came along once, transformed.
     assert_eq!(s.lights.len(), 1);
     assert_close(s.lights[0].pos, Vec3::new(2.0, 4.0, 11.0));
@@ -1521,19 +1556,19 @@ material = "mine"
     // define a copy under that name.
     write(dir.path(), "models/QUAD.OBJ", QUAD_OBJ);
     let s = scene_toml::load(&main).unwrap();
-    assert_eq!(s.count(Kind::Triangle), 4);
+    assert_eq!(s.count_with_instances(Kind::Triangle), 4);
     assert_eq!(s.geometry.count(Kind::Triangle), 2);
     // `mine`, then the OBJ's `blue` (the two names are two files, read once each).
     assert_eq!(s.materials[0].color, Vec3::X);
-    let blue = s.materials[s.triangles.material[0] as usize];
+    let blue = s.materials[s.geometry.triangles.material[0] as usize];
     assert_eq!(blue.color, Vec3::Z);
     // The quad in the z = 0 plane facing +z, turned to face +y, lifted by 2.
-    for t in &s.triangles.items {
+    for t in &s.geometry.triangles.items {
         assert!(t.p.iter().all(|p| (p.y - 2.0).abs() < 1e-5), "{t:?}");
         assert!(t.normal().y > 0.0);
     }
-    let k = s.triangle_normals[0] as usize;
-    assert_close(s.vertex_normals[k][0], Vec3::Y);
+    let k = s.geometry.triangle_normals[0] as usize;
+    assert_close(s.geometry.vertex_normals[k][0], Vec3::Y);
     // Inside the define the OBJ keeps its own material (an instance's material only
     // fills primitives that have none).
     let obj = &s.objects[s.instances[0].object as usize];
@@ -1888,7 +1923,7 @@ fn valid_but_surprising_inputs() {
     let s = build(
         "[define.unused]\ntype = \"sphere\"\ncenter = [0, 0, 0]\nradius = 1\n[[objects]]\ntype = \"group\"\nchildren = []\n",
     );
-    assert_eq!(s.prim_count(), 0);
+    assert_eq!(s.prim_count_with_instances(), 0);
     error_at(
         "[define.unused]\ntype = \"sphere\"\ncenter = [0, 0, 0]\nradius = 0 # HERE\n",
         &["must be positive"],
@@ -2012,12 +2047,13 @@ transform = [{ translate = [0, 0, 1] }]
 color = [0, 0, 1]
 "#,
     );
-    assert_eq!(s.count(Kind::Sphere), 1);
-    assert_eq!(s.count(Kind::Csg), 1);
-    assert_eq!(s.spheres.material[0], 0);
-    assert_eq!(s.shapes.material[0], 0);
-    assert!(s.shapes.items[0].contains(Vec3::new(0.0, 6.0, 1.0)));
-    assert!(!s.shapes.items[0].contains(Vec3::new(0.0, 6.9, 0.0)));
+    assert_eq!(s.count_with_instances(Kind::Sphere), 1);
+    assert_eq!(s.count_with_instances(Kind::Csg), 1);
+    assert_eq!(s.geometry.spheres().material[0], 0);
+    assert_eq!(s.geometry.csg().material[0], 0);
+    let csg = s.geometry.shape(Kind::Csg, 0).unwrap();
+    assert!(csg.contains(Vec3::new(0.0, 6.0, 1.0)));
+    assert!(!csg.contains(Vec3::new(0.0, 6.9, 0.0)));
     // An error in such a table points into it.
     error_at(
         "[[objects]]\ntype = \"group\"\n[[objects.children]]\ntype = \"sphere\"\ncenter = [1, 0, 0]\nradius = 0 # HERE\n",

@@ -109,7 +109,11 @@ fn hostile_rays_give_no_nan_and_no_panic() {
         b 0.1 0.1 0.1\nl 2 -3 4\nf 0.8 0.8 0.8 0.9 0.2 10 0 1\np 4 -5 -5 0 5 -5 0 5 5 0 -5 5 0\n\
         p 3 0 0 1 1 1 2 2 2 3\nf 1 1 1 0.1 0.1 10 0.9 1.5\ns 0 -6 0 0.5\ns 0 0 1 1\n";
     let s = parse_str(src, Path::new("<t>")).unwrap();
-    assert_eq!(s.triangles.len(), 2, "the collinear triangle is dropped");
+    assert_eq!(
+        s.geometry.triangles.len(),
+        2,
+        "the collinear triangle is dropped"
+    );
     for b in backends() {
         let f = render(&s, b);
         assert!(f.pixels.iter().all(|p| p.is_finite()), "{b:?}");

@@ -450,10 +450,10 @@ fn six_file_cube_map_faces_are_seen_in_their_directions() {
 
     // A face of another size, and a missing face, are errors naming the file.
     write_png(&sky.join("py.png"), 8, 8, |_, _| [0, 0, 0]);
-    let e = Environment::load(&sky).unwrap_err();
+    let e = Environment::load(&sky).unwrap_err().to_string();
     assert!(e.contains("py is 8 × 8"), "{e}");
     std::fs::remove_file(sky.join("py.png")).unwrap();
-    let e = Environment::load(&sky).unwrap_err();
+    let e = Environment::load(&sky).unwrap_err().to_string();
     assert!(e.contains("py.png"), "{e}");
 }
 

@@ -1,10 +1,13 @@
 //! Acceleration structures behind one trait: Intel Embree (feature `embree`) and the
 //! pure-Rust BVH. Both report hits in the same terms (geometry id = [`Kind`], primitive
-//! index within the kind), so the renderer cannot tell them apart.
+//! index within the kind), so the renderer cannot tell them apart. Primitives with
+//! infinite bounds stay out of both structures: [`unbounded`] tests them first, for
+//! both.
 
 pub mod bvh;
 #[cfg(feature = "embree")]
 pub mod embree;
+pub mod unbounded;
 
 use crate::geometry::Kind;
 use crate::math::Ray;

@@ -289,7 +289,7 @@ pub fn run_child(spec: &RunSpec) -> Result<RunResult, BenchError> {
         _ => accel,
     };
     Ok(RunResult {
-        prims: scene.prim_count(),
+        prims: scene.prim_count_with_instances(),
         load_ms,
         build_ms,
         ms,
@@ -682,7 +682,7 @@ mod tests {
             r.prims,
             crate::run::load_scene("spd:balls?size=1")
                 .unwrap()
-                .prim_count()
+                .prim_count_with_instances()
         );
         let raw = run_child(&RunSpec {
             mode: Mode::Raw,

@@ -70,7 +70,8 @@ pub fn differences(scene: &Scene) -> String {
         notes.push("no refraction");
     }
     if scene
-        .cones
+        .geometry
+        .cones()
         .items
         .iter()
         .any(|c| c.base_radius != c.apex_radius)

@@ -10,7 +10,8 @@
 //! The oriented box takes the ray into its own frame (a rotation, so `t` is unchanged)
 //! and runs the same test against `[−h, h]`.
 
-use super::{Intersect, ShapeHit, Solid, Span, Spans, SurfacePoint};
+use super::param::box_param;
+use super::{Intersect, Param, Primitive, ShapeError, ShapeHit, Solid, Span, Spans, SurfacePoint};
 use crate::math::{Aabb, Ray, Vec3, gamma};
 use glam::{DMat3, DQuat, Mat3, Quat};
 
@@ -140,15 +141,12 @@ impl AaBox {
     ///
     /// # Errors
     /// When a coordinate is not finite or `min` is not below `max` on every axis.
-    pub fn new(min: Vec3, max: Vec3) -> Result<Self, String> {
+    pub fn new(min: Vec3, max: Vec3) -> Result<Self, ShapeError> {
         if !min.is_finite() || !max.is_finite() {
-            return Err(format!("box: corners {min} and {max} must be finite"));
+            return Err(ShapeError::BoxNotFinite { min, max });
         }
         if !min.cmplt(max).all() {
-            return Err(format!(
-                "box: min {min} must be below max {max} on every axis (size {})",
-                max - min
-            ));
+            return Err(ShapeError::BoxNotBelow { min, max });
         }
         Ok(AaBox { min, max })
     }
@@ -260,22 +258,32 @@ impl OBox {
     /// # Errors
     /// When a number is not finite, a half extent is not positive, or the quaternion is
     /// zero.
-    pub fn new(center: Vec3, half_extents: Vec3, rotation: Quat) -> Result<Self, String> {
+    pub fn new(center: Vec3, half_extents: Vec3, rotation: Quat) -> Result<Self, ShapeError> {
         if !center.is_finite() {
-            return Err(format!("oriented box: centre {center} is not finite"));
+            return Err(ShapeError::parameter_not_finite(
+                "oriented box",
+                "centre",
+                center,
+            ));
         }
         if !half_extents.is_finite() || !half_extents.cmpgt(Vec3::ZERO).all() {
-            return Err(format!(
-                "oriented box: half extents {half_extents} must be positive and finite"
+            return Err(ShapeError::parameter_not_positive(
+                "oriented box",
+                "half extents",
+                half_extents,
             ));
         }
         if !rotation.is_finite() {
-            return Err(format!("oriented box: rotation {rotation} is not finite"));
+            return Err(ShapeError::parameter_not_finite(
+                "oriented box",
+                "rotation",
+                rotation,
+            ));
         }
         let q = rotation.as_dquat();
         let len = q.length();
         if !(len.is_finite() && len > 0.0) {
-            return Err(format!("oriented box: rotation {rotation} is zero"));
+            return Err(ShapeError::ZeroRotation(rotation));
         }
         let rotation = (q / len).as_quat();
         let b = OBox {
@@ -284,9 +292,10 @@ impl OBox {
             rotation: rotation.to_array(),
         };
         if !b.bounds().is_finite() {
-            return Err(format!(
-                "oriented box: centre {center} and half extents {half_extents} overflow"
-            ));
+            return Err(ShapeError::OBoxOverflow {
+                center,
+                half_extents,
+            });
         }
         Ok(b)
     }
@@ -297,15 +306,19 @@ impl OBox {
     ///
     /// # Errors
     /// As [`OBox::new`], and when the axes are not orthonormal.
-    pub fn from_axes(center: Vec3, half_extents: Vec3, axes: [Vec3; 3]) -> Result<Self, String> {
+    pub fn from_axes(
+        center: Vec3,
+        half_extents: Vec3,
+        axes: [Vec3; 3],
+    ) -> Result<Self, ShapeError> {
         let a = axes.map(|v| v.as_dvec3());
         if !a.iter().all(|v| v.is_finite()) {
-            return Err(format!("oriented box: axes {axes:?} are not finite"));
+            return Err(ShapeError::AxesNotFinite(axes));
         }
         let ortho = (0..3)
             .all(|i| (a[i].length() - 1.0).abs() < 1e-4 && a[i].dot(a[(i + 1) % 3]).abs() < 1e-4);
         if !ortho {
-            return Err(format!("oriented box: axes {axes:?} are not orthonormal"));
+            return Err(ShapeError::AxesNotOrthonormal(axes));
         }
         // Gram–Schmidt in f64, then a right-handed third axis.
         let x = a[0].normalize();
@@ -443,6 +456,43 @@ impl Solid for OBox {
     fn contains(&self, p: Vec3) -> bool {
         let y = Self::to_local(&self.matrix(), p - self.center);
         y.abs().cmple(self.half).all()
+    }
+}
+
+impl Primitive for AaBox {
+    fn is_solid(&self) -> bool {
+        true
+    }
+    fn spans(&self, ray: &Ray, out: &mut Spans) {
+        Solid::spans(self, ray, out)
+    }
+    fn contains(&self, p: Vec3) -> bool {
+        Solid::contains(self, p)
+    }
+    fn param(&self, p: Vec3, ng: Vec3) -> Param {
+        let (min, max) = (self.min(), self.max());
+        box_param(
+            p,
+            ng,
+            (min + max) * 0.5,
+            (max - min) * 0.5,
+            [Vec3::X, Vec3::Y, Vec3::Z],
+        )
+    }
+}
+
+impl Primitive for OBox {
+    fn is_solid(&self) -> bool {
+        true
+    }
+    fn spans(&self, ray: &Ray, out: &mut Spans) {
+        Solid::spans(self, ray, out)
+    }
+    fn contains(&self, p: Vec3) -> bool {
+        Solid::contains(self, p)
+    }
+    fn param(&self, p: Vec3, ng: Vec3) -> Param {
+        box_param(p, ng, self.center(), self.half_extents(), self.axes())
     }
 }
 

@@ -16,10 +16,13 @@
 //! `a → 0` (a ray along a cylinder's axis, or parallel to a cone's side) degenerates to a
 //! linear or constant equation instead of dividing by zero.
 
+use super::param::{axis_frame, cylindrical};
 use super::{
-    Intersect, ShapeHit, Solid, Span, Spans, SurfacePoint, diff_of_products, quadratic_roots,
+    Intersect, Param, Primitive, ShapeError, ShapeHit, Solid, Span, Spans, SurfacePoint,
+    diff_of_products, quadratic_roots,
 };
 use crate::math::{Aabb, DVec3, Frame, Ray, Vec3, gamma};
+use glam::Vec2;
 use std::f32::consts::TAU;
 
 /// Which part of the surface an end of the line's stretch lies on.
@@ -104,41 +107,61 @@ impl CappedCone {
         height: f32,
         base_radius: f32,
         top_radius: f32,
-    ) -> Result<Self, String> {
+    ) -> Result<Self, ShapeError> {
+        Self::build(
+            "capped cone",
+            base_center,
+            axis_dir,
+            height,
+            base_radius,
+            top_radius,
+        )
+    }
+
+    /// [`CappedCone::new`], with `shape` naming the shape in errors.
+    fn build(
+        shape: &'static str,
+        base_center: Vec3,
+        axis_dir: Vec3,
+        height: f32,
+        base_radius: f32,
+        top_radius: f32,
+    ) -> Result<Self, ShapeError> {
         if !base_center.is_finite() {
-            return Err(format!(
-                "capped cone: base centre {base_center} is not finite"
+            return Err(ShapeError::parameter_not_finite(
+                shape,
+                "base centre",
+                base_center,
             ));
         }
         if !axis_dir.is_finite() {
-            return Err(format!("capped cone: axis {axis_dir} is not finite"));
+            return Err(ShapeError::parameter_not_finite(shape, "axis", axis_dir));
         }
         let a = axis_dir.as_dvec3();
         let len = a.length();
         if !(len.is_finite() && len > 0.0) {
-            return Err("capped cone: the axis direction is zero".to_string());
+            return Err(ShapeError::ZeroAxis { shape });
         }
         let axis = (a / len).as_vec3();
         if !(height > 0.0 && height.is_finite()) {
-            return Err(format!(
-                "capped cone: height {height} must be positive and finite"
-            ));
+            return Err(ShapeError::parameter_not_positive(shape, "height", height));
         }
-        for (name, r) in [("base", base_radius), ("top", top_radius)] {
-            if !(r >= 0.0 && r.is_finite()) {
-                return Err(format!(
-                    "capped cone: {name} radius {r} must be zero or positive and finite"
-                ));
+        for (end, radius) in [("base", base_radius), ("top", top_radius)] {
+            if !(radius >= 0.0 && radius.is_finite()) {
+                return Err(ShapeError::EndRadius { shape, end, radius });
             }
         }
         if base_radius == 0.0 && top_radius == 0.0 {
-            return Err("capped cone: both radii are zero (no volume)".to_string());
+            return Err(ShapeError::NoRadius { shape });
         }
         let slope = ((top_radius as f64 - base_radius as f64) / height as f64) as f32;
         if !slope.is_finite() {
-            return Err(format!(
-                "capped cone: height {height} is too small for radii {base_radius} and {top_radius}"
-            ));
+            return Err(ShapeError::TooFlat {
+                shape,
+                height,
+                base_radius,
+                top_radius,
+            });
         }
         let c = CappedCone {
             base: base_center,
@@ -149,9 +172,11 @@ impl CappedCone {
             slope,
         };
         if !c.bounds().is_finite() {
-            return Err(format!(
-                "capped cone: base {base_center}, height {height} and radii overflow"
-            ));
+            return Err(ShapeError::CappedOverflow {
+                shape,
+                base: base_center,
+                height,
+            });
         }
         Ok(c)
     }
@@ -166,14 +191,13 @@ impl CappedCone {
         axis_dir: Vec3,
         height: f32,
         radius: f32,
-    ) -> Result<Self, String> {
+    ) -> Result<Self, ShapeError> {
         if !(radius > 0.0 && radius.is_finite()) {
-            return Err(format!(
-                "cylinder: radius {radius} must be positive and finite"
+            return Err(ShapeError::parameter_not_positive(
+                "cylinder", "radius", radius,
             ));
         }
-        Self::new(base_center, axis_dir, height, radius, radius)
-            .map_err(|e| e.replacen("capped cone", "cylinder", 1))
+        Self::build("cylinder", base_center, axis_dir, height, radius, radius)
     }
 
     /// Centre of the base disk.
@@ -626,6 +650,55 @@ impl Solid for CappedCone {
         }
         let r = self.base_radius + self.slope * s;
         (q - self.axis * s).length_squared() <= r * r
+    }
+}
+
+impl CappedCone {
+    /// The cylindrical parameterisation on the side, a disk onto `[0, 1]²` on the caps
+    /// (`ng` the unit outward normal tells them apart).
+    pub fn param(&self, p: Vec3, ng: Vec3) -> Param {
+        let axis = self.axis();
+        let h = (p - self.base()).dot(axis);
+        let on_cap = ng.dot(axis).abs() > 0.999
+            && (h.abs() < 1e-3 * self.height() || (h - self.height()).abs() < 1e-3 * self.height());
+        if !on_cap {
+            let slope = (self.top_radius() - self.base_radius()) / self.height();
+            return cylindrical(p, self.base(), axis, self.height(), slope);
+        }
+        let (e1, e2) = axis_frame(axis);
+        let top = h > 0.5 * self.height();
+        let (centre, r) = if top {
+            (self.top(), self.top_radius())
+        } else {
+            (self.base(), self.base_radius())
+        };
+        let r = r.max(f32::MIN_POSITIVE);
+        let q = p - centre;
+        // The base cap faces −axis: mirror u there so that ∂p/∂u × ∂p/∂v = −axis.
+        let su = if top { 1.0 } else { -1.0 };
+        Param {
+            uv: Vec2::new(
+                0.5 + su * q.dot(e1) / (2.0 * r),
+                0.5 + q.dot(e2) / (2.0 * r),
+            ),
+            dpdu: e1 * (su * 2.0 * r),
+            dpdv: e2 * (2.0 * r),
+        }
+    }
+}
+
+impl Primitive for CappedCone {
+    fn is_solid(&self) -> bool {
+        true
+    }
+    fn spans(&self, ray: &Ray, out: &mut Spans) {
+        Solid::spans(self, ray, out)
+    }
+    fn contains(&self, p: Vec3) -> bool {
+        Solid::contains(self, p)
+    }
+    fn param(&self, p: Vec3, ng: Vec3) -> Param {
+        CappedCone::param(self, p, ng)
     }
 }
 

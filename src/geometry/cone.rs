@@ -1,4 +1,7 @@
-use super::{ShapeHit, SurfacePoint, diff_of_products, quadratic_roots};
+use super::param::cylindrical;
+use super::{
+    Intersect, Param, Primitive, ShapeHit, Spans, SurfacePoint, diff_of_products, quadratic_roots,
+};
 use crate::math::{Aabb, Ray, Vec3, gamma};
 
 /// NFF's open cone or cylinder: the lateral surface between a base disk and an apex
@@ -196,5 +199,44 @@ impl Cone {
             err: Vec3::splat(scale * gamma(32)),
             ng,
         }
+    }
+}
+
+impl Intersect for Cone {
+    fn bounds(&self) -> Aabb {
+        Cone::bounds(self)
+    }
+    #[inline]
+    fn intersect(&self, ray: &Ray) -> Option<ShapeHit> {
+        Cone::intersect(self, ray)
+    }
+    #[inline]
+    fn occluded(&self, ray: &Ray) -> bool {
+        Cone::occluded(self, ray)
+    }
+    fn surface(&self, ray: &Ray, hit: &ShapeHit) -> SurfacePoint {
+        Cone::surface(self, ray, hit.t)
+    }
+}
+
+impl Cone {
+    /// The cylindrical parameterisation at `p`.
+    pub fn param(&self, p: Vec3) -> Param {
+        let slope = (self.apex_radius - self.base_radius) / self.height();
+        cylindrical(p, self.base, self.axis(), self.height(), slope)
+    }
+}
+
+/// An open surface: not a CSG operand, no inside.
+impl Primitive for Cone {
+    fn is_solid(&self) -> bool {
+        false
+    }
+    fn spans(&self, _ray: &Ray, _out: &mut Spans) {}
+    fn contains(&self, _p: Vec3) -> bool {
+        false
+    }
+    fn param(&self, p: Vec3, _ng: Vec3) -> Param {
+        Cone::param(self, p)
     }
 }

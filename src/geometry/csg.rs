@@ -8,7 +8,9 @@
 //! flip travel in the hit's `u`/`v` so that [`Csg::surface`] can ask the leaf for the
 //! accurate point.
 
-use super::{Intersect, Shape, ShapeHit, Solid, Span, Spans, SurfacePoint};
+use super::{
+    Intersect, Param, Primitive, Shape, ShapeError, ShapeHit, Solid, Span, Spans, SurfacePoint,
+};
 use crate::math::{Aabb, Ray, Vec3, Xform};
 use smallvec::SmallVec;
 
@@ -130,7 +132,7 @@ type List = SmallVec<[(End, End); 4]>;
 impl Csg {
     /// Compile `tree`; `Err` if a leaf is not a closed solid, the result is unbounded,
     /// or the nesting is deeper than [`MAX_DEPTH`].
-    pub fn new(tree: &CsgTree) -> Result<Csg, String> {
+    pub fn new(tree: &CsgTree) -> Result<Csg, ShapeError> {
         let mut csg = Csg {
             leaves: Vec::new(),
             program: Vec::new(),
@@ -138,10 +140,7 @@ impl Csg {
         };
         let bounds = csg.compile(tree, None, 1)?;
         if !bounds.is_finite() && !bounds.is_empty() {
-            return Err(
-                "the CSG solid is unbounded (intersect unbounded operands with a bounded solid)"
-                    .into(),
-            );
+            return Err(ShapeError::CsgUnbounded);
         }
         csg.bounds = bounds;
         Ok(csg)
@@ -152,17 +151,14 @@ impl Csg {
         tree: &CsgTree,
         xform: Option<Xform>,
         level: usize,
-    ) -> Result<Aabb, String> {
+    ) -> Result<Aabb, ShapeError> {
         if level > MAX_DEPTH {
-            return Err(format!("CSG nested deeper than {MAX_DEPTH} levels"));
+            return Err(ShapeError::CsgTooDeep);
         }
         match tree {
             CsgTree::Leaf { shape, material } => {
                 if !shape.is_solid() {
-                    return Err(format!(
-                        "a {} is not a closed solid and cannot be a CSG operand",
-                        shape.kind().singular()
-                    ));
+                    return Err(ShapeError::NotSolid(shape.kind()));
                 }
                 let b = shape.bounds();
                 let b = match &xform {
@@ -172,7 +168,7 @@ impl Csg {
                 let id = u32::try_from(self.leaves.len())
                     .ok()
                     .filter(|&i| i < 1 << 23)
-                    .ok_or("too many CSG leaves")?;
+                    .ok_or(ShapeError::CsgTooManyLeaves)?;
                 self.leaves.push(Leaf {
                     shape: shape.clone(),
                     xform,
@@ -423,5 +419,26 @@ impl Solid for Csg {
             }
         }
         stack.pop().unwrap_or(false)
+    }
+}
+
+impl Primitive for Csg {
+    fn is_solid(&self) -> bool {
+        true
+    }
+    fn spans(&self, ray: &Ray, out: &mut Spans) {
+        Solid::spans(self, ray, out)
+    }
+    fn contains(&self, p: Vec3) -> bool {
+        Solid::contains(self, p)
+    }
+    /// The planar parameterisation about the normal ([`Param::planar`]).
+    fn param(&self, p: Vec3, ng: Vec3) -> Param {
+        Param::planar(p, ng)
+    }
+    /// The material of the leaf hit, if it has its own.
+    fn material(&self, hit: &ShapeHit, own: u32) -> u32 {
+        let (leaf, _) = Csg::hit_leaf(hit);
+        self.leaf_material(leaf).unwrap_or(own)
     }
 }

@@ -3,14 +3,20 @@
 //! The pure-Rust BVH calls them from its leaves; the Embree backend calls the very same
 //! functions from its user-geometry callbacks, so the two backends agree by
 //! construction on everything but triangles (which Embree intersects natively).
-//! Every intersector has a double-precision reference in [`reference`] used by the
-//! tests to bound the f32 error.
+//! Every intersector has a double-precision reference in [`reference`](mod@reference)
+//! used by the tests to bound the f32 error.
+//!
+//! The primitive kinds are listed once, in the table behind [`Kind`] and [`Shape`]:
+//! adding an analytic primitive means its own file (the type and its [`Intersect`],
+//! [`Primitive`] and [`Solid`] impls) plus one row in that table.
 
 pub mod bezier;
 mod boxes;
 mod capped;
 mod cone;
 pub mod csg;
+mod error;
+mod kinds;
 mod param;
 mod plane;
 pub mod polygon;
@@ -25,9 +31,12 @@ pub use boxes::{AaBox, OBox};
 pub use capped::CappedCone;
 pub use cone::Cone;
 pub use csg::{Csg, CsgOp, CsgTree};
+pub use error::ShapeError;
+pub(crate) use kinds::for_each_kind;
+pub use kinds::{Analytic, Kind, Primitive, Shape};
 pub use param::{Param, QuadUv, inverse_bilinear};
 pub use plane::Plane;
-pub use polyhedron::Polyhedron;
+pub use polyhedron::{MAX_PLANES, Polyhedron};
 pub use quadric::Quadric;
 pub use sphere::Sphere;
 pub use torus::Torus;
@@ -37,7 +46,6 @@ pub use triangle::{Triangle, WatertightRay};
 pub use crate::math::SurfacePoint;
 
 use crate::math::{Aabb, Ray, Vec3};
-use std::sync::Arc;
 
 /// What an intersector reports: the distance, two surface parameters and the
 /// (unnormalised) geometric normal, which for closed shapes points outwards.
@@ -102,236 +110,6 @@ pub trait Solid: Intersect {
     fn contains(&self, p: Vec3) -> bool;
 }
 
-/// The primitive kinds. The discriminant is the geometry id both backends report in
-/// [`crate::Hit::geom_id`].
-#[derive(Clone, Copy, Debug, PartialEq, Eq, Hash, PartialOrd, Ord)]
-#[repr(u32)]
-pub enum Kind {
-    /// Triangles (NFF `p` and `pp`, meshes, tessellated patches).
-    Triangle = 0,
-    /// Spheres (NFF `s`).
-    Sphere = 1,
-    /// Open cones and cylinders (NFF `c`).
-    Cone = 2,
-    /// Constructive solid geometry roots.
-    Csg = 3,
-    /// General quadrics, optionally clipped to a box.
-    Quadric = 4,
-    /// Capped (closed) cones and cylinders.
-    CappedCone = 5,
-    /// Axis-aligned boxes.
-    Box = 6,
-    /// Oriented boxes.
-    OBox = 7,
-    /// Convex polyhedra.
-    Polyhedron = 8,
-    /// Infinite planes.
-    Plane = 9,
-    /// Tori.
-    Torus = 10,
-}
-
-impl Kind {
-    /// All kinds in geometry-id order.
-    pub const ALL: [Kind; 11] = [
-        Kind::Triangle,
-        Kind::Sphere,
-        Kind::Cone,
-        Kind::Csg,
-        Kind::Quadric,
-        Kind::CappedCone,
-        Kind::Box,
-        Kind::OBox,
-        Kind::Polyhedron,
-        Kind::Plane,
-        Kind::Torus,
-    ];
-
-    /// The kind with geometry id `id`.
-    pub fn from_id(id: u32) -> Option<Kind> {
-        Kind::ALL.get(id as usize).copied()
-    }
-
-    /// Plural name used in statistics (`triangles`, `spheres`, `cones`, ...).
-    pub fn name(self) -> &'static str {
-        match self {
-            Kind::Triangle => "triangles",
-            Kind::Sphere => "spheres",
-            Kind::Cone => "cones",
-            Kind::Csg => "csg",
-            Kind::Quadric => "quadrics",
-            Kind::CappedCone => "capped_cones",
-            Kind::Box => "boxes",
-            Kind::OBox => "oriented_boxes",
-            Kind::Polyhedron => "polyhedra",
-            Kind::Plane => "planes",
-            Kind::Torus => "tori",
-        }
-    }
-
-    /// Singular name for messages.
-    pub fn singular(self) -> &'static str {
-        match self {
-            Kind::Triangle => "triangle",
-            Kind::Sphere => "sphere",
-            Kind::Cone => "open cone",
-            Kind::Csg => "CSG solid",
-            Kind::Quadric => "quadric",
-            Kind::CappedCone => "capped cone",
-            Kind::Box => "box",
-            Kind::OBox => "oriented box",
-            Kind::Polyhedron => "polyhedron",
-            Kind::Plane => "plane",
-            Kind::Torus => "torus",
-        }
-    }
-}
-
-/// An analytic primitive, intersected by user geometry on Embree.
-#[derive(Clone, Debug, PartialEq)]
-pub enum Shape {
-    /// A sphere.
-    Sphere(Sphere),
-    /// An open cone or cylinder.
-    Cone(Cone),
-    /// A CSG root.
-    Csg(Arc<Csg>),
-    /// A general quadric.
-    Quadric(Arc<Quadric>),
-    /// A capped cone or cylinder.
-    CappedCone(Arc<CappedCone>),
-    /// An axis-aligned box.
-    Box(AaBox),
-    /// An oriented box.
-    OBox(Arc<OBox>),
-    /// A convex polyhedron.
-    Polyhedron(Arc<Polyhedron>),
-    /// An infinite plane.
-    Plane(Plane),
-    /// A torus.
-    Torus(Arc<Torus>),
-}
-
-/// Call `$f` on the primitive inside any [`Shape`].
-macro_rules! dispatch {
-    ($shape:expr, $s:ident => $e:expr) => {
-        match $shape {
-            Shape::Sphere($s) => $e,
-            Shape::Cone($s) => $e,
-            Shape::Csg(c) => {
-                let $s: &Csg = c;
-                $e
-            }
-            Shape::Quadric(c) => {
-                let $s: &Quadric = c;
-                $e
-            }
-            Shape::CappedCone(c) => {
-                let $s: &CappedCone = c;
-                $e
-            }
-            Shape::Box($s) => $e,
-            Shape::OBox(c) => {
-                let $s: &OBox = c;
-                $e
-            }
-            Shape::Polyhedron(c) => {
-                let $s: &Polyhedron = c;
-                $e
-            }
-            Shape::Plane($s) => $e,
-            Shape::Torus(c) => {
-                let $s: &Torus = c;
-                $e
-            }
-        }
-    };
-}
-
-impl Shape {
-    /// The kind (geometry id) of this shape.
-    pub fn kind(&self) -> Kind {
-        match self {
-            Shape::Sphere(_) => Kind::Sphere,
-            Shape::Cone(_) => Kind::Cone,
-            Shape::Csg(_) => Kind::Csg,
-            Shape::Quadric(_) => Kind::Quadric,
-            Shape::CappedCone(_) => Kind::CappedCone,
-            Shape::Box(_) => Kind::Box,
-            Shape::OBox(_) => Kind::OBox,
-            Shape::Polyhedron(_) => Kind::Polyhedron,
-            Shape::Plane(_) => Kind::Plane,
-            Shape::Torus(_) => Kind::Torus,
-        }
-    }
-
-    /// Whether this is a closed solid (usable as a CSG operand).
-    pub fn is_solid(&self) -> bool {
-        match self {
-            Shape::Sphere(s) => !s.inside_only,
-            Shape::Cone(_) => false,
-            // A quadric is a solid where {F <= 0} is bounded (clipped or an ellipsoid).
-            Shape::Quadric(q) => q.is_bounded(),
-            // The plane's half-space: unbounded, but usable to cut bounded solids.
-            Shape::Plane(_) => true,
-            _ => true,
-        }
-    }
-
-    /// Append the spans of the whole line inside the solid (nothing for open surfaces).
-    #[inline]
-    pub fn spans(&self, ray: &Ray, out: &mut Spans) {
-        match self {
-            Shape::Sphere(s) => s.spans(ray, out),
-            Shape::Cone(_) => {}
-            Shape::Csg(c) => c.spans(ray, out),
-            Shape::Quadric(c) => c.spans(ray, out),
-            Shape::CappedCone(c) => c.spans(ray, out),
-            Shape::Box(c) => c.spans(ray, out),
-            Shape::OBox(c) => c.spans(ray, out),
-            Shape::Polyhedron(c) => c.spans(ray, out),
-            Shape::Plane(c) => c.spans(ray, out),
-            Shape::Torus(c) => c.spans(ray, out),
-        }
-    }
-
-    /// Whether `p` is inside the solid (false for open surfaces).
-    pub fn contains(&self, p: Vec3) -> bool {
-        match self {
-            Shape::Sphere(s) => s.contains(p),
-            Shape::Cone(_) => false,
-            Shape::Csg(c) => c.contains(p),
-            Shape::Quadric(c) => c.contains(p),
-            Shape::CappedCone(c) => c.contains(p),
-            Shape::Box(c) => c.contains(p),
-            Shape::OBox(c) => c.contains(p),
-            Shape::Polyhedron(c) => c.contains(p),
-            Shape::Plane(c) => c.contains(p),
-            Shape::Torus(c) => c.contains(p),
-        }
-    }
-}
-
-impl Intersect for Shape {
-    fn bounds(&self) -> Aabb {
-        dispatch!(self, s => Intersect::bounds(s))
-    }
-
-    #[inline]
-    fn intersect(&self, ray: &Ray) -> Option<ShapeHit> {
-        dispatch!(self, s => Intersect::intersect(s, ray))
-    }
-
-    #[inline]
-    fn occluded(&self, ray: &Ray) -> bool {
-        dispatch!(self, s => Intersect::occluded(s, ray))
-    }
-
-    fn surface(&self, ray: &Ray, hit: &ShapeHit) -> SurfacePoint {
-        dispatch!(self, s => Intersect::surface(s, ray, hit))
-    }
-}
-
 /// `a·b − c·d` without cancellation: both products are exact in f64 (24 + 24 bits of
 /// significand fit in 53), so the result is rounded once in f64 and once to f32, within
 /// about half an f32 ulp of the exact value. (Kahan's algorithm with two fused
@@ -362,59 +140,6 @@ pub(crate) fn quadratic_roots(a: f32, b: f32, c: f32, disc: f32) -> (f32, f32) {
         (r_cq, r_qa)
     } else {
         (r_qa, r_cq)
-    }
-}
-
-impl Intersect for Sphere {
-    fn bounds(&self) -> Aabb {
-        Sphere::bounds(self)
-    }
-    #[inline]
-    fn intersect(&self, ray: &Ray) -> Option<ShapeHit> {
-        Sphere::intersect(self, ray)
-    }
-    #[inline]
-    fn occluded(&self, ray: &Ray) -> bool {
-        Sphere::occluded(self, ray)
-    }
-    fn surface(&self, ray: &Ray, hit: &ShapeHit) -> SurfacePoint {
-        Sphere::surface(self, ray, hit.t)
-    }
-}
-
-impl Intersect for Cone {
-    fn bounds(&self) -> Aabb {
-        Cone::bounds(self)
-    }
-    #[inline]
-    fn intersect(&self, ray: &Ray) -> Option<ShapeHit> {
-        Cone::intersect(self, ray)
-    }
-    #[inline]
-    fn occluded(&self, ray: &Ray) -> bool {
-        Cone::occluded(self, ray)
-    }
-    fn surface(&self, ray: &Ray, hit: &ShapeHit) -> SurfacePoint {
-        Cone::surface(self, ray, hit.t)
-    }
-}
-
-impl Solid for Sphere {
-    fn spans(&self, ray: &Ray, out: &mut Spans) {
-        if let Some((t0, t1)) = self.roots(ray) {
-            if t0 <= t1 {
-                out.push(Span {
-                    t_in: t0,
-                    n_in: ray.at(t0) - self.center,
-                    t_out: t1,
-                    n_out: ray.at(t1) - self.center,
-                });
-            }
-        }
-    }
-
-    fn contains(&self, p: Vec3) -> bool {
-        (p - self.center).length_squared() <= self.radius * self.radius
     }
 }
 

@@ -19,10 +19,10 @@
 //! At the poles of the sphere and the apex of a cone `∂p/∂u` vanishes; there it is
 //! replaced by the tangent of the nearest regular point, so the frame never has a NaN.
 
-use super::{CappedCone, Cone, Shape, Sphere, Torus, Triangle};
+use super::Triangle;
 use crate::math::{Frame, Vec3};
 use glam::Vec2;
-use std::f32::consts::{PI, TAU};
+use std::f32::consts::TAU;
 
 /// A point's texture coordinates and surface tangents.
 #[derive(Clone, Copy, Debug, PartialEq)]
@@ -49,11 +49,11 @@ impl Param {
 }
 
 /// Smallest sine of the polar angle used for `∂p/∂u` (poles and apices).
-const MIN_SIN: f32 = 1e-4;
+pub(super) const MIN_SIN: f32 = 1e-4;
 
 /// `atan2(y, x) / 2π` in `[0, 1)`.
 #[inline]
-fn turn(y: f32, x: f32) -> f32 {
+pub(super) fn turn(y: f32, x: f32) -> f32 {
     let a = y.atan2(x) / TAU;
     if a < 0.0 {
         (a + 1.0).min(next_below_one())
@@ -68,35 +68,14 @@ fn next_below_one() -> f32 {
 }
 
 /// Two unit vectors completing the unit `axis` to a right-handed frame `(e1, e2, axis)`.
-fn axis_frame(axis: Vec3) -> (Vec3, Vec3) {
+pub(super) fn axis_frame(axis: Vec3) -> (Vec3, Vec3) {
     let f = Frame::from_z(axis);
     (f.x, f.y)
 }
 
-impl Sphere {
-    /// The spherical parameterisation at `p` (see the module documentation).
-    pub fn param(&self, p: Vec3) -> Param {
-        let q = ((p - self.center) / self.radius).clamp(Vec3::splat(-1.0), Vec3::splat(1.0));
-        let phi = q.x.atan2(q.z);
-        let u = turn(q.x, q.z);
-        let theta = q.y.clamp(-1.0, 1.0).acos();
-        let (sin_t, cos_t) = theta.sin_cos();
-        let (sin_p, cos_p) = phi.sin_cos();
-        let r = self.radius;
-        let dpdu = Vec3::new(cos_p, 0.0, -sin_p) * (TAU * r * sin_t.max(MIN_SIN));
-        // v = 1 − θ/π, so ∂p/∂v = −π ∂p/∂θ.
-        let dpdv = Vec3::new(cos_t * sin_p, -sin_t, cos_t * cos_p) * (-PI * r);
-        Param {
-            uv: Vec2::new(u, 1.0 - theta / PI),
-            dpdu,
-            dpdv,
-        }
-    }
-}
-
 /// The cylindrical parameterisation about the axis through `base` with unit `axis`,
 /// length `height` and radius growing by `slope` per unit of height.
-fn cylindrical(p: Vec3, base: Vec3, axis: Vec3, height: f32, slope: f32) -> Param {
+pub(super) fn cylindrical(p: Vec3, base: Vec3, axis: Vec3, height: f32, slope: f32) -> Param {
     let (e1, e2) = axis_frame(axis);
     let q = p - base;
     let h = q.dot(axis);
@@ -113,73 +92,9 @@ fn cylindrical(p: Vec3, base: Vec3, axis: Vec3, height: f32, slope: f32) -> Para
     }
 }
 
-impl Cone {
-    /// The cylindrical parameterisation at `p`.
-    pub fn param(&self, p: Vec3) -> Param {
-        let slope = (self.apex_radius - self.base_radius) / self.height();
-        cylindrical(p, self.base, self.axis(), self.height(), slope)
-    }
-}
-
-impl CappedCone {
-    /// The cylindrical parameterisation on the side, a disk onto `[0, 1]²` on the caps
-    /// (`ng` the unit outward normal tells them apart).
-    pub fn param(&self, p: Vec3, ng: Vec3) -> Param {
-        let axis = self.axis();
-        let h = (p - self.base()).dot(axis);
-        let on_cap = ng.dot(axis).abs() > 0.999
-            && (h.abs() < 1e-3 * self.height() || (h - self.height()).abs() < 1e-3 * self.height());
-        if !on_cap {
-            let slope = (self.top_radius() - self.base_radius()) / self.height();
-            return cylindrical(p, self.base(), axis, self.height(), slope);
-        }
-        let (e1, e2) = axis_frame(axis);
-        let top = h > 0.5 * self.height();
-        let (centre, r) = if top {
-            (self.top(), self.top_radius())
-        } else {
-            (self.base(), self.base_radius())
-        };
-        let r = r.max(f32::MIN_POSITIVE);
-        let q = p - centre;
-        // The base cap faces −axis: mirror u there so that ∂p/∂u × ∂p/∂v = −axis.
-        let su = if top { 1.0 } else { -1.0 };
-        Param {
-            uv: Vec2::new(
-                0.5 + su * q.dot(e1) / (2.0 * r),
-                0.5 + q.dot(e2) / (2.0 * r),
-            ),
-            dpdu: e1 * (su * 2.0 * r),
-            dpdv: e2 * (2.0 * r),
-        }
-    }
-}
-
-impl Torus {
-    /// The toroidal parameterisation at `p`.
-    pub fn param(&self, p: Vec3) -> Param {
-        let (ex, ey, a) = self.frame();
-        let (big, small) = (self.major_radius(), self.minor_radius());
-        let q = p - self.center();
-        let (x, y, z) = (q.dot(ex), q.dot(ey), q.dot(a));
-        let rho = x.hypot(y);
-        let phi = y.atan2(x);
-        let psi = z.atan2(rho - big);
-        let (sp, cp) = phi.sin_cos();
-        let (ss, cs) = psi.sin_cos();
-        let radial = ex * cp + ey * sp;
-        let tangent = ey * cp - ex * sp;
-        Param {
-            uv: Vec2::new(turn(y, x), turn(z, rho - big)),
-            dpdu: tangent * (TAU * (big + small * cs).max(MIN_SIN * small)),
-            dpdv: (a * cs - radial * ss) * (TAU * small),
-        }
-    }
-}
-
 /// The face parameterisation of a box with centre `c`, half extents `half` along the
 /// unit axes `axes`, at `p` with unit outward normal `ng`.
-fn box_param(p: Vec3, ng: Vec3, c: Vec3, half: Vec3, axes: [Vec3; 3]) -> Param {
+pub(super) fn box_param(p: Vec3, ng: Vec3, c: Vec3, half: Vec3, axes: [Vec3; 3]) -> Param {
     let q = p - c;
     let local = Vec3::new(q.dot(axes[0]), q.dot(axes[1]), q.dot(axes[2]));
     let nl = Vec3::new(ng.dot(axes[0]), ng.dot(axes[1]), ng.dot(axes[2]));
@@ -197,33 +112,6 @@ fn box_param(p: Vec3, ng: Vec3, c: Vec3, half: Vec3, axes: [Vec3; 3]) -> Param {
         uv: Vec2::new(0.5 + us * local[ua] / wu, 0.5 + vs * local[va] / wv),
         dpdu: axes[ua] * (us * wu),
         dpdv: axes[va] * (vs * wv),
-    }
-}
-
-impl Shape {
-    /// The texture coordinates and tangents at `p`, a point on the shape with unit
-    /// outward geometric normal `ng` (see the module documentation).
-    pub fn param(&self, p: Vec3, ng: Vec3) -> Param {
-        match self {
-            Shape::Sphere(s) => s.param(p),
-            Shape::Cone(c) => c.param(p),
-            Shape::CappedCone(c) => c.param(p, ng),
-            Shape::Torus(t) => t.param(p),
-            Shape::Box(b) => {
-                let (min, max) = (b.min(), b.max());
-                box_param(
-                    p,
-                    ng,
-                    (min + max) * 0.5,
-                    (max - min) * 0.5,
-                    [Vec3::X, Vec3::Y, Vec3::Z],
-                )
-            }
-            Shape::OBox(b) => box_param(p, ng, b.center(), b.half_extents(), b.axes()),
-            Shape::Plane(_) | Shape::Quadric(_) | Shape::Polyhedron(_) | Shape::Csg(_) => {
-                Param::planar(p, ng)
-            }
-        }
     }
 }
 
@@ -397,6 +285,7 @@ impl QuadUv {
 #[cfg(test)]
 mod tests {
     use super::*;
+    use crate::geometry::{Cone, Primitive, Shape, Sphere, Torus};
 
     fn assert_frame_outward(param: &Param, n: Vec3) {
         let c = param.dpdu.cross(param.dpdv);

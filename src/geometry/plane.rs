@@ -5,7 +5,7 @@
 //! the surface point are rounded to f32.
 
 use super::quadric::{check_finite, gamma64, rounding_err, unit_axis};
-use super::{Intersect, ShapeHit, Solid, Span, Spans, SurfacePoint};
+use super::{Intersect, Param, Primitive, ShapeError, ShapeHit, Solid, Span, Spans, SurfacePoint};
 use crate::math::{Aabb, DVec3, Ray, Vec3};
 
 /// An infinite plane `n·x = d` (unit `n`); as a solid, the half-space `n·x ≤ d`, so the
@@ -23,18 +23,18 @@ pub struct Plane {
 impl Plane {
     /// The plane `normal·x = offset` (any non-zero length of `normal`; both are divided
     /// by it in f64).
-    pub fn new(normal: Vec3, offset: f32) -> Result<Self, String> {
+    pub fn new(normal: Vec3, offset: f32) -> Result<Self, ShapeError> {
         let len = normal.as_dvec3().length();
         let n = unit_axis("plane normal", normal)?;
         if !offset.is_finite() {
-            return Err(format!("plane offset is not finite ({offset})"));
+            return Err(ShapeError::PlaneOffset(offset));
         }
         Ok(Self::from_unit(n, offset as f64 / len))
     }
 
     /// The plane through `point` perpendicular to `normal` (any non-zero length),
     /// with `normal` pointing out of the half-space.
-    pub fn from_point_normal(point: Vec3, normal: Vec3) -> Result<Self, String> {
+    pub fn from_point_normal(point: Vec3, normal: Vec3) -> Result<Self, ShapeError> {
         check_finite("plane point", point)?;
         let n = unit_axis("plane normal", normal)?;
         Ok(Self::from_unit(n, n.dot(point.as_dvec3())))
@@ -155,6 +155,23 @@ impl Solid for Plane {
     }
     fn contains(&self, p: Vec3) -> bool {
         Plane::contains(self, p)
+    }
+}
+
+impl Primitive for Plane {
+    /// The half-space: unbounded, but usable to cut bounded solids.
+    fn is_solid(&self) -> bool {
+        true
+    }
+    fn spans(&self, ray: &Ray, out: &mut Spans) {
+        Solid::spans(self, ray, out)
+    }
+    fn contains(&self, p: Vec3) -> bool {
+        Solid::contains(self, p)
+    }
+    /// The planar parameterisation about the normal ([`Param::planar`]).
+    fn param(&self, p: Vec3, ng: Vec3) -> Param {
+        Param::planar(p, ng)
     }
 }
 

@@ -11,7 +11,7 @@
 //! world origin keeps offsets of its own size and a ray starting near it evaluates them
 //! without cancellation.
 
-use super::{Intersect, ShapeHit, Solid, Span, Spans, SurfacePoint};
+use super::{Intersect, Param, Primitive, ShapeError, ShapeHit, Solid, Span, Spans, SurfacePoint};
 use crate::math::{Aabb, DVec3, Ray, Vec3, gamma, next_float_down, next_float_up};
 
 /// The most planes a polyhedron may have (validation enumerates plane triples).
@@ -121,25 +121,23 @@ impl Polyhedron {
     /// # Errors
     /// With fewer than 4 or more than [`MAX_PLANES`] planes, a non-finite number or zero
     /// normal, or when the planes bound no volume (empty, flat or unbounded).
-    pub fn new(planes: Vec<(Vec3, f32)>) -> Result<Self, String> {
+    pub fn new(planes: Vec<(Vec3, f32)>) -> Result<Self, ShapeError> {
         if planes.len() < 4 {
-            return Err(format!(
-                "polyhedron: {} planes given, at least 4 needed",
-                planes.len()
-            ));
+            return Err(ShapeError::TooFewPlanes(planes.len()));
         }
         let mut local = Vec::with_capacity(planes.len());
         for (i, &(n, d)) in planes.iter().enumerate() {
             if !n.is_finite() || !d.is_finite() {
-                return Err(format!(
-                    "polyhedron: plane {} ({n}, {d}) is not finite",
-                    i + 1
-                ));
+                return Err(ShapeError::PlaneNotFinite {
+                    index: i + 1,
+                    normal: n,
+                    offset: d,
+                });
             }
             let nd = n.as_dvec3();
             let len = nd.length();
             if !(len.is_finite() && len > 0.0) {
-                return Err(format!("polyhedron: plane {} has a zero normal", i + 1));
+                return Err(ShapeError::PlaneZeroNormal(i + 1));
             }
             local.push((nd / len, d as f64 / len));
         }
@@ -157,13 +155,19 @@ impl Polyhedron {
     /// # Errors
     /// For an unknown name, a non-finite centre or radius, or a radius that is not
     /// positive.
-    pub fn preset(name: &str, center: Vec3, radius: f32) -> Result<Self, String> {
+    pub fn preset(name: &str, center: Vec3, radius: f32) -> Result<Self, ShapeError> {
         if !center.is_finite() {
-            return Err(format!("polyhedron {name}: centre {center} is not finite"));
+            return Err(ShapeError::parameter_not_finite(
+                format!("polyhedron {name}"),
+                "centre",
+                center,
+            ));
         }
         if !(radius > 0.0 && radius.is_finite()) {
-            return Err(format!(
-                "polyhedron {name}: radius {radius} must be positive and finite"
+            return Err(ShapeError::parameter_not_positive(
+                format!("polyhedron {name}"),
+                "radius",
+                radius,
             ));
         }
         let r = radius as f64;
@@ -238,10 +242,9 @@ impl Polyhedron {
                 inradius = r * ico_ratio;
             }
             _ => {
-                return Err(format!(
-                    "unknown polyhedron {name:?} (known: {})",
-                    Self::PRESETS.join(", ")
-                ));
+                return Err(ShapeError::UnknownPolyhedron {
+                    name: name.to_string(),
+                });
             }
         }
         let planes = normals
@@ -249,7 +252,7 @@ impl Polyhedron {
             .map(|n| (n.normalize(), inradius))
             .collect();
         Self::build(center.as_dvec3(), planes)
-            .map_err(|e| format!("polyhedron {name} of radius {radius} at {center}: {e}"))
+            .map_err(|e| e.within(format!("polyhedron {name} of radius {radius} at {center}")))
     }
 
     /// A right prism over a regular `sides`-gon of circumradius `radius`, with its axis
@@ -259,24 +262,21 @@ impl Polyhedron {
     /// # Errors
     /// With fewer than 3 sides (or more than [`MAX_PLANES`] − 2), a non-finite centre,
     /// or a radius or height that is not positive and finite.
-    pub fn prism(center: Vec3, sides: u32, radius: f32, height: f32) -> Result<Self, String> {
+    pub fn prism(center: Vec3, sides: u32, radius: f32, height: f32) -> Result<Self, ShapeError> {
         if sides < 3 || sides as usize > MAX_PLANES - 2 {
-            return Err(format!(
-                "prism: {sides} sides (between 3 and {} allowed)",
-                MAX_PLANES - 2
-            ));
+            return Err(ShapeError::PrismSides { sides });
         }
         if !center.is_finite() {
-            return Err(format!("prism: centre {center} is not finite"));
+            return Err(ShapeError::parameter_not_finite("prism", "centre", center));
         }
         if !(radius > 0.0 && radius.is_finite()) {
-            return Err(format!(
-                "prism: radius {radius} must be positive and finite"
+            return Err(ShapeError::parameter_not_positive(
+                "prism", "radius", radius,
             ));
         }
         if !(height > 0.0 && height.is_finite()) {
-            return Err(format!(
-                "prism: height {height} must be positive and finite"
+            return Err(ShapeError::parameter_not_positive(
+                "prism", "height", height,
             ));
         }
         let n = sides as f64;
@@ -291,17 +291,14 @@ impl Polyhedron {
         planes.push((DVec3::Z, 0.5 * height as f64));
         planes.push((-DVec3::Z, 0.5 * height as f64));
         Self::build(center.as_dvec3(), planes)
-            .map_err(|e| format!("prism of {sides} sides at {center}: {e}"))
+            .map_err(|e| e.within(format!("prism of {sides} sides at {center}")))
     }
 
     /// Validate the planes `n·(x − center) ≤ d` (unit normals, in f64), compute the
     /// bounds and store the planes relative to their centre.
-    fn build(center: DVec3, planes: Vec<(DVec3, f64)>) -> Result<Self, String> {
+    fn build(center: DVec3, planes: Vec<(DVec3, f64)>) -> Result<Self, ShapeError> {
         if planes.len() > MAX_PLANES {
-            return Err(format!(
-                "{} planes (at most {MAX_PLANES} allowed)",
-                planes.len()
-            ));
+            return Err(ShapeError::TooManyPlanes(planes.len()));
         }
         // The normals as they will be stored (in f32).
         let planes: Vec<(DVec3, f64)> = planes
@@ -311,16 +308,12 @@ impl Polyhedron {
         let scale = planes.iter().fold(0.0f64, |m, &(_, d)| m.max(d.abs()));
         let verts = corners(&planes, 1e-6 * scale.max(f64::MIN_POSITIVE));
         if verts.is_empty() {
-            return Err(
-                "the planes have no common corner: they enclose no volume or an unbounded one"
-                    .to_string(),
-            );
+            return Err(ShapeError::NoCorner);
         }
         if let Some(v) = recession(&planes) {
-            return Err(format!(
-                "the planes enclose an unbounded region (open towards {:.4})",
-                v.as_vec3()
-            ));
+            return Err(ShapeError::OpenPolyhedron {
+                towards: v.as_vec3(),
+            });
         }
         let (lo, hi) = verts.iter().fold(
             (DVec3::splat(f64::INFINITY), DVec3::splat(f64::NEG_INFINITY)),
@@ -332,7 +325,7 @@ impl Polyhedron {
             .iter()
             .fold(f64::INFINITY, |m, &(n, d)| m.min(d - n.dot(mean)));
         if size.is_nan() || size <= 0.0 || depth.is_nan() || depth <= 1e-5 * size {
-            return Err("the planes enclose no volume (flat or empty)".to_string());
+            return Err(ShapeError::FlatPolyhedron);
         }
         // World bounds, widened for the corner tolerance and the rounding of the offsets.
         let (wlo, whi) = (center + lo, center + hi);
@@ -351,7 +344,7 @@ impl Polyhedron {
             ),
         };
         if !bounds.is_finite() {
-            return Err("the polyhedron's bounds overflow".to_string());
+            return Err(ShapeError::PolyhedronOverflow);
         }
         let shift = bounds.centroid().as_dvec3() - center;
         let planes: Box<[Plane]> = planes
@@ -585,6 +578,22 @@ impl Solid for Polyhedron {
     fn contains(&self, p: Vec3) -> bool {
         let o = p - self.origin();
         self.planes.iter().all(|pl| pl.n.dot(o) <= pl.d)
+    }
+}
+
+impl Primitive for Polyhedron {
+    fn is_solid(&self) -> bool {
+        true
+    }
+    fn spans(&self, ray: &Ray, out: &mut Spans) {
+        Solid::spans(self, ray, out)
+    }
+    fn contains(&self, p: Vec3) -> bool {
+        Solid::contains(self, p)
+    }
+    /// The planar parameterisation about the normal ([`Param::planar`]).
+    fn param(&self, p: Vec3, ng: Vec3) -> Param {
+        Param::planar(p, ng)
     }
 }
 

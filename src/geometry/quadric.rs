@@ -32,7 +32,7 @@
 //!
 //! Only the results (`t`, normals, points) are rounded to f32.
 
-use super::{Intersect, ShapeHit, Solid, Span, Spans, SurfacePoint};
+use super::{Intersect, Param, Primitive, ShapeError, ShapeHit, Solid, Span, Spans, SurfacePoint};
 use crate::math::{Aabb, DVec3, Ray, Vec3, next_float_down, next_float_up};
 use glam::DMat3;
 
@@ -95,33 +95,106 @@ pub(super) fn rounding_err(p: Vec3, delta: f64) -> Vec3 {
     ulp + Vec3::splat(f32_up(delta))
 }
 
+/// The quadric constructors' checks of their input: finite coefficients, not all of
+/// the second- and first-order ones zero, and a finite clip box with volume.
+fn check_input(coeffs: &[f64; 10], clip: Option<Aabb>) -> Result<(), ShapeError> {
+    if let Some(k) = coeffs.iter().position(|c| !c.is_finite()) {
+        return Err(ShapeError::QuadricCoefficient {
+            name: "abcdefghij".as_bytes()[k] as char,
+            value: coeffs[k],
+        });
+    }
+    if let Some(b) = clip {
+        if !b.is_finite() {
+            return Err(ShapeError::ClipNotFinite);
+        }
+        if !(b.min.cmplt(b.max).all()) {
+            return Err(ShapeError::ClipEmpty {
+                min: b.min,
+                max: b.max,
+            });
+        }
+    }
+    if coeffs[..9].iter().all(|&c| c == 0.0) {
+        return Err(ShapeError::QuadricNoTerms);
+    }
+    Ok(())
+}
+
+/// The bounds of an ellipsoid `pᵀMp + 2lᵀp + j ≤ 0` about `origin`, given the
+/// eigen-decomposition `lam`, `vecs` of `M` (eigenvalues below `tol` count as zero):
+/// `None` unless `M` is positive definite and the solid is not empty.
+fn ellipsoid_bounds(
+    lam: &[f64; 3],
+    vecs: &[DVec3; 3],
+    l: DVec3,
+    j: f64,
+    origin: DVec3,
+    tol: f64,
+) -> Option<Aabb> {
+    let lam_max = lam.iter().fold(0.0f64, |a, x| a.max(x.abs()));
+    let lam_min = lam.iter().fold(f64::INFINITY, |a, &x| a.min(x));
+    if lam_min <= tol {
+        return None;
+    }
+    // The tangent planes x_k = const satisfy πᵀ adj(Q) π = 0 (the dual quadric), which
+    // for F = (p − c)ᵀM(p − c) + k reduces to c_k ± √(−k·(M⁻¹)_kk). The diagonal of
+    // M⁻¹ = Σᵢ vᵢvᵢᵀ/λᵢ is a sum of positive terms, so it is formed from the
+    // eigen-decomposition instead of the adjugate: no cancellation, and an axis-aligned
+    // ellipsoid gets its exact box.
+    let mut diag = DVec3::ZERO;
+    let mut c = DVec3::ZERO;
+    for i in 0..3 {
+        diag += vecs[i] * vecs[i] / lam[i];
+        c -= vecs[i] * (vecs[i].dot(l) / lam[i]);
+    }
+    let k = j + l.dot(c);
+    if !(k < 0.0 && diag.is_finite()) {
+        return None;
+    }
+    let half = diag * -k;
+    let half = DVec3::new(half.x.sqrt(), half.y.sqrt(), half.z.sqrt());
+    // The eigenvalues' relative error (Jacobi on a definite matrix) is a small multiple
+    // of ε, degrading at worst with the condition number.
+    let rel = 1e-13 + 4.0 * f64::EPSILON * (lam_max / lam_min);
+    let slack = (half + c.abs() + origin.abs()) * rel;
+    let centre_w = origin + c;
+    Some(aabb_out(centre_w - half - slack, centre_w + half + slack))
+}
+
 /// Checks that a vector is finite, for constructors.
-pub(super) fn check_finite(what: &str, v: Vec3) -> Result<(), String> {
+pub(super) fn check_finite(what: &str, v: Vec3) -> Result<(), ShapeError> {
     if v.is_finite() {
         Ok(())
     } else {
-        Err(format!("{what} ({}, {}, {}) is not finite", v.x, v.y, v.z))
+        Err(ShapeError::NotFinite {
+            what: what.into(),
+            value: v,
+        })
     }
 }
 
 /// Checks that a size is finite and positive, for constructors.
-pub(super) fn check_positive(what: &str, x: f32) -> Result<(), String> {
+pub(super) fn check_positive(what: &str, x: f32) -> Result<(), ShapeError> {
     if x.is_finite() && x > 0.0 {
         Ok(())
     } else {
-        Err(format!("{what} must be finite and positive, got {x}"))
+        Err(ShapeError::NotPositive {
+            what: what.into(),
+            value: x,
+        })
     }
 }
 
 /// A unit axis from a finite non-zero vector, normalised in f64.
-pub(super) fn unit_axis(what: &str, axis: Vec3) -> Result<DVec3, String> {
+pub(super) fn unit_axis(what: &str, axis: Vec3) -> Result<DVec3, ShapeError> {
     check_finite(what, axis)?;
     let a = axis.as_dvec3();
     let len = a.length();
     if len > 0.0 {
         Ok(a / len)
     } else {
-        Err(format!("{what} must not be zero"))
+        Err(ShapeError::Zero { what: what.into() })
     }
 }
 
@@ -299,20 +372,20 @@ impl Quadric {
     /// a quadric with no real surface (`x² + y² + z² + 1`), one that fills all space or
     /// is a single point or line, an invalid clip box, or a clip box that misses an
     /// ellipsoid.
-    pub fn new(coeffs: [f64; 10], clip: Option<Aabb>) -> Result<Self, String> {
+    pub fn new(coeffs: [f64; 10], clip: Option<Aabb>) -> Result<Self, ShapeError> {
         Self::build(DVec3::ZERO, coeffs, clip, true)
     }
 
     /// A quadric whose coefficients (same order as [`Quadric::new`]) describe
     /// `F(p − origin)`: the precise way to give a small quadric far from the world
     /// origin.
-    pub fn about(origin: Vec3, coeffs: [f64; 10], clip: Option<Aabb>) -> Result<Self, String> {
+    pub fn about(origin: Vec3, coeffs: [f64; 10], clip: Option<Aabb>) -> Result<Self, ShapeError> {
         check_finite("quadric origin", origin)?;
         Self::build(origin.as_dvec3(), coeffs, clip, false)
     }
 
     /// The sphere `|p − center|² = radius²`.
-    pub fn sphere(center: Vec3, radius: f32) -> Result<Self, String> {
+    pub fn sphere(center: Vec3, radius: f32) -> Result<Self, ShapeError> {
         check_positive("sphere radius", radius)?;
         let r = radius as f64;
         Self::about(
@@ -323,7 +396,7 @@ impl Quadric {
     }
 
     /// The axis-aligned ellipsoid `Σ ((p − center)ᵢ / radiiᵢ)² = 1`.
-    pub fn ellipsoid(center: Vec3, radii: Vec3) -> Result<Self, String> {
+    pub fn ellipsoid(center: Vec3, radii: Vec3) -> Result<Self, ShapeError> {
         for (k, r) in radii.to_array().into_iter().enumerate() {
             check_positive(&format!("ellipsoid radius {}", ["x", "y", "z"][k]), r)?;
         }
@@ -337,7 +410,7 @@ impl Quadric {
     }
 
     /// The infinite cylinder of `radius` around the line through `point` along `axis`.
-    pub fn cylinder(point: Vec3, axis: Vec3, radius: f32) -> Result<Self, String> {
+    pub fn cylinder(point: Vec3, axis: Vec3, radius: f32) -> Result<Self, ShapeError> {
         check_positive("cylinder radius", radius)?;
         let w = unit_axis("cylinder axis", axis)?;
         let r = radius as f64;
@@ -346,7 +419,7 @@ impl Quadric {
 
     /// The infinite double cone with its apex at `apex`, around `axis`, whose radius
     /// grows by `slope` per unit of height (`slope = tan` of the half-angle).
-    pub fn cone(apex: Vec3, axis: Vec3, slope: f32) -> Result<Self, String> {
+    pub fn cone(apex: Vec3, axis: Vec3, slope: f32) -> Result<Self, ShapeError> {
         check_positive("cone slope", slope)?;
         let w = unit_axis("cone axis", axis)?;
         let k = slope as f64;
@@ -355,7 +428,7 @@ impl Quadric {
 
     /// The paraboloid of revolution with its vertex at `vertex`, opening along `axis`,
     /// with focal length `focal`: `|p⊥|² = 4·focal·h` (`h` the height along the axis).
-    pub fn paraboloid(vertex: Vec3, axis: Vec3, focal: f32) -> Result<Self, String> {
+    pub fn paraboloid(vertex: Vec3, axis: Vec3, focal: f32) -> Result<Self, ShapeError> {
         check_positive("paraboloid focal length", focal)?;
         let w = unit_axis("paraboloid axis", axis)?;
         Self::about(vertex, axial(w, 1.0, 0.0, -2.0 * focal as f64, 0.0), None)
@@ -369,7 +442,7 @@ impl Quadric {
         axis: Vec3,
         waist: f32,
         slope: f32,
-    ) -> Result<Self, String> {
+    ) -> Result<Self, ShapeError> {
         check_positive("hyperboloid waist radius", waist)?;
         check_positive("hyperboloid slope", slope)?;
         let w = unit_axis("hyperboloid axis", axis)?;
@@ -385,7 +458,7 @@ impl Quadric {
         axis: Vec3,
         vertex: f32,
         slope: f32,
-    ) -> Result<Self, String> {
+    ) -> Result<Self, ShapeError> {
         check_positive("hyperboloid vertex distance", vertex)?;
         check_positive("hyperboloid slope", slope)?;
         let w = unit_axis("hyperboloid axis", axis)?;
@@ -394,7 +467,7 @@ impl Quadric {
     }
 
     /// The same quadric clipped by `clip` (replacing any previous clip box).
-    pub fn with_clip(self, clip: Aabb) -> Result<Self, String> {
+    pub fn with_clip(self, clip: Aabb) -> Result<Self, ShapeError> {
         let c = self.local_coefficients();
         Self::build(self.origin, c, Some(clip), false)
     }
@@ -441,28 +514,8 @@ impl Quadric {
         coeffs: [f64; 10],
         clip: Option<Aabb>,
         recentre: bool,
-    ) -> Result<Self, String> {
-        if let Some(k) = coeffs.iter().position(|c| !c.is_finite()) {
-            return Err(format!(
-                "quadric coefficient {} is not finite ({})",
-                "abcdefghij".as_bytes()[k] as char,
-                coeffs[k]
-            ));
-        }
-        if let Some(b) = clip {
-            if !b.is_finite() {
-                return Err("quadric clip box is not finite".into());
-            }
-            if !(b.min.cmplt(b.max).all()) {
-                return Err(format!(
-                    "quadric clip box is empty or flat: min ({}, {}, {}) must be below max ({}, {}, {})",
-                    b.min.x, b.min.y, b.min.z, b.max.x, b.max.y, b.max.z
-                ));
-            }
-        }
-        if coeffs[..9].iter().all(|&c| c == 0.0) {
-            return Err("quadric has no second- or first-order terms: no surface".into());
-        }
+    ) -> Result<Self, ShapeError> {
+        check_input(&coeffs, clip)?;
         // Scale exactly by a power of two so the largest coefficient is in [1, 2).
         let big = coeffs.iter().fold(0.0f64, |a, c| a.max(c.abs()));
         let s = pow2(-(big.log2().floor() as i32));
@@ -495,17 +548,17 @@ impl Quadric {
         let linear_part = residual.length() > 1e-12 * (l.length() + lam_max * centre.length());
         if !linear_part {
             if nonzero.is_empty() {
-                return Err("quadric is constant: no surface".into());
+                return Err(ShapeError::QuadricConstant);
             }
             if nonzero.iter().all(|&x| x > 0.0) && f_centre >= 0.0 {
                 return Err(if f_centre > 0.0 {
-                    "quadric has no real points (F > 0 everywhere)".into()
+                    ShapeError::QuadricNoPoints
                 } else {
-                    "quadric is degenerate: its solid is a single point, line or plane".into()
+                    ShapeError::QuadricDegenerate
                 });
             }
             if nonzero.iter().all(|&x| x < 0.0) && f_centre <= 0.0 {
-                return Err("quadric fills all space (F ≤ 0 everywhere): no surface".into());
+                return Err(ShapeError::QuadricFillsSpace);
             }
         }
 
@@ -515,35 +568,9 @@ impl Quadric {
             (origin, l, j)
         };
 
-        // Ellipsoid: M positive definite (the checks above made its solid non-empty).
-        let mut bounds = Aabb::INFINITE;
-        let mut bounded = false;
-        let lam_min = lam.iter().fold(f64::INFINITY, |a, &x| a.min(x));
-        if lam_min > tol {
-            // The tangent planes x_k = const satisfy πᵀ adj(Q) π = 0 (the dual quadric),
-            // which for F = (p − c)ᵀM(p − c) + k reduces to c_k ± √(−k·(M⁻¹)_kk). The
-            // diagonal of M⁻¹ = Σᵢ vᵢvᵢᵀ/λᵢ is a sum of positive terms, so it is formed
-            // from the eigen-decomposition instead of the adjugate: no cancellation, and
-            // an axis-aligned ellipsoid gets its exact box.
-            let mut diag = DVec3::ZERO;
-            let mut c = DVec3::ZERO;
-            for i in 0..3 {
-                diag += vecs[i] * vecs[i] / lam[i];
-                c -= vecs[i] * (vecs[i].dot(l) / lam[i]);
-            }
-            let k = j + l.dot(c);
-            if k < 0.0 && diag.is_finite() {
-                let half = diag * -k;
-                let half = DVec3::new(half.x.sqrt(), half.y.sqrt(), half.z.sqrt());
-                // The eigenvalues' relative error (Jacobi on a definite matrix) is a
-                // small multiple of ε, degrading at worst with the condition number.
-                let rel = 1e-13 + 4.0 * f64::EPSILON * (lam_max / lam_min);
-                let slack = (half + c.abs() + origin.abs()) * rel;
-                let centre_w = origin + c;
-                bounds = aabb_out(centre_w - half - slack, centre_w + half + slack);
-                bounded = true;
-            }
-        }
+        let ellipsoid = ellipsoid_bounds(&lam, &vecs, l, j, origin, tol);
+        let mut bounded = ellipsoid.is_some();
+        let mut bounds = ellipsoid.unwrap_or(Aabb::INFINITE);
         if let Some(b) = clip {
             bounds = Aabb {
                 min: bounds.min.max(b.min),
@@ -551,7 +578,7 @@ impl Quadric {
             };
             bounded = true;
             if bounds.is_empty() {
-                return Err("quadric clip box does not meet the ellipsoid".into());
+                return Err(ShapeError::ClipMisses);
             }
         }
         let rebase = clip.map_or(DVec3::ZERO, |b| {
@@ -985,6 +1012,23 @@ impl Solid for Quadric {
     }
 }
 
+impl Primitive for Quadric {
+    /// A solid where `{F ≤ 0}` is bounded (clipped, or an ellipsoid).
+    fn is_solid(&self) -> bool {
+        self.is_bounded()
+    }
+    fn spans(&self, ray: &Ray, out: &mut Spans) {
+        Solid::spans(self, ray, out)
+    }
+    fn contains(&self, p: Vec3) -> bool {
+        Solid::contains(self, p)
+    }
+    /// The planar parameterisation about the normal ([`Param::planar`]).
+    fn param(&self, p: Vec3, ng: Vec3) -> Param {
+        Param::planar(p, ng)
+    }
+}
+
 #[cfg(test)]
 mod tests {
     use super::*;
@@ -1010,21 +1054,33 @@ mod tests {
     #[test]
     fn rejects_bad_input() {
         let nan = [f64::NAN, 1.0, 1.0, 0.0, 0.0, 0.0, 0.0, 0.0, 0.0, -1.0];
-        assert!(Quadric::new(nan, None).unwrap_err().contains("not finite"));
+        assert!(
+            Quadric::new(nan, None)
+                .unwrap_err()
+                .to_string()
+                .contains("not finite")
+        );
         let empty = [1.0, 1.0, 1.0, 0.0, 0.0, 0.0, 0.0, 0.0, 0.0, 1.0];
         assert!(
             Quadric::new(empty, None)
                 .unwrap_err()
+                .to_string()
                 .contains("no real points")
         );
         let point = [1.0, 1.0, 1.0, 0.0, 0.0, 0.0, 0.0, 0.0, 0.0, 0.0];
         assert!(
             Quadric::new(point, None)
                 .unwrap_err()
+                .to_string()
                 .contains("degenerate")
         );
         let all = [-1.0, -1.0, -1.0, 0.0, 0.0, 0.0, 0.0, 0.0, 0.0, -1.0];
-        assert!(Quadric::new(all, None).unwrap_err().contains("all space"));
+        assert!(
+            Quadric::new(all, None)
+                .unwrap_err()
+                .to_string()
+                .contains("all space")
+        );
         let constant = [0.0, 0.0, 0.0, 0.0, 0.0, 0.0, 0.0, 0.0, 0.0, -1.0];
         assert!(Quadric::new(constant, None).is_err());
         // An imaginary cylinder x² + y² + 1 = 0.
@@ -1042,6 +1098,7 @@ mod tests {
         assert!(
             Quadric::new(cyl, Some(flat))
                 .unwrap_err()
+                .to_string()
                 .contains("clip box")
         );
         assert!(Quadric::sphere(Vec3::ZERO, 0.0).is_err());

@@ -1,5 +1,11 @@
-use super::{ShapeHit, SurfacePoint, diff_of_products, quadratic_roots};
+use super::param::{MIN_SIN, turn};
+use super::{
+    Intersect, Param, Primitive, ShapeHit, Solid, Span, Spans, SurfacePoint, diff_of_products,
+    quadratic_roots,
+};
 use crate::math::{Aabb, Ray, Vec3, gamma};
+use glam::Vec2;
+use std::f32::consts::{PI, TAU};
 
 /// A sphere. With `inside_only` (NFF's negative radius) only hits where the ray leaves
 /// the sphere count, so the inside is visible and the outside is not.
@@ -100,5 +106,78 @@ impl Sphere {
             -ray.dir.normalize()
         };
         SurfacePoint { p, err, ng }
+    }
+}
+
+impl Intersect for Sphere {
+    fn bounds(&self) -> Aabb {
+        Sphere::bounds(self)
+    }
+    #[inline]
+    fn intersect(&self, ray: &Ray) -> Option<ShapeHit> {
+        Sphere::intersect(self, ray)
+    }
+    #[inline]
+    fn occluded(&self, ray: &Ray) -> bool {
+        Sphere::occluded(self, ray)
+    }
+    fn surface(&self, ray: &Ray, hit: &ShapeHit) -> SurfacePoint {
+        Sphere::surface(self, ray, hit.t)
+    }
+}
+
+impl Solid for Sphere {
+    fn spans(&self, ray: &Ray, out: &mut Spans) {
+        if let Some((t0, t1)) = self.roots(ray) {
+            if t0 <= t1 {
+                out.push(Span {
+                    t_in: t0,
+                    n_in: ray.at(t0) - self.center,
+                    t_out: t1,
+                    n_out: ray.at(t1) - self.center,
+                });
+            }
+        }
+    }
+
+    fn contains(&self, p: Vec3) -> bool {
+        (p - self.center).length_squared() <= self.radius * self.radius
+    }
+}
+
+impl Sphere {
+    /// The spherical parameterisation at `p` (see [`Param`]).
+    pub fn param(&self, p: Vec3) -> Param {
+        let q = ((p - self.center) / self.radius).clamp(Vec3::splat(-1.0), Vec3::splat(1.0));
+        let phi = q.x.atan2(q.z);
+        let u = turn(q.x, q.z);
+        let theta = q.y.clamp(-1.0, 1.0).acos();
+        let (sin_t, cos_t) = theta.sin_cos();
+        let (sin_p, cos_p) = phi.sin_cos();
+        let r = self.radius;
+        let dpdu = Vec3::new(cos_p, 0.0, -sin_p) * (TAU * r * sin_t.max(MIN_SIN));
+        // v = 1 − θ/π, so ∂p/∂v = −π ∂p/∂θ.
+        let dpdv = Vec3::new(cos_t * sin_p, -sin_t, cos_t * cos_p) * (-PI * r);
+        Param {
+            uv: Vec2::new(u, 1.0 - theta / PI),
+            dpdu,
+            dpdv,
+        }
+    }
+}
+
+impl Primitive for Sphere {
+    /// A sphere is a solid unless only its inside is visible.
+    fn is_solid(&self) -> bool {
+        !self.inside_only
+    }
+    fn spans(&self, ray: &Ray, out: &mut Spans) {
+        Solid::spans(self, ray, out)
+    }
+    fn contains(&self, p: Vec3) -> bool {
+        Solid::contains(self, p)
+    }
+    fn param(&self, p: Vec3, _ng: Vec3) -> Param {
+        Sphere::param(self, p)
     }
 }

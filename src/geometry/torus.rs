@@ -25,12 +25,14 @@
 //! are the roots where the sign of `g` (inside or outside the solid), tested between
 //! consecutive roots, changes.
 
+use super::param::{MIN_SIN, turn};
 use super::quadric::{
     aabb_out, check_finite, check_positive, gamma64, outward_or_dir, rounding_err, unit_axis,
     unit_f32,
 };
-use super::{Intersect, ShapeHit, Solid, Span, Spans, SurfacePoint};
+use super::{Intersect, Param, Primitive, ShapeError, ShapeHit, Solid, Span, Spans, SurfacePoint};
 use crate::math::{Aabb, DVec3, Ray, Vec3};
+use glam::Vec2;
 use std::f64::consts::TAU;
 
 /// A torus around `axis` through `center`: the circle of radius `major` in the plane
@@ -79,7 +81,7 @@ struct TorusLine {
 impl Torus {
     /// A torus; `axis` need not be unit (it is normalised in f64). Errors: non-finite
     /// values, a zero axis, non-positive radii.
-    pub fn new(center: Vec3, axis: Vec3, major: f32, minor: f32) -> Result<Self, String> {
+    pub fn new(center: Vec3, axis: Vec3, major: f32, minor: f32) -> Result<Self, ShapeError> {
         check_finite("torus centre", center)?;
         let w = unit_axis("torus axis", axis)?;
         check_positive("torus major radius", major)?;
@@ -495,6 +497,43 @@ impl Solid for Torus {
     }
     fn contains(&self, p: Vec3) -> bool {
         Torus::contains(self, p)
+    }
+}
+
+impl Torus {
+    /// The toroidal parameterisation at `p`.
+    pub fn param(&self, p: Vec3) -> Param {
+        let (ex, ey, a) = self.frame();
+        let (big, small) = (self.major_radius(), self.minor_radius());
+        let q = p - self.center();
+        let (x, y, z) = (q.dot(ex), q.dot(ey), q.dot(a));
+        let rho = x.hypot(y);
+        let phi = y.atan2(x);
+        let psi = z.atan2(rho - big);
+        let (sp, cp) = phi.sin_cos();
+        let (ss, cs) = psi.sin_cos();
+        let radial = ex * cp + ey * sp;
+        let tangent = ey * cp - ex * sp;
+        Param {
+            uv: Vec2::new(turn(y, x), turn(z, rho - big)),
+            dpdu: tangent * (std::f32::consts::TAU * (big + small * cs).max(MIN_SIN * small)),
+            dpdv: (a * cs - radial * ss) * (std::f32::consts::TAU * small),
+        }
+    }
+}
+
+impl Primitive for Torus {
+    fn is_solid(&self) -> bool {
+        true
+    }
+    fn spans(&self, ray: &Ray, out: &mut Spans) {
+        Solid::spans(self, ray, out)
+    }
+    fn contains(&self, p: Vec3) -> bool {
+        Solid::contains(self, p)
+    }
+    fn param(&self, p: Vec3, _ng: Vec3) -> Param {
+        Torus::param(self, p)
     }
 }
 

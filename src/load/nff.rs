@@ -313,8 +313,12 @@ impl<'a> Parser<'a, '_> {
     }
 
     /// A range check's verdict as an error at `tok`.
-    fn in_range(&self, tok: &Tok<'a>, verdict: Result<(), String>) -> Result<(), LoadError> {
-        verdict.map_err(|message| self.err(tok, message))
+    fn in_range(
+        &self,
+        tok: &Tok<'a>,
+        verdict: Result<(), range::RangeError>,
+    ) -> Result<(), LoadError> {
+        verdict.map_err(|e| self.err(tok, e.to_string()))
     }
 
     fn keyword(&mut self, kw: &str) -> Result<Tok<'a>, LoadError> {
@@ -515,7 +519,7 @@ impl<'a> Parser<'a, '_> {
         let sphere = Sphere::new(center, r);
         self.in_range(&r_tok, range::check_bounds("the sphere", &sphere.bounds()))?;
         let m = self.material_index();
-        self.scene.spheres.push(sphere, m);
+        self.scene.geometry.push(sphere, m);
         Ok(())
     }
 
@@ -543,7 +547,7 @@ impl<'a> Parser<'a, '_> {
         let cone = Cone::new(base, rb, apex, ra);
         self.in_range(&ra_tok, range::check_bounds("the cone", &cone.bounds()))?;
         let m = self.material_index();
-        self.scene.cones.push(cone, m);
+        self.scene.geometry.push(cone, m);
         Ok(())
     }
 
@@ -601,25 +605,27 @@ impl<'a> Parser<'a, '_> {
             Ok(()) => {
                 let m = self.material_index();
                 for &[a, b, c] in &self.tris {
-                    self.scene.triangles.push(
+                    self.scene.geometry.triangles.push(
                         Triangle {
                             p: [self.pts[a], self.pts[b], self.pts[c]],
                         },
                         m,
                     );
                     let k = if with_normals {
-                        let k = self.scene.vertex_normals.len();
+                        let k = self.scene.geometry.vertex_normals.len();
                         if k >= u32::MAX as usize {
                             return Err(self.err(&n_tok, "too many smooth triangles".into()));
                         }
-                        self.scene
-                            .vertex_normals
-                            .push([self.nrm[a], self.nrm[b], self.nrm[c]]);
+                        self.scene.geometry.vertex_normals.push([
+                            self.nrm[a],
+                            self.nrm[b],
+                            self.nrm[c],
+                        ]);
                         k as u32
                     } else {
                         u32::MAX
                     };
-                    self.scene.triangle_normals.push(k);
+                    self.scene.geometry.triangle_normals.push(k);
                 }
             }
             Err(_) => {

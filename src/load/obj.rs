@@ -841,7 +841,7 @@ fn find_bad_number(text: &str, limit: usize) -> Option<Located> {
             match tok.parse::<f32>() {
                 Ok(v) if what == "vertex" && v.is_finite() => {
                     if let Err(e) = range::check_coordinate(&format!("vertex {name}"), v) {
-                        return err(Some(tok), e);
+                        return err(Some(tok), e.to_string());
                     }
                     xyz[k] = v
                 }
@@ -886,7 +886,7 @@ fn find_bad_number(text: &str, limit: usize) -> Option<Located> {
                 for (c, name) in xyz.iter().zip(XYZ) {
                     let what = format!("vertex {name} / w =");
                     if let Err(e) = range::check_coordinate(&what, c / w) {
-                        return err(Some(w_tok), e);
+                        return err(Some(w_tok), e.to_string());
                     }
                 }
             }

@@ -5,7 +5,7 @@ use super::{Aabb, Ray, SurfacePoint, Vec3, gamma};
 use glam::{Affine3A, Mat3};
 
 /// Why a matrix is not a usable transform.
-#[derive(Clone, Debug, PartialEq, thiserror::Error)]
+#[derive(Clone, Copy, Debug, PartialEq, thiserror::Error)]
 pub enum XformError {
     /// An entry is NaN or infinite.
     #[error("the transform has a non-finite entry")]

@@ -167,8 +167,8 @@ impl Mesh {
             ..Default::default()
         };
         let top = |g: &Geometry| g.count_unmeshed();
-        for (k, tri) in scene.triangles.items.iter().enumerate() {
-            let material = scene.triangles.material[k];
+        for (k, tri) in scene.geometry.triangles.items.iter().enumerate() {
+            let material = scene.geometry.triangles.material[k];
             let root = mesh.add_source(tri.p, Vec3::ZERO, material, patch_size, 0)?;
             if let Some(root) = root {
                 mesh.sources.insert((NO_INSTANCE, k as u32), root);
@@ -202,16 +202,8 @@ impl Mesh {
     /// number of the others (left out of the mesh).
     fn add_shapes(&mut self, g: &Geometry, patch_size: f32) -> Result<usize, RadiosityError> {
         let mut unmeshed = 0;
-        for (k, s) in g.spheres.items.iter().enumerate() {
-            let t = tessellate::sphere(s, patch_size);
-            self.add_shape((Kind::Sphere, k), t, g.spheres.material[k], patch_size)?;
-        }
-        for (k, c) in g.cones.items.iter().enumerate() {
-            let t = tessellate::cone(c, patch_size);
-            self.add_shape((Kind::Cone, k), t, g.cones.material[k], patch_size)?;
-        }
-        for (k, shape) in g.shapes.items.iter().enumerate() {
-            let t = match shape {
+        for entry in g.shapes() {
+            let t = match &entry.shape {
                 Shape::Sphere(s) => tessellate::sphere(s, patch_size),
                 Shape::Cone(c) => tessellate::cone(c, patch_size),
                 Shape::CappedCone(c) => tessellate::capped(c, patch_size),
@@ -223,7 +215,8 @@ impl Mesh {
                     continue;
                 }
             };
-            self.add_shape((shape.kind(), k), t, g.shapes.material[k], patch_size)?;
+            let id = (entry.kind, entry.prim as usize);
+            self.add_shape(id, t, entry.material, patch_size)?;
         }
         Ok(unmeshed)
     }
@@ -485,7 +478,7 @@ fn too_many(patch_size: f32) -> RadiosityError {
 impl Geometry {
     /// Analytic primitives of an instanced object, which the radiosity mesh leaves out.
     fn count_unmeshed(&self) -> usize {
-        self.spheres.len() + self.cones.len() + self.shapes.len()
+        self.prim_count() - self.triangles.len()
     }
 }
 

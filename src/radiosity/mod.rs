@@ -383,7 +383,7 @@ pub fn solve_mesh<A: Accel>(
 /// triangles.
 pub fn default_patch_size(scene: &Scene) -> f32 {
     let mut b = crate::math::Aabb::EMPTY;
-    for t in &scene.triangles.items {
+    for t in &scene.geometry.triangles.items {
         b = b.union(&t.bounds());
     }
     for inst in &scene.instances {

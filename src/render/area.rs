@@ -48,8 +48,8 @@ pub fn collect(scene: &Scene) -> Vec<AreaLight> {
             err: err + Vec3::splat(m * gamma(12)),
         });
     };
-    for (k, t) in scene.triangles.items.iter().enumerate() {
-        push(t.p, Vec3::ZERO, scene.triangles.material[k]);
+    for (k, t) in scene.geometry.triangles.items.iter().enumerate() {
+        push(t.p, Vec3::ZERO, scene.geometry.triangles.material[k]);
     }
     for inst in &scene.instances {
         let object = &scene.objects[inst.object as usize];

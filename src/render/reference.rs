@@ -13,6 +13,7 @@
 
 use super::film::Film;
 use super::whitted::RayCounts;
+use crate::geometry::Kind;
 use crate::geometry::reference as r64;
 use crate::math::DRay;
 use crate::scene::{Camera, Scene};
@@ -42,8 +43,12 @@ pub enum Unsupported {
 /// Why a scene cannot be rendered by the reference (the first reason found), or
 /// `None` when it can.
 pub fn unsupported(scene: &Scene) -> Option<Unsupported> {
-    if let Some(shape) = scene.shapes.items.first() {
-        return Some(Unsupported::Shape(shape.kind().name()));
+    let modelled = [Kind::Triangle, Kind::Sphere, Kind::Cone];
+    let other = Kind::ALL
+        .into_iter()
+        .find(|&k| !modelled.contains(&k) && scene.geometry.count(k) > 0);
+    if let Some(kind) = other {
+        return Some(Unsupported::Shape(kind.name()));
     }
     if !scene.instances.is_empty() {
         return Some(Unsupported::Instances);
@@ -126,7 +131,7 @@ impl<'a> Reference<'a> {
                 }
             }
         }
-        for (k, s) in g.spheres.items.iter().enumerate() {
+        for (k, s) in g.spheres().items.iter().enumerate() {
             let c = d(s.center);
             let r = s.radius as f64;
             if let Some(t) = r64::sphere(ray, c, r, s.inside_only, 0.0) {
@@ -137,12 +142,12 @@ impl<'a> Reference<'a> {
                         t,
                         ng: n,
                         ns: n,
-                        material: g.spheres.material[k],
+                        material: g.spheres().material[k],
                     });
                 }
             }
         }
-        for (k, c) in g.cones.items.iter().enumerate() {
+        for (k, c) in g.cones().items.iter().enumerate() {
             let (base, apex) = (d(c.base), d(c.apex));
             let (rb, ra) = (c.base_radius as f64, c.apex_radius as f64);
             if let Some(t) = r64::cone(ray, base, rb, apex, ra, c.inside_only, 0.0) {
@@ -158,7 +163,7 @@ impl<'a> Reference<'a> {
                         t,
                         ng: n,
                         ns: n,
-                        material: g.cones.material[k],
+                        material: g.cones().material[k],
                     });
                 }
             }

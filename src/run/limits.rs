@@ -17,7 +17,7 @@ pub fn estimate_bytes(scene: &Scene, settings: &RenderSettings) -> u64 {
         .unwrap_or(Region::full(settings.width, settings.height));
     let extra = u64::from(settings.spd);
     let samples = (r.width() as u64 + extra) * (r.height() as u64 + extra);
-    let prims = scene.prim_count() as u64
+    let prims = scene.prim_count_with_instances() as u64
         + scene
             .objects
             .iter()
@@ -118,7 +118,7 @@ pub fn check(
             scene: scene_path.to_path_buf(),
             width: settings.width,
             height: settings.height,
-            prims: scene.prim_count(),
+            prims: scene.prim_count_with_instances(),
             need,
             limit: max,
         });

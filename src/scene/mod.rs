@@ -1,21 +1,21 @@
 //! The backend-free scene: camera, lights, materials and primitives. No I/O here; the
 //! loaders in [`crate::load`] build it and the backends in [`crate::accel`] read it.
 
-use crate::geometry::{
-    Cone, Csg, Intersect, Kind, Param, QuadUv, Shape, ShapeHit, Sphere, SurfacePoint, Triangle,
-};
-use crate::math::{Aabb, Ray, Vec3, Xform};
+use crate::geometry::{Kind, Param, SurfacePoint};
+use crate::math::{Ray, Vec3, Xform};
 use glam::Vec2;
 
 mod hit;
 pub mod range;
+mod store;
 pub mod texture;
 
 pub use hit::{Hit, NO_INSTANCE};
+pub use store::{Geometry, GeometryMark, KindVisitor, Prims, ShapeEntry};
 
 pub use texture::{Environment, Maps, NO_TEXTURE, Texture};
 
-/// The NFF viewpoint (`v`): see DESIGN.md §3 for the exact ray construction.
+/// The NFF viewpoint (`v`); [`crate::render::RayGen`] builds the eye rays from it.
 #[derive(Clone, Copy, Debug, PartialEq)]
 pub struct Camera {
     /// Eye position.
@@ -159,42 +159,6 @@ impl Default for Material {
     }
 }
 
-/// Primitives of one kind with a material index each.
-#[derive(Clone, Debug, PartialEq)]
-pub struct Prims<T> {
-    /// The primitives; a primitive's index is its `prim_id`.
-    pub items: Vec<T>,
-    /// Material index per primitive.
-    pub material: Vec<u32>,
-}
-
-impl<T> Default for Prims<T> {
-    fn default() -> Self {
-        Prims {
-            items: Vec::new(),
-            material: Vec::new(),
-        }
-    }
-}
-
-impl<T> Prims<T> {
-    /// Append one primitive.
-    pub fn push(&mut self, item: T, material: u32) {
-        self.items.push(item);
-        self.material.push(material);
-    }
-
-    /// Number of primitives.
-    pub fn len(&self) -> usize {
-        self.items.len()
-    }
-
-    /// True when there are none.
-    pub fn is_empty(&self) -> bool {
-        self.items.is_empty()
-    }
-}
-
 /// Counts of what the loader saw, for `--stats`.
 #[derive(Clone, Debug, Default, PartialEq)]
 pub struct LoadStats {
@@ -203,38 +167,6 @@ pub struct LoadStats {
     /// Degenerate polygons or triangles dropped (zero area, fewer than 3 distinct vertices).
     pub degenerate_dropped: usize,
 }
-
-/// Primitives: the top level of a scene, or an object that instances place.
-#[derive(Clone, Debug, Default, PartialEq)]
-pub struct Geometry {
-    /// Triangles.
-    pub triangles: Prims<Triangle>,
-    /// Per triangle: index into `vertex_normals`, or `u32::MAX` for flat shading.
-    pub triangle_normals: Vec<u32>,
-    /// Per-vertex shading normals of smooth triangles.
-    pub vertex_normals: Vec<[Vec3; 3]>,
-    /// Per triangle: index into `vertex_uvs`, or `u32::MAX` for none; may be shorter
-    /// than `triangles` (the rest have none).
-    pub triangle_uvs: Vec<u32>,
-    /// Per-vertex texture coordinates of triangles that have them (OBJ `vt`).
-    pub vertex_uvs: Vec<[Vec2; 3]>,
-    /// Per triangle: index into `quads` when the triangle is half of a textured quad
-    /// face (its `(u, v)` then come from the quad's bilinear patch), or `u32::MAX`; may
-    /// be shorter than `triangles`.
-    pub triangle_quads: Vec<u32>,
-    /// Textured quad faces (OBJ faces of four vertices with `vt`, planar and convex).
-    pub quads: Vec<QuadUv>,
-    /// Spheres.
-    pub spheres: Prims<Sphere>,
-    /// Open cones and cylinders.
-    pub cones: Prims<Cone>,
-    /// Every other analytic primitive (any order; `Kind` from [`Shape::kind`]).
-    pub shapes: Prims<Shape>,
-}
-
-/// The primitive counts of a [`Geometry`] at one moment ([`Geometry::mark`]).
-#[derive(Clone, Copy, Debug, Default, PartialEq, Eq)]
-pub struct GeometryMark([usize; 4]);
 
 /// Material index meaning "the material of the instance that places this object".
 pub const INHERIT: u32 = u32::MAX;
@@ -263,8 +195,7 @@ pub struct Scene {
     pub ambient: Vec3,
     /// Materials, indexed by the primitives.
     pub materials: Vec<Material>,
-    /// The top-level primitives (also reachable as `scene.triangles` etc. through
-    /// `Deref`).
+    /// The top-level primitives.
     pub geometry: Geometry,
     /// Objects that [`Scene::instances`] place (one level of instancing).
     pub objects: Vec<Geometry>,
@@ -289,19 +220,6 @@ pub struct RenderHints {
     pub max_depth: Option<u32>,
 }
 
-impl std::ops::Deref for Scene {
-    type Target = Geometry;
-    fn deref(&self) -> &Geometry {
-        &self.geometry
-    }
-}
-
-impl std::ops::DerefMut for Scene {
-    fn deref_mut(&mut self) -> &mut Geometry {
-        &mut self.geometry
-    }
-}
-
 /// Everything shading needs about a hit.
 #[derive(Clone, Copy, Debug, PartialEq)]
 pub struct Surface {
@@ -323,214 +241,6 @@ pub fn default_light_intensity(n: usize) -> f32 {
     n.sqrt() / (2.0 * n)
 }
 
-impl Geometry {
-    /// Number of primitives of `kind`.
-    pub fn count(&self, kind: Kind) -> usize {
-        match kind {
-            Kind::Triangle => self.triangles.len(),
-            Kind::Sphere => self.spheres.len(),
-            Kind::Cone => self.cones.len(),
-            k => self.shapes.items.iter().filter(|s| s.kind() == k).count(),
-        }
-    }
-
-    /// Total number of primitives.
-    pub fn prim_count(&self) -> usize {
-        self.triangles.len() + self.spheres.len() + self.cones.len() + self.shapes.len()
-    }
-
-    /// Add an analytic primitive: spheres and cones to their own lists, everything else
-    /// to `shapes`.
-    pub fn add_shape(&mut self, shape: Shape, material: u32) {
-        match shape {
-            Shape::Sphere(s) => self.spheres.push(s, material),
-            Shape::Cone(c) => self.cones.push(c, material),
-            other => self.shapes.push(other, material),
-        }
-    }
-
-    /// Add a flat triangle.
-    pub fn add_triangle(&mut self, tri: Triangle, material: u32) {
-        self.triangles.push(tri, material);
-        self.triangle_normals.push(u32::MAX);
-    }
-
-    /// Add a triangle with per-vertex shading normals.
-    pub fn add_smooth_triangle(&mut self, tri: Triangle, normals: [Vec3; 3], material: u32) {
-        self.triangles.push(tri, material);
-        self.triangle_normals.push(self.vertex_normals.len() as u32);
-        self.vertex_normals.push(normals);
-    }
-
-    /// The analytic shape of a hit on geometry `kind`, primitive `prim` (`None` for
-    /// triangles). Spheres and cones index their own lists, other kinds `shapes`.
-    #[inline]
-    pub fn shape(&self, kind: Kind, prim: u32) -> Option<Shape> {
-        match kind {
-            Kind::Triangle => None,
-            Kind::Sphere => Some(Shape::Sphere(self.spheres.items[prim as usize])),
-            Kind::Cone => Some(Shape::Cone(self.cones.items[prim as usize])),
-            _ => self.shapes.items.get(prim as usize).cloned(),
-        }
-    }
-
-    /// Every analytic primitive with its `(kind, prim_id)`.
-    pub fn analytic(&self) -> impl Iterator<Item = (Kind, u32, Shape)> + '_ {
-        let spheres = (0u32..)
-            .zip(&self.spheres.items)
-            .map(|(i, s)| (Kind::Sphere, i, Shape::Sphere(*s)));
-        let cones = (0u32..)
-            .zip(&self.cones.items)
-            .map(|(i, c)| (Kind::Cone, i, Shape::Cone(*c)));
-        let others = (0u32..)
-            .zip(&self.shapes.items)
-            .map(|(i, s)| (s.kind(), i, s.clone()));
-        spheres.chain(cones).chain(others)
-    }
-
-    /// How many primitives of each list there are now, to find later the ones added
-    /// since ([`Geometry::bounds_since`]).
-    pub fn mark(&self) -> GeometryMark {
-        GeometryMark([
-            self.triangles.len(),
-            self.spheres.len(),
-            self.cones.len(),
-            self.shapes.len(),
-        ])
-    }
-
-    /// The bounds of each primitive added since `mark`.
-    pub fn bounds_since(&self, mark: GeometryMark) -> impl Iterator<Item = Aabb> + '_ {
-        let [t, s, c, o] = mark.0;
-        let tris = self.triangles.items[t..].iter().map(Triangle::bounds);
-        let spheres = self.spheres.items[s..].iter().map(Sphere::bounds);
-        let cones = self.cones.items[c..].iter().map(Cone::bounds);
-        let others = self.shapes.items[o..].iter().map(|s| s.bounds());
-        tris.chain(spheres).chain(cones).chain(others)
-    }
-
-    /// Bounds of everything (infinite when an unbounded primitive is present).
-    pub fn bounds(&self) -> Aabb {
-        let mut b = Aabb::EMPTY;
-        for t in &self.triangles.items {
-            b = b.union(&t.bounds());
-        }
-        for (_, _, s) in self.analytic() {
-            b = b.union(&s.bounds());
-        }
-        b
-    }
-
-    /// Add texture coordinates to triangle `tri` (an index into `triangles`).
-    pub fn set_triangle_uvs(&mut self, tri: usize, uv: [Vec2; 3]) {
-        if self.triangle_uvs.len() <= tri {
-            self.triangle_uvs.resize(tri + 1, u32::MAX);
-        }
-        self.triangle_uvs[tri] = self.vertex_uvs.len() as u32;
-        self.vertex_uvs.push(uv);
-    }
-
-    /// Add a textured quad face; returns its index for [`Geometry::set_triangle_quad`].
-    pub fn add_quad(&mut self, quad: QuadUv) -> u32 {
-        self.quads.push(quad);
-        self.quads.len() as u32 - 1
-    }
-
-    /// Make triangle `tri` (an index into `triangles`) half of quad `quad`: its texture
-    /// coordinates come from the quad's bilinear patch.
-    pub fn set_triangle_quad(&mut self, tri: usize, quad: u32) {
-        if self.triangle_quads.len() <= tri {
-            self.triangle_quads.resize(tri + 1, u32::MAX);
-        }
-        self.triangle_quads[tri] = quad;
-    }
-
-    /// The texture coordinates and tangents at `surf`, a hit on these primitives (in
-    /// their space).
-    pub fn param(&self, hit: &Hit, surf: &Surface) -> Param {
-        let kind = Kind::from_id(hit.geom_id).unwrap_or(Kind::Triangle);
-        let i = hit.prim_id as usize;
-        match kind {
-            Kind::Triangle => {
-                let quad = match self.triangle_quads.get(i) {
-                    Some(&k) if k != u32::MAX => self.quads[k as usize].param(surf.point.p),
-                    _ => None,
-                };
-                if let Some(param) = quad {
-                    return param;
-                }
-                let uv = match self.triangle_uvs.get(i) {
-                    Some(&k) if k != u32::MAX => Some(&self.vertex_uvs[k as usize]),
-                    _ => None,
-                };
-                self.triangles.items[i].param(hit.u, hit.v, uv)
-            }
-            Kind::Sphere => self.spheres.items[i].param(surf.point.p),
-            Kind::Cone => self.cones.items[i].param(surf.point.p),
-            _ => self.shapes.items[i].param(surf.point.p, surf.point.ng),
-        }
-    }
-
-    /// The surface at a hit on these primitives, for `ray` in their space.
-    pub fn surface(&self, hit: &Hit, ray: &Ray) -> Surface {
-        let kind = Kind::from_id(hit.geom_id).expect("backend reported an unknown geometry");
-        let i = hit.prim_id as usize;
-        let analytic = |shape: &dyn Intersect, material: u32| {
-            let point = shape.surface(
-                ray,
-                &ShapeHit {
-                    t: hit.t,
-                    u: hit.u,
-                    v: hit.v,
-                    ng: hit.ng,
-                },
-            );
-            Surface {
-                point,
-                ns: point.ng,
-                material,
-                param: None,
-            }
-        };
-        match kind {
-            Kind::Triangle => {
-                let tri = &self.triangles.items[i];
-                let point = tri.surface(hit.u, hit.v);
-                let ns = match self.triangle_normals[i] {
-                    u32::MAX => point.ng,
-                    k => {
-                        let n = self.vertex_normals[k as usize];
-                        let w = 1.0 - hit.u - hit.v;
-                        (n[0] * w + n[1] * hit.u + n[2] * hit.v).normalize_or(point.ng)
-                    }
-                };
-                Surface {
-                    point,
-                    ns,
-                    material: self.triangles.material[i],
-                    param: None,
-                }
-            }
-            Kind::Sphere => analytic(&self.spheres.items[i], self.spheres.material[i]),
-            Kind::Cone => analytic(&self.cones.items[i], self.cones.material[i]),
-            _ => {
-                let shape = &self.shapes.items[i];
-                let mut material = self.shapes.material[i];
-                if let Shape::Csg(c) = shape {
-                    let (leaf, _) = Csg::hit_leaf(&ShapeHit {
-                        t: hit.t,
-                        u: hit.u,
-                        v: hit.v,
-                        ng: hit.ng,
-                    });
-                    material = c.leaf_material(leaf).unwrap_or(material);
-                }
-                analytic(shape, material)
-            }
-        }
-    }
-}
-
 impl Scene {
     /// An empty scene with the given camera, a black background and no lights.
     pub fn new(camera: Camera) -> Self {
@@ -550,8 +260,10 @@ impl Scene {
         }
     }
 
-    /// Number of primitives of `kind` in the scene, counting each instance's copy.
-    pub fn count(&self, kind: Kind) -> usize {
+    /// Number of primitives of `kind` a ray can meet: the top level's and each
+    /// instance's copy of its object's (`self.geometry.count(kind)` counts the top
+    /// level only).
+    pub fn count_with_instances(&self, kind: Kind) -> usize {
         self.geometry.count(kind)
             + self
                 .instances
@@ -560,8 +272,9 @@ impl Scene {
                 .sum::<usize>()
     }
 
-    /// Total number of primitives, counting each instance's copy.
-    pub fn prim_count(&self) -> usize {
+    /// Total number of primitives a ray can meet: the top level's and each instance's
+    /// copy of its object's (`self.geometry.prim_count()` counts the top level only).
+    pub fn prim_count_with_instances(&self) -> usize {
         self.geometry.prim_count()
             + self
                 .instances

@@ -52,8 +52,93 @@
 
 use crate::math::Vec3;
 use glam::Vec2;
-use std::path::Path;
+use std::path::{Path, PathBuf};
 use std::sync::Arc;
+
+/// Why an image or environment map cannot be read or used.
+#[derive(Debug, thiserror::Error)]
+pub enum TextureError {
+    /// The size does not match the texels.
+    #[error("an image of {width} × {height} texels cannot hold {texels} values")]
+    Size {
+        /// Width asked for.
+        width: u32,
+        /// Height asked for.
+        height: u32,
+        /// Texels given.
+        texels: usize,
+    },
+    /// The file cannot be opened or read.
+    #[error("{}: cannot read image: {source}", .path.display())]
+    Read {
+        /// The file.
+        path: PathBuf,
+        /// What failed.
+        source: std::io::Error,
+    },
+    /// The file is not an image the decoders read.
+    #[error("{}: cannot decode image: {source}", .path.display())]
+    Decode {
+        /// The file.
+        path: PathBuf,
+        /// What failed.
+        source: image::ImageError,
+    },
+    /// An image is neither a 2:1 latitude-longitude map nor a 4:3 cube cross.
+    #[error(
+        "an environment map is a 2:1 latitude-longitude image or a 4:3 cube cross, \
+         not {width} × {height}"
+    )]
+    EnvironmentShape {
+        /// Width of the image.
+        width: u32,
+        /// Height of the image.
+        height: u32,
+    },
+    /// A cube map's faces are not square or not of one size.
+    #[error(
+        "the cube map's faces must be square and of one size: {face} is {} × {}, {} is \
+         {} × {}",
+        .size.0, .size.1, CUBE_FACES[0], .first.0, .first.1
+    )]
+    CubeFaces {
+        /// The face that differs (`px`, ...).
+        face: &'static str,
+        /// Its width and height.
+        size: (u32, u32),
+        /// Width and height of the first face.
+        first: (u32, u32),
+    },
+    /// A cube map directory lacks a face.
+    #[error(
+        "{}: a cube map directory needs {face}.png (or .jpg, .jpeg), one of the faces px, \
+         nx, py, ny, pz, nz",
+        .dir.display()
+    )]
+    MissingFace {
+        /// The directory.
+        dir: PathBuf,
+        /// The face (`px`, ...).
+        face: &'static str,
+    },
+    /// An error about the image or map read from `path`.
+    #[error("{}: {source}", .path.display())]
+    In {
+        /// The file.
+        path: PathBuf,
+        /// The error.
+        source: Box<TextureError>,
+    },
+}
+
+impl TextureError {
+    fn in_file(self, path: &Path) -> TextureError {
+        TextureError::In {
+            path: path.to_path_buf(),
+            source: Box::new(self),
+        }
+    }
+}
 
 /// Texture index meaning "no texture".
 pub const NO_TEXTURE: u32 = u32::MAX;
@@ -153,12 +238,13 @@ impl Image {
     ///
     /// # Errors
     /// When the size is zero or does not match the texels.
-    pub fn new(width: u32, height: u32, texels: Vec<Vec3>) -> Result<Image, String> {
+    pub fn new(width: u32, height: u32, texels: Vec<Vec3>) -> Result<Image, TextureError> {
         if width == 0 || height == 0 || texels.len() != width as usize * height as usize {
-            return Err(format!(
-                "an image of {width} × {height} texels cannot hold {} values",
-                texels.len()
-            ));
+            return Err(TextureError::Size {
+                width,
+                height,
+                texels: texels.len(),
+            });
         }
         Ok(Image {
             width,
@@ -173,13 +259,20 @@ impl Image {
     ///
     /// # Errors
     /// A message naming the file when it cannot be read or decoded.
-    pub fn load(path: &Path, srgb: bool) -> Result<Image, String> {
+    pub fn load(path: &Path, srgb: bool) -> Result<Image, TextureError> {
+        let unreadable = |source| TextureError::Read {
+            path: path.to_path_buf(),
+            source,
+        };
         let img = image::ImageReader::open(path)
-            .map_err(|e| format!("{}: cannot read image: {e}", path.display()))?
+            .map_err(unreadable)?
             .with_guessed_format()
-            .map_err(|e| format!("{}: cannot read image: {e}", path.display()))?
+            .map_err(unreadable)?
             .decode()
-            .map_err(|e| format!("{}: cannot decode image: {e}", path.display()))?;
+            .map_err(|source| TextureError::Decode {
+                path: path.to_path_buf(),
+                source,
+            })?;
         let rgb = img.to_rgb32f();
         let (w, h) = rgb.dimensions();
         let lin = |c: f32| if srgb { srgb_to_linear(c) } else { c };
@@ -187,7 +280,7 @@ impl Image {
             .pixels()
             .map(|p| Vec3::new(lin(p.0[0]), lin(p.0[1]), lin(p.0[2])))
             .collect();
-        Image::new(w, h, texels).map_err(|e| format!("{}: {e}", path.display()))
+        Image::new(w, h, texels).map_err(|e| e.in_file(path))
     }
 
     /// Width in texels.
@@ -431,7 +524,7 @@ impl Environment {
     ///
     /// # Errors
     /// When the image has neither shape.
-    pub fn from_image(img: Image) -> Result<Environment, String> {
+    pub fn from_image(img: Image) -> Result<Environment, TextureError> {
         let (w, h) = (img.width, img.height);
         if w == 2 * h {
             let mut img = img;
@@ -457,10 +550,10 @@ impl Environment {
             });
             return Ok(Environment::Cube(Box::new(faces)));
         }
-        Err(format!(
-            "an environment map is a 2:1 latitude-longitude image or a 4:3 cube cross, \
-             not {w} × {h}"
-        ))
+        Err(TextureError::EnvironmentShape {
+            width: w,
+            height: h,
+        })
     }
 
     /// A cube map from six square faces of one size, in the order +x, −x, +y, −y, +z,
@@ -468,15 +561,15 @@ impl Environment {
     ///
     /// # Errors
     /// When a face is not square or the sizes differ.
-    pub fn from_faces(faces: [Image; 6]) -> Result<Environment, String> {
+    pub fn from_faces(faces: [Image; 6]) -> Result<Environment, TextureError> {
         let (w, h) = (faces[0].width, faces[0].height);
         for (f, name) in faces.iter().zip(CUBE_FACES) {
             if f.width != f.height || (f.width, f.height) != (w, h) {
-                return Err(format!(
-                    "the cube map's faces must be square and of one size: {name} is {} × \
-                     {}, {} is {w} × {h}",
-                    f.width, f.height, CUBE_FACES[0]
-                ));
+                return Err(TextureError::CubeFaces {
+                    face: name,
+                    size: (f.width, f.height),
+                    first: (w, h),
+                });
             }
         }
         Ok(Environment::Cube(Box::new(faces.map(|mut f| {
@@ -490,13 +583,13 @@ impl Environment {
     ///
     /// # Errors
     /// A message naming the file that cannot be read, or the faces' mismatch.
-    pub fn load_faces(files: &[std::path::PathBuf; 6]) -> Result<Environment, String> {
+    pub fn load_faces(files: &[PathBuf; 6]) -> Result<Environment, TextureError> {
         let mut faces = Vec::with_capacity(6);
         for f in files {
             faces.push(Image::load(f, true)?);
         }
         let faces: [Image; 6] = faces.try_into().expect("six faces");
-        Environment::from_faces(faces).map_err(|e| format!("{}: {e}", files[0].display()))
+        Environment::from_faces(faces).map_err(|e| e.in_file(&files[0]))
     }
 
     /// Read an environment map (colour, sRGB-decoded): an image file (2:1 latitude-
@@ -506,26 +599,23 @@ impl Environment {
     ///
     /// # Errors
     /// A message naming the file (or the missing face).
-    pub fn load(path: &Path) -> Result<Environment, String> {
+    pub fn load(path: &Path) -> Result<Environment, TextureError> {
         if path.is_dir() {
-            let mut files: [std::path::PathBuf; 6] = Default::default();
-            for (file, name) in files.iter_mut().zip(CUBE_FACES) {
+            let mut files: [PathBuf; 6] = Default::default();
+            for (file, face) in files.iter_mut().zip(CUBE_FACES) {
                 *file = ["png", "jpg", "jpeg"]
                     .iter()
-                    .map(|ext| path.join(format!("{name}.{ext}")))
+                    .map(|ext| path.join(format!("{face}.{ext}")))
                     .find(|f| f.is_file())
-                    .ok_or_else(|| {
-                        format!(
-                            "{}: a cube map directory needs {name}.png (or .jpg, .jpeg), \
-                             one of the faces px, nx, py, ny, pz, nz",
-                            path.display()
-                        )
+                    .ok_or_else(|| TextureError::MissingFace {
+                        dir: path.to_path_buf(),
+                        face,
                     })?;
             }
             return Environment::load_faces(&files);
         }
         let img = Image::load(path, true)?;
-        Environment::from_image(img).map_err(|e| format!("{}: {e}", path.display()))
+        Environment::from_image(img).map_err(|e| e.in_file(path))
     }
 
     /// The radiance arriving from direction `d` (any length).
@@ -579,6 +669,46 @@ pub fn cube_face(d: Vec3) -> (usize, Vec2) {
 #[cfg(test)]
 mod tests {
     use super::*;
+
+    #[test]
+    fn error_messages_name_the_file_and_the_problem() {
+        let image = |w: u32, h: u32| Image::new(w, h, vec![Vec3::ONE; (w * h) as usize]);
+        assert_eq!(
+            Image::new(2, 2, vec![Vec3::ONE; 3])
+                .unwrap_err()
+                .to_string(),
+            "an image of 2 × 2 texels cannot hold 3 values"
+        );
+        assert_eq!(
+            Environment::from_image(image(3, 3).unwrap())
+                .unwrap_err()
+                .to_string(),
+            "an environment map is a 2:1 latitude-longitude image or a 4:3 cube cross, not \
+             3 × 3"
+        );
+        let mut faces = std::array::from_fn(|_| image(4, 4).unwrap());
+        faces[2] = image(8, 8).unwrap();
+        assert_eq!(
+            Environment::from_faces(faces).unwrap_err().to_string(),
+            "the cube map's faces must be square and of one size: py is 8 × 8, px is 4 × 4"
+        );
+        let tmp = tempfile::tempdir().unwrap();
+        let dir = tmp.path();
+        assert_eq!(
+            Environment::load(dir).unwrap_err().to_string(),
+            format!(
+                "{}: a cube map directory needs px.png (or .jpg, .jpeg), one of the faces px, \
+                 nx, py, ny, pz, nz",
+                dir.display()
+            )
+        );
+        let missing = dir.join("missing.png");
+        let e = Image::load(&missing, true).unwrap_err().to_string();
+        assert!(
+            e.starts_with(&format!("{}: cannot read image: ", missing.display())),
+            "{e}"
+        );
+    }
 
     #[test]
     fn srgb_decode_endpoints() {

@@ -255,7 +255,7 @@ mod tests {
             generate(n, &mut w);
             let text = w.finish();
             let scene = crate::load::nff::parse_str(&text, Path::new("x")).unwrap();
-            assert_eq!(scene.spheres.len(), sphere_count(n));
+            assert_eq!(scene.geometry.spheres().len(), sphere_count(n));
             assert_eq!(scene.load_stats.polygons, 1);
             assert_eq!(scene.lights.len(), 3);
             assert_eq!(scene.materials.len(), 2);

@@ -333,8 +333,11 @@ mod tests {
         assert_eq!(scene.load_stats.polygons, 147);
         assert_eq!(scene.load_stats.degenerate_dropped, 0);
         assert_eq!(scene.lights.len(), 5);
-        assert_eq!(scene.spheres.len() + scene.cones.len(), 0);
+        assert_eq!(
+            scene.geometry.spheres().len() + scene.geometry.cones().len(),
+            0
+        );
         // 144-gons triangulate into 142 triangles, quads into 2.
-        assert_eq!(scene.triangles.len(), 2 * 142 + 145 * 2);
+        assert_eq!(scene.geometry.triangles.len(), 2 * 142 + 145 * 2);
     }
 }

@@ -289,8 +289,8 @@ mod tests {
     fn output_parses_with_the_nff_loader() {
         let text = super::super::Database::Jacks.generate(2);
         let scene = crate::load::nff::parse_str(&text, Path::new("x")).unwrap();
-        assert_eq!(scene.cones.len(), 27);
-        assert_eq!(scene.spheres.len(), 54);
+        assert_eq!(scene.geometry.cones().len(), 27);
+        assert_eq!(scene.geometry.spheres().len(), 54);
         assert_eq!(scene.lights.len(), 1);
         assert_eq!(scene.load_stats.polygons, 0);
     }

@@ -319,12 +319,12 @@ mod tests {
     fn output_parses_with_the_expected_counts() {
         let text = nff(2);
         let scene = crate::load::nff::parse_str(&text, Path::new("x")).unwrap();
-        assert_eq!(scene.spheres.len(), 4);
-        assert_eq!(scene.triangles.len(), 32);
+        assert_eq!(scene.geometry.spheres().len(), 4);
+        assert_eq!(scene.geometry.triangles.len(), 32);
         assert_eq!(scene.load_stats.polygons, 32);
         assert_eq!(scene.load_stats.degenerate_dropped, 0);
         assert_eq!(scene.lights.len(), 1);
-        assert_eq!(scene.cones.len(), 0);
+        assert_eq!(scene.geometry.cones().len(), 0);
     }
 
     #[test]

@@ -215,8 +215,8 @@ mod tests {
     fn output_parses_with_the_nff_loader() {
         let text = super::super::Database::Rings.generate(2);
         let scene = crate::load::nff::parse_str(&text, Path::new("x")).unwrap();
-        assert_eq!(scene.spheres.len(), 150);
-        assert_eq!(scene.cones.len(), 150);
+        assert_eq!(scene.geometry.spheres().len(), 150);
+        assert_eq!(scene.geometry.cones().len(), 150);
         assert_eq!(scene.load_stats.polygons, 1);
         assert_eq!(scene.lights.len(), 3);
     }

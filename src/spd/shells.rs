@@ -111,8 +111,8 @@ mod tests {
         let mut w = NffWriter::new();
         generate(1, &mut w);
         let scene = crate::load::nff::parse_str(&w.finish(), Path::new("x")).unwrap();
-        assert_eq!(scene.spheres.len(), 361);
-        assert_eq!(scene.triangles.len(), 0);
+        assert_eq!(scene.geometry.spheres().len(), 361);
+        assert_eq!(scene.geometry.triangles.len(), 0);
         assert_eq!(scene.lights.len(), 1);
     }
 }

@@ -172,7 +172,7 @@ mod tests {
         generate(1, &mut w);
         let scene = crate::load::nff::parse_str(&w.finish(), Path::new("x")).unwrap();
         assert_eq!(scene.load_stats.polygons, 1922);
-        assert_eq!(scene.triangles.len(), 1922);
+        assert_eq!(scene.geometry.triangles.len(), 1922);
         assert_eq!(scene.load_stats.degenerate_dropped, 0);
         assert_eq!(scene.lights.len(), 1);
     }

@@ -1011,8 +1011,8 @@ mod tests {
             let flat = if size == 1 { 4 } else { 0 };
             assert_eq!(scene.load_stats.degenerate_dropped, flat, "size {size}");
             // Each square is two triangles; every patch triangle has vertex normals.
-            assert_eq!(scene.triangles.len(), tris - flat + 2 * n * n);
-            assert_eq!(scene.vertex_normals.len(), tris - flat);
+            assert_eq!(scene.geometry.triangles.len(), tris - flat + 2 * n * n);
+            assert_eq!(scene.geometry.vertex_normals.len(), tris - flat);
             assert_eq!(scene.lights.len(), 2);
         }
     }

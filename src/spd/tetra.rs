@@ -160,9 +160,9 @@ mod tests {
             generate(n, &mut w);
             let scene = crate::load::nff::parse_str(&w.finish(), Path::new("x")).unwrap();
             assert_eq!(scene.load_stats.polygons, 4usize.pow(n));
-            assert_eq!(scene.triangles.len(), 4usize.pow(n));
+            assert_eq!(scene.geometry.triangles.len(), 4usize.pow(n));
             assert_eq!(scene.load_stats.degenerate_dropped, 0);
-            assert_eq!(scene.spheres.len(), 0);
+            assert_eq!(scene.geometry.spheres().len(), 0);
             assert_eq!(scene.lights.len(), 1);
         }
     }

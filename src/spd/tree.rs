@@ -225,10 +225,10 @@ mod tests {
     fn output_parses_with_the_expected_counts() {
         let text = nff(3);
         let scene = crate::load::nff::parse_str(&text, Path::new("x")).unwrap();
-        assert_eq!(scene.cones.len(), 15);
-        assert_eq!(scene.spheres.len(), 15);
+        assert_eq!(scene.geometry.cones().len(), 15);
+        assert_eq!(scene.geometry.spheres().len(), 15);
         assert_eq!(scene.load_stats.polygons, 1);
-        assert_eq!(scene.triangles.len(), 2);
+        assert_eq!(scene.geometry.triangles.len(), 2);
         assert_eq!(scene.lights.len(), 7);
     }
 }

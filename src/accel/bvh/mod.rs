@@ -7,10 +7,11 @@
 mod build;
 mod wide;
 
+use crate::accel::unbounded::Unbounded;
 use crate::accel::{Accel, AccelStats, Hit, NO_INSTANCE};
-use crate::geometry::{Intersect, Kind, Shape, Triangle, WatertightRay};
+use crate::geometry::{Analytic, Intersect, Kind, Shape, Triangle, WatertightRay};
 use crate::math::{Aabb, Ray, Xform};
-use crate::scene::{Geometry, Scene};
+use crate::scene::{Geometry, KindVisitor, Prims, Scene};
 use std::sync::Arc;
 use wide::{Node4, Visit};
 
@@ -48,6 +49,23 @@ impl Prim {
     }
 }
 
+/// Appends every analytic primitive of the lists it visits to `prims`, with its
+/// `(geom_id, prim_id)` in `ids`.
+struct Gather<'a> {
+    prims: &'a mut Vec<Prim>,
+    ids: &'a mut Vec<(u32, u32)>,
+}
+
+impl KindVisitor for Gather<'_> {
+    type Output = ();
+    fn visit<P: Analytic>(&mut self, list: &Prims<P>) {
+        for (i, prim, _) in list.iter() {
+            self.prims.push(Prim::Shape(prim.clone().into()));
+            self.ids.push((P::KIND as u32, i));
+        }
+    }
+}
+
 /// An instance: the object's own hierarchy under a transform.
 struct PlacedObject {
     xform: Xform,
@@ -69,10 +87,14 @@ pub struct Bvh {
     /// `(geom_id, prim_id)` of each entry of `prims` (`(u32::MAX, instance)` for
     /// instances).
     ids: Vec<(u32, u32)>,
-    /// Primitives with infinite bounds (planes, unbounded quadrics, instances of
-    /// them): kept out of the tree and tested against every ray before it.
-    unbounded: Vec<usize>,
+    /// The scene's primitives with infinite bounds (planes, unbounded quadrics, the
+    /// instances' copies of them), kept out of every level's tree and tested against
+    /// every ray before the top level's (empty in the objects' levels).
+    unbounded: Unbounded,
     instances: Vec<PlacedObject>,
+    /// The kinds of the top level and of each instanced object, once per object (see
+    /// [`AccelStats::kinds`]).
+    kinds: Vec<(Kind, usize)>,
 }
 
 /// Traversal stack depth; the builder caps the tree depth below it.
@@ -80,7 +102,8 @@ const STACK: usize = 64;
 
 impl Bvh {
     /// Build over every primitive of `scene`: a hierarchy per instanced object, and a
-    /// top-level one over the scene's own primitives and the instances.
+    /// top-level one over the scene's own primitives and the instances; the unbounded
+    /// primitives of all of them in one [`Unbounded`] list.
     pub fn build(scene: &Scene) -> Bvh {
         let objects: Vec<Arc<Bvh>> = scene
             .objects
@@ -92,7 +115,7 @@ impl Bvh {
             .iter()
             .map(|inst| {
                 let object = objects[inst.object as usize].clone();
-                let bounds = inst.xform.bounds_to_world(&object.bounds());
+                let bounds = inst.xform.bounds_to_world(&object.tree_bounds);
                 PlacedObject {
                     xform: inst.xform,
                     object,
@@ -100,9 +123,14 @@ impl Bvh {
                 }
             })
             .collect();
-        Bvh::build_level(&scene.geometry, instances)
+        let mut bvh = Bvh::build_level(&scene.geometry, instances);
+        bvh.unbounded = Unbounded::new(scene);
+        bvh.kinds = scene_kinds(scene);
+        bvh
     }
 
+    /// The hierarchy over the bounded primitives of `geometry` and `instances` (an
+    /// instance whose object's tree is empty is left out).
     fn build_level(geometry: &Geometry, instances: Vec<PlacedObject>) -> Bvh {
         let n = geometry.prim_count() + instances.len();
         let mut prims = Vec::with_capacity(n);
@@ -111,20 +139,17 @@ impl Bvh {
             prims.push(Prim::Triangle(*t));
             ids.push((Kind::Triangle as u32, i as u32));
         }
-        for (kind, i, shape) in geometry.analytic() {
-            prims.push(Prim::Shape(shape));
-            ids.push((kind as u32, i));
-        }
+        geometry.visit_all(&mut Gather {
+            prims: &mut prims,
+            ids: &mut ids,
+        });
         for i in 0..instances.len() {
             prims.push(Prim::Instance(i as u32));
             ids.push((u32::MAX, i as u32));
         }
         let all_bounds: Vec<Aabb> = prims.iter().map(|p| p.bounds(&instances)).collect();
-        // Unbounded primitives stay out of the tree; empty ones (an instance of an empty
-        // object) are dropped.
-        let unbounded_idx: Vec<usize> = (0..prims.len())
-            .filter(|&i| !all_bounds[i].is_finite() && !all_bounds[i].is_empty())
-            .collect();
+        // Unbounded primitives stay out of the tree (see `Unbounded`), and so do empty
+        // ones (an instance of an object without bounded primitives).
         let bounded: Vec<usize> = (0..prims.len())
             .filter(|&i| all_bounds[i].is_finite())
             .collect();
@@ -132,18 +157,11 @@ impl Bvh {
         let (binary, order) = build::build(&bounds);
         let tree_bounds = binary.first().map_or(Aabb::EMPTY, |n| n.bounds);
         let (nodes, leaves, stack_need) = wide::collapse(&binary);
-        let mut out_prims: Vec<Prim> = order
+        let out_prims: Vec<Prim> = order
             .iter()
             .map(|&k| prims[bounded[k as usize]].clone())
             .collect();
-        let mut out_ids: Vec<(u32, u32)> =
-            order.iter().map(|&k| ids[bounded[k as usize]]).collect();
-        let mut unbounded = Vec::with_capacity(unbounded_idx.len());
-        for i in unbounded_idx {
-            unbounded.push(out_prims.len());
-            out_prims.push(prims[i].clone());
-            out_ids.push(ids[i]);
-        }
+        let out_ids: Vec<(u32, u32)> = order.iter().map(|&k| ids[bounded[k as usize]]).collect();
         Bvh {
             nodes,
             leaves,
@@ -151,18 +169,10 @@ impl Bvh {
             tree_bounds,
             prims: out_prims,
             ids: out_ids,
-            unbounded,
+            unbounded: Unbounded::default(),
             instances,
+            kinds: Vec::new(),
         }
-    }
-
-    /// Bounds of everything in this level (infinite with unbounded primitives).
-    fn bounds(&self) -> Aabb {
-        let mut b = self.tree_bounds;
-        for &i in &self.unbounded {
-            b = b.union(&self.prims[i].bounds(&self.instances));
-        }
-        b
     }
 
     /// Number of nodes.
@@ -230,15 +240,9 @@ impl Bvh {
         if !ray.is_traceable() {
             return None;
         }
-        let mut best: Option<Hit> = None;
+        let mut best = self.unbounded.nearest(ray);
         let mut wt = WatertightRay::new(ray);
-        let mut tmax = ray.tmax;
-        for &i in &self.unbounded {
-            if let Some(h) = self.hit_prim(i, ray, &mut wt, tmax) {
-                tmax = h.t;
-                best = Some(h);
-            }
-        }
+        let tmax = best.map_or(ray.tmax, |h| h.t);
         let ray = Ray { tmax, ..*ray };
         self.traverse::<true>(&ray, |i, tmax| {
             match self.hit_prim(i, &ray, &mut wt, tmax) {
@@ -258,10 +262,10 @@ impl Bvh {
         if !ray.is_traceable() {
             return false;
         }
-        let wt = WatertightRay::new(ray);
-        if self.unbounded.iter().any(|&i| self.occludes(i, ray, &wt)) {
+        if self.unbounded.any(ray) {
             return true;
         }
+        let wt = WatertightRay::new(ray);
         let mut hit = false;
         self.traverse::<false>(ray, |i, tmax| {
             if self.occludes(i, ray, &wt) {
@@ -275,26 +279,24 @@ impl Bvh {
     }
 }
 
-impl Bvh {
-    /// The kinds in the leaves and the unbounded list, each instanced object counted
-    /// once (see [`AccelStats::kinds`]).
-    fn kinds(&self) -> Vec<(Kind, usize)> {
-        let mut kinds = Vec::new();
-        let mut levels: Vec<&Bvh> = vec![self];
-        for inst in &self.instances {
-            if !levels.iter().any(|l| std::ptr::eq(*l, &*inst.object)) {
-                levels.push(&inst.object);
-            }
+/// The kinds of `scene`'s top level and of each object its instances place, each
+/// object counted once (see [`AccelStats::kinds`]).
+fn scene_kinds(scene: &Scene) -> Vec<(Kind, usize)> {
+    let mut kinds = Vec::new();
+    let mut levels: Vec<&Geometry> = vec![&scene.geometry];
+    let mut placed = vec![false; scene.objects.len()];
+    for inst in &scene.instances {
+        let object = inst.object as usize;
+        if !std::mem::replace(&mut placed[object], true) {
+            levels.push(&scene.objects[object]);
         }
-        for level in levels {
-            for &(geom_id, _) in &level.ids {
-                if let Some(kind) = Kind::from_id(geom_id) {
-                    crate::accel::add_kind(&mut kinds, kind, 1);
-                }
-            }
-        }
-        kinds
     }
+    for level in levels {
+        for kind in Kind::ALL {
+            crate::accel::add_kind(&mut kinds, kind, level.count(kind));
+        }
+    }
+    kinds
 }
 
 impl Accel for Bvh {
@@ -309,18 +311,18 @@ impl Accel for Bvh {
     fn stats(&self) -> AccelStats {
         AccelStats {
             backend: "bvh",
-            prims: self.prims.len(),
+            prims: self.prims.len() + self.unbounded.len(),
             nodes: self.nodes.len(),
             bytes: self.nodes.len() * std::mem::size_of::<Node4>()
                 + self.leaves.len() * std::mem::size_of::<(u32, u32)>()
-                + self.prims.len()
+                + (self.prims.len() + self.unbounded.len())
                     * (std::mem::size_of::<Prim>() + std::mem::size_of::<(u32, u32)>()),
             detail: format!(
                 "binned SAH, {} bins, max leaf {}, 4-wide nodes",
                 build::BINS,
                 build::MAX_LEAF
             ),
-            kinds: self.kinds(),
+            kinds: self.kinds.clone(),
         }
     }
 }
@@ -369,16 +371,16 @@ mod agreement {
             let c = v(rng, 10.0);
             match rng.below(3) {
                 0 => {
-                    s.triangles.push(
+                    s.geometry.triangles.push(
                         Triangle {
                             p: [c + v(rng, 1.0), c + v(rng, 1.0), c + v(rng, 1.0)],
                         },
                         0,
                     );
-                    s.triangle_normals.push(u32::MAX);
+                    s.geometry.triangle_normals.push(u32::MAX);
                 }
-                1 => s.spheres.push(Sphere::new(c, rng.range(0.05, 0.55)), 0),
-                _ => s.cones.push(
+                1 => s.geometry.push(Sphere::new(c, rng.range(0.05, 0.55)), 0),
+                _ => s.geometry.push(
                     Cone::new(c, rng.range(0.0, 0.5), c + v(rng, 2.0), rng.range(0.0, 0.5)),
                     0,
                 ),
@@ -390,15 +392,15 @@ mod agreement {
     fn brute(scene: &Scene, ray: &Ray) -> Option<(f32, u32, u32)> {
         let mut best: Option<(f32, u32, u32)> = None;
         let mut r = *ray;
-        for (i, t) in scene.triangles.items.iter().enumerate() {
+        for (i, t) in scene.geometry.triangles.items.iter().enumerate() {
             if let Some(h) = t.intersect(&r) {
                 r.tmax = h.t;
                 best = Some((h.t, 0, i as u32));
             }
         }
         for kind in [Kind::Sphere, Kind::Cone] {
-            for i in 0..scene.count(kind) {
-                if let Some(h) = scene.shape(kind, i as u32).unwrap().intersect(&r) {
+            for i in 0..scene.geometry.count(kind) {
+                if let Some(h) = scene.geometry.shape(kind, i as u32).unwrap().intersect(&r) {
                     r.tmax = h.t;
                     best = Some((h.t, kind as u32, i as u32));
                 }
@@ -491,7 +493,7 @@ mod agreement {
         // 10 000 identical spheres: no split separates them; median splits must.
         let mut s = random_scene(0, &mut Rng::new(1));
         for _ in 0..10_000 {
-            s.spheres.push(Sphere::new(Vec3::ZERO, 1.0), 0);
+            s.geometry.push(Sphere::new(Vec3::ZERO, 1.0), 0);
         }
         let bvh = Bvh::build(&s);
         let h = bvh

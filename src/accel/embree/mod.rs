@@ -5,7 +5,7 @@
 //! - `scene`: the build (triangles natively, one user geometry per analytic kind) and
 //!   the committed scene the queries run on;
 //! - `user`: the user-geometry callbacks, which call the shared `geometry::`
-//!   intersectors.
+//!   intersectors and keep their panics from unwinding into Embree.
 //!
 //! Geometry ids are the [`Kind`](crate::geometry::Kind) discriminants and primitive ids
 //! the index within the kind, exactly as the BVH reports them. Embree 3 and 4 differ in
@@ -85,7 +85,7 @@ impl EmbreeAccel {
             bytes: device.allocated_bytes(),
             scene: committed,
             device,
-            prims: scene.prim_count(),
+            prims: scene.prim_count_with_instances(),
             detail,
             packet_width: crate::accel::DEFAULT_PACKET_WIDTH,
         })
@@ -116,7 +116,7 @@ impl Accel for EmbreeAccel {
         self.scene.intersect(ray)
     }
 
-    #[inline]
+    #[inline(always)]
     fn occluded(&self, ray: &Ray) -> bool {
         self.scene.occluded(ray)
     }

@@ -1,14 +1,15 @@
-//! Scene building (triangles natively, spheres and cones as user geometry) and the
+//! Scene building (triangles natively, one user geometry per analytic kind) and the
 //! committed, immutable scene the ray queries run on.
 
 use super::device::Device;
 use super::error::EmbreeError;
 use super::sys;
-use super::user::{self, UserPrims, UserShape};
+use super::user::{self, UserGeometry, UserPrims, rethrow_caught};
+use crate::accel::unbounded::{Unbounded, is_unbounded};
 use crate::accel::{Hit, NO_INSTANCE, add_kind};
-use crate::geometry::{Cone, Intersect, Kind, Shape, Sphere, Triangle};
+use crate::geometry::{Analytic, Kind, Triangle};
 use crate::math::{Ray, Vec3, Xform};
-use crate::scene::Geometry as SceneGeometry;
+use crate::scene::{Geometry as SceneGeometry, KindVisitor, Prims};
 
 /// An owned geometry handle during the build; released once attached (the scene keeps
 /// its own reference).
@@ -81,26 +82,12 @@ impl Drop for Level {
     }
 }
 
-/// The user data of the analytic geometries (boxed: Embree holds their addresses).
-/// Never read from Rust, only kept alive for the callbacks.
+/// The user data of the analytic geometries, one `UserPrims<P>` per kind attached
+/// (boxed: Embree holds their addresses). Kept alive for the callbacks; read from Rust
+/// only for a panic caught in a bounds callback.
 #[derive(Debug, Default)]
 struct UserData {
-    _spheres: Option<Box<UserPrims<Sphere>>>,
-    _cones: Option<Box<UserPrims<Cone>>>,
-    // Boxed: Embree holds each one's address, which a growing Vec would move.
-    #[allow(clippy::vec_box)]
-    _shapes: Vec<Box<UserPrims<Shape>>>,
-}
-
-/// A primitive Embree cannot hold (infinite bounds), intersected in Rust before each
-/// query: a plane, an unbounded quadric, possibly inside an instance.
-#[derive(Debug)]
-struct Unbounded {
-    shape: Shape,
-    kind: Kind,
-    prim: u32,
-    /// `(instance index, its transform)` for instanced ones.
-    inst: Option<(u32, Xform)>,
+    kinds: Vec<Box<dyn UserGeometry>>,
 }
 
 /// A committed Embree scene: the top level (with one instance geometry per instance),
@@ -112,7 +99,8 @@ pub(super) struct CommittedScene {
     // geometries let go of the objects' scenes before those are released.
     top: Level,
     _objects: Vec<Level>,
-    unbounded: Vec<Unbounded>,
+    /// What Embree cannot hold (infinite bounds), intersected in Rust before each query.
+    unbounded: Unbounded,
     /// The kinds attached, with counts (see [`crate::accel::AccelStats::kinds`]).
     pub(super) kinds: Vec<(Kind, usize)>,
 }
@@ -122,7 +110,9 @@ pub(super) struct CommittedScene {
 unsafe impl Send for CommittedScene {}
 // SAFETY: after `rtcCommitScene` the scenes are never modified, and Embree documents
 // `rtcIntersect1`/`rtcOccluded1` on a committed scene as safe to call from many threads
-// at once. The user data the callbacks read is immutable, and `Shape` is `Sync`.
+// at once. The primitives the callbacks read are immutable and `Sync` (`Analytic`
+// requires it); the only state they write is the bounds callbacks' panic slot, a
+// `OnceLock`, and only during the commit.
 unsafe impl Sync for CommittedScene {}
 
 impl Level {
@@ -155,56 +145,27 @@ impl Level {
     }
 
     /// Attach every bounded primitive of `geometry`, one geometry per kind present,
-    /// adding what it attaches to `kinds`; returns the unbounded ones (also counted) as
-    /// `(kind, prim_id, shape)`.
+    /// adding to `kinds` the count of each kind (the unbounded ones included: the
+    /// [`Unbounded`] list holds them).
     fn attach_geometry(
         &mut self,
         device: &Device,
         geometry: &SceneGeometry,
         kinds: &mut Vec<(Kind, usize)>,
-    ) -> Result<Vec<(Kind, u32, Shape)>, EmbreeError> {
+    ) -> Result<(), EmbreeError> {
         if !geometry.triangles.is_empty() {
             attach_triangles(device, self, &geometry.triangles.items)?;
             add_kind(kinds, Kind::Triangle, geometry.triangles.len());
         }
-        add_kind(kinds, Kind::Sphere, geometry.spheres.len());
-        add_kind(kinds, Kind::Cone, geometry.cones.len());
-        let all = |n: usize| (0..n as u32).collect::<Vec<u32>>();
-        self.user._spheres = attach_user(
+        let mut attach = AttachUser {
             device,
-            self,
-            Kind::Sphere,
-            &geometry.spheres.items,
-            all(geometry.spheres.len()),
-        )?;
-        self.user._cones = attach_user(
-            device,
-            self,
-            Kind::Cone,
-            &geometry.cones.items,
-            all(geometry.cones.len()),
-        )?;
-        let mut unbounded = Vec::new();
-        for kind in Kind::ALL.into_iter().filter(|k| *k > Kind::Cone) {
-            let mut items = Vec::new();
-            let mut ids = Vec::new();
-            for (i, shape) in (0u32..).zip(&geometry.shapes.items) {
-                if shape.kind() != kind {
-                    continue;
-                }
-                add_kind(kinds, kind, 1);
-                if shape.bounds().is_finite() {
-                    items.push(shape.clone());
-                    ids.push(i);
-                } else {
-                    unbounded.push((kind, i, shape.clone()));
-                }
-            }
-            if let Some(data) = attach_user(device, self, kind, &items, ids)? {
-                self.user._shapes.push(data);
-            }
-        }
-        Ok(unbounded)
+            level: self,
+            kinds,
+            user: Vec::new(),
+        };
+        geometry.try_visit_all(&mut attach)?;
+        self.user.kinds = attach.user;
+        Ok(())
     }
 
     /// Commit after every geometry is attached, building at `quality`.
@@ -216,7 +177,39 @@ impl Level {
         // is boxed in `self.user` (or an object level's), which lives as long as the
         // scene.
         unsafe { sys::rtcCommitScene(self.raw) };
+        if let Some(message) = self.user.kinds.iter().find_map(|u| u.bounds_panic()) {
+            panic!("{message}");
+        }
         device.check("rtcCommitScene")
+    }
+}
+
+/// Attaches one user geometry per kind visited (the bounded primitives of the list),
+/// keeping its user data in `user`.
+struct AttachUser<'a> {
+    device: &'a Device,
+    level: &'a Level,
+    kinds: &'a mut Vec<(Kind, usize)>,
+    user: Vec<Box<dyn UserGeometry>>,
+}
+
+impl KindVisitor for AttachUser<'_> {
+    type Output = Result<(), EmbreeError>;
+
+    fn visit<P: Analytic>(&mut self, list: &Prims<P>) -> Result<(), EmbreeError> {
+        add_kind(self.kinds, P::KIND, list.len());
+        let mut items = Vec::new();
+        let mut ids = Vec::new();
+        for (i, prim, _) in list.iter() {
+            if !is_unbounded(&prim.bounds()) {
+                items.push(prim.clone());
+                ids.push(i);
+            }
+        }
+        if let Some(data) = attach_user(self.device, self.level, P::KIND, items, ids)? {
+            self.user.push(data);
+        }
+        Ok(())
     }
 }
 
@@ -237,34 +230,16 @@ impl CommittedScene {
         };
         let mut kinds = Vec::new();
         let mut objects = Vec::with_capacity(scene.objects.len());
-        let mut object_unbounded = Vec::with_capacity(scene.objects.len());
         for object in &scene.objects {
             let mut level = Level::new(device, robust)?;
-            object_unbounded.push(level.attach_geometry(device, object, &mut kinds)?);
+            level.attach_geometry(device, object, &mut kinds)?;
             level.commit(device, quality)?;
             objects.push(level);
         }
         let mut top = Level::new(device, robust)?;
-        let mut unbounded: Vec<Unbounded> = top
-            .attach_geometry(device, &scene.geometry, &mut kinds)?
-            .into_iter()
-            .map(|(kind, prim, shape)| Unbounded {
-                shape,
-                kind,
-                prim,
-                inst: None,
-            })
-            .collect();
+        top.attach_geometry(device, &scene.geometry, &mut kinds)?;
         for (i, inst) in (0u32..).zip(&scene.instances) {
             let object = inst.object as usize;
-            for (kind, prim, shape) in &object_unbounded[object] {
-                unbounded.push(Unbounded {
-                    shape: shape.clone(),
-                    kind: *kind,
-                    prim: *prim,
-                    inst: Some((i, inst.xform)),
-                });
-            }
             let id = INSTANCE_BASE.checked_add(i).ok_or_else(|| {
                 EmbreeError::emray("building the instances", "too many instances")
             })?;
@@ -274,41 +249,8 @@ impl CommittedScene {
         Ok(CommittedScene {
             top,
             _objects: objects,
-            unbounded,
+            unbounded: Unbounded::new(scene),
             kinds,
-        })
-    }
-
-    /// The nearest unbounded primitive hit in `(ray.tmin, ray.tmax)`.
-    #[inline]
-    fn nearest_unbounded(&self, ray: &Ray) -> Option<Hit> {
-        let mut best: Option<Hit> = None;
-        let mut r = *ray;
-        for u in &self.unbounded {
-            let h = match &u.inst {
-                None => u.shape.intersect(&r),
-                Some((_, x)) => u.shape.intersect(&x.ray_to_object(&r)),
-            };
-            if let Some(h) = h {
-                r.tmax = h.t;
-                best = Some(Hit {
-                    t: h.t,
-                    geom_id: u.kind as u32,
-                    prim_id: u.prim,
-                    u: h.u,
-                    v: h.v,
-                    ng: h.ng,
-                    inst_id: u.inst.map_or(NO_INSTANCE, |(i, _)| i),
-                });
-            }
-        }
-        best
-    }
-
-    fn any_unbounded(&self, ray: &Ray) -> bool {
-        self.unbounded.iter().any(|u| match &u.inst {
-            None => u.shape.occluded(ray),
-            Some((_, x)) => u.shape.occluded(&x.ray_to_object(ray)),
         })
     }
 
@@ -322,8 +264,10 @@ impl CommittedScene {
         if self.unbounded.is_empty() {
             return self.intersect_embree(ray);
         }
+        // The unbounded primitives first, from `tnear` as Embree would, then Embree up
+        // to the nearest of them.
         let tnear = ray.tmin.max(0.0);
-        let near = self.nearest_unbounded(&Ray {
+        let near = self.unbounded.nearest(&Ray {
             tmin: tnear,
             ..*ray
         });
@@ -336,14 +280,16 @@ impl CommittedScene {
     }
 
     /// Whether anything lies in the ray's interval (any hit).
-    #[inline]
+    // Always inlined, as it was before the panic check after the query: shadow rays are
+    // the most frequent query, and the call costs more than the check.
+    #[inline(always)]
     pub(super) fn occluded(&self, ray: &Ray) -> bool {
         if !ray.is_traceable() {
             return false;
         }
         if !self.unbounded.is_empty() {
             let tnear = ray.tmin.max(0.0);
-            if self.any_unbounded(&Ray {
+            if self.unbounded.any(&Ray {
                 tmin: tnear,
                 ..*ray
             }) {
@@ -363,6 +309,7 @@ impl CommittedScene {
             hit: empty_hit(),
         };
         query::intersect(self.top.raw, &mut rayhit);
+        rethrow_caught();
         let hit = &rayhit.hit;
         if hit.geomID == sys::INVALID_GEOMETRY_ID {
             return None;
@@ -381,13 +328,14 @@ impl CommittedScene {
         })
     }
 
-    #[inline]
+    #[inline(always)]
     fn occluded_embree(&self, ray: &Ray) -> bool {
         let Some(tnear) = embree_tnear(ray) else {
             return false;
         };
         let mut r = rtc_ray(ray, tnear);
         query::occluded(self.top.raw, &mut r);
+        rethrow_caught();
         r.tfar == f32::NEG_INFINITY
     }
 }
@@ -455,6 +403,7 @@ macro_rules! packet_query {
                 }
             }
             query::$query(&valid, scene, &mut p);
+            rethrow_caught();
             for (i, out) in hits.iter_mut().enumerate().take($n) {
                 let h = &p.hit;
                 *out = (valid[i] != 0 && h.geomID[i] != sys::INVALID_GEOMETRY_ID).then(|| Hit {
@@ -732,11 +681,11 @@ fn attach_triangles(device: &Device, scene: &Level, tris: &[Triangle]) -> Result
 
 /// One user geometry holding all `prims` of `kind` (none when there are none). Returns
 /// the boxed user data Embree's callbacks read, which must outlive `scene`'s handle.
-fn attach_user<T: UserShape>(
+fn attach_user<T: Analytic>(
     device: &Device,
     scene: &Level,
     kind: Kind,
-    prims: &[T],
+    prims: Vec<T>,
     ids: Vec<u32>,
 ) -> Result<Option<Box<UserPrims<T>>>, EmbreeError> {
     if prims.is_empty() {
@@ -751,10 +700,10 @@ fn attach_user<T: UserShape>(
             ),
         )
     })?;
-    let data = Box::new(UserPrims {
-        items: prims.to_vec().into_boxed_slice(),
-        ids: ids.into_boxed_slice(),
-    });
+    let data = Box::new(UserPrims::new(
+        prims.into_boxed_slice(),
+        ids.into_boxed_slice(),
+    ));
     let geometry = Geometry::new(
         device,
         sys::RTCGeometryType::RTC_GEOMETRY_TYPE_USER,

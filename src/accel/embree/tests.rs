@@ -22,8 +22,8 @@ fn scene() -> Scene {
 }
 
 fn add_triangle(s: &mut Scene, p0: Vec3, p1: Vec3, p2: Vec3) {
-    s.triangles.push(Triangle { p: [p0, p1, p2] }, 0);
-    s.triangle_normals.push(u32::MAX);
+    s.geometry.triangles.push(Triangle { p: [p0, p1, p2] }, 0);
+    s.geometry.triangle_normals.push(u32::MAX);
 }
 
 fn build(s: &Scene) -> EmbreeAccel {
@@ -85,7 +85,7 @@ fn one_triangle_hit_t_u_v_and_normal() {
         Vec3::new(-1.0, 2.5, 4.5),
     );
     add_triangle(&mut s, p0, p1, p2);
-    let tri = s.triangles.items[0];
+    let tri = s.geometry.triangles.items[0];
     let accel = build(&s);
 
     for (u, v) in [(0.2f32, 0.3f32), (0.6, 0.1), (0.05, 0.9), (0.33, 0.33)] {
@@ -137,7 +137,7 @@ fn one_triangle_hit_t_u_v_and_normal() {
 fn sphere_hits_equal_the_shared_intersector() {
     let mut s = scene();
     let sphere = Sphere::new(Vec3::new(0.5, -0.25, 6.0), 1.5);
-    s.spheres.push(sphere, 0);
+    s.geometry.push(sphere, 0);
     let accel = build(&s);
     let origins = [
         Vec3::ZERO,
@@ -180,7 +180,7 @@ fn cone_hits_equal_the_shared_intersector() {
     ];
     for cone in cones {
         let mut s = scene();
-        s.cones.push(cone, 0);
+        s.geometry.push(cone, 0);
         let accel = build(&s);
         let centre = (cone.base + cone.apex) * 0.5;
         let mut hits = 0;
@@ -213,8 +213,9 @@ fn ids_are_kind_and_index_with_several_prims_of_each_kind() {
             Vec3::new(x + 0.5, 2.5, 10.0),
             Vec3::new(x, 3.5, 10.0),
         );
-        s.spheres.push(Sphere::new(Vec3::new(x, 0.0, 10.0), 0.5), 0);
-        s.cones.push(
+        s.geometry
+            .push(Sphere::new(Vec3::new(x, 0.0, 10.0), 0.5), 0);
+        s.geometry.push(
             Cone::new(Vec3::new(x, -3.5, 10.0), 0.5, Vec3::new(x, -2.5, 10.0), 0.5),
             0,
         );
@@ -251,9 +252,9 @@ fn nearest_hit_across_kinds() {
         Vec3::new(1.0, -1.0, 3.0),
         Vec3::new(0.0, 1.0, 3.0),
     );
-    s.spheres
+    s.geometry
         .push(Sphere::new(Vec3::new(0.0, 0.0, 6.0), 1.0), 0);
-    s.cones.push(
+    s.geometry.push(
         Cone::new(
             Vec3::new(-2.0, 0.0, 9.0),
             0.5,
@@ -291,9 +292,9 @@ fn occluded_true_and_false() {
         Vec3::new(1.0, -1.0, 3.0),
         Vec3::new(0.0, 1.0, 3.0),
     );
-    s.spheres
+    s.geometry
         .push(Sphere::new(Vec3::new(5.0, 0.0, 6.0), 1.0), 0);
-    s.cones.push(
+    s.geometry.push(
         Cone::new(
             Vec3::new(-5.0, -1.0, 6.0),
             1.0,
@@ -325,7 +326,7 @@ fn occluded_true_and_false() {
 #[test]
 fn tmin_and_tmax_are_honoured() {
     let mut s = scene();
-    s.spheres
+    s.geometry
         .push(Sphere::new(Vec3::new(0.0, 0.0, 5.0), 1.0), 0);
     add_triangle(
         &mut s,
@@ -334,7 +335,7 @@ fn tmin_and_tmax_are_honoured() {
         Vec3::new(3.0, 1.0, 5.0),
     );
     let accel = build(&s);
-    let sphere = s.spheres.items[0];
+    let sphere = s.geometry.spheres().items[0];
     let with = |dir: Vec3, tmin: f32, tmax: f32| Ray {
         org: Vec3::ZERO,
         dir,
@@ -387,7 +388,7 @@ fn inside_only_sphere_seen_from_outside_shows_its_far_side() {
     let mut s = scene();
     let sphere = Sphere::new(Vec3::new(0.0, 0.0, 5.0), -1.0);
     assert!(sphere.inside_only);
-    s.spheres.push(sphere, 0);
+    s.geometry.push(sphere, 0);
     let accel = build(&s);
     let r = ray(Vec3::ZERO, Vec3::Z);
     let h = accel.intersect(&r).expect("far side");
@@ -412,7 +413,7 @@ fn inside_only_sphere_seen_from_outside_shows_its_far_side() {
 #[test]
 fn stats_report_embree_and_its_version() {
     let mut s = scene();
-    s.spheres
+    s.geometry
         .push(Sphere::new(Vec3::new(0.0, 0.0, 5.0), 1.0), 0);
     add_triangle(&mut s, Vec3::X, Vec3::Y, Vec3::Z);
     let accel = build(&s);
@@ -438,9 +439,9 @@ fn queries_from_many_threads_agree() {
     let mut s = scene();
     for i in 0..20 {
         let x = i as f32 - 10.0;
-        s.spheres
+        s.geometry
             .push(Sphere::new(Vec3::new(x, 0.3 * x, 12.0), 0.6), 0);
-        s.cones.push(
+        s.geometry.push(
             Cone::new(Vec3::new(x, -3.0, 14.0), 0.4, Vec3::new(x, 3.0, 14.0), 0.1),
             0,
         );
@@ -547,11 +548,11 @@ fn triangles_spheres_cones() -> Scene {
             );
         }
     }
-    s.spheres
+    s.geometry
         .push(Sphere::new(Vec3::new(0.5, -0.25, 6.0), 1.2), 0);
-    s.spheres
+    s.geometry
         .push(Sphere::new(Vec3::new(-1.5, 1.0, 5.0), 0.6), 0);
-    s.cones.push(
+    s.geometry.push(
         Cone::new(
             Vec3::new(-2.0, -1.5, 5.0),
             0.4,
@@ -598,7 +599,8 @@ fn packets_find_what_single_rays_find() {
 fn packets_with_an_unbounded_plane_fall_back_to_single_rays() {
     let mut s = triangles_spheres_cones();
     let plane = crate::geometry::Plane::new(Vec3::new(0.0, 0.0, -1.0), -7.0).expect("plane");
-    s.add_shape(crate::geometry::Shape::Plane(plane), 0);
+    s.geometry
+        .add_shape(crate::geometry::Shape::Plane(plane), 0);
     let accel = build(&s);
     let rays = packet_rays();
     let mut hits = vec![None; rays.len()];
@@ -635,4 +637,60 @@ fn packet_width_does_not_change_a_render_of_spheres() {
                 .all(|(a, b)| a.to_bits() == b.to_bits())
         );
     }
+}
+
+/// The text of a caught panic.
+fn panic_text(payload: Box<dyn std::any::Any + Send>) -> String {
+    match payload.downcast::<String>() {
+        Ok(s) => *s,
+        Err(payload) => payload
+            .downcast_ref::<&str>()
+            .map_or_else(|| "(no message)".into(), |s| s.to_string()),
+    }
+}
+
+#[test]
+fn a_panic_in_a_callback_comes_back_after_the_query_instead_of_aborting() {
+    use super::user::{Callback, inject};
+    use std::panic::{AssertUnwindSafe, catch_unwind};
+    let mut s = scene();
+    s.geometry
+        .push(Sphere::new(Vec3::new(0.0, 0.0, 5.0), 1.0), 0);
+    let accel = build(&s).with_packet_width(8);
+    let r = ray(Vec3::ZERO, Vec3::Z);
+    let rays = vec![r; 8];
+    let mut hits = vec![None; 8];
+    let cases: [(Callback, &str, &dyn Fn()); 3] = [
+        (Callback::Intersect, "intersect", &|| {
+            accel.intersect(&r);
+        }),
+        (Callback::Occluded, "occluded", &|| {
+            accel.occluded(&r);
+        }),
+        (Callback::Intersect, "intersect", &|| {
+            accel.intersect_coherent(&rays, &mut vec![None; 8]);
+        }),
+    ];
+    for (callback, name, query) in cases {
+        inject::panic_next(callback);
+        let caught = catch_unwind(AssertUnwindSafe(query)).expect_err("the query panics");
+        assert_eq!(
+            panic_text(caught),
+            format!("the Embree {name} callback of the spheres panicked: injected panic")
+        );
+        // Nothing is left over: the next queries on this thread are as usual.
+        assert_eq!(accel.intersect(&r).map(|h| h.t), Some(4.0));
+        assert!(accel.occluded(&r));
+        accel.intersect_coherent(&rays, &mut hits);
+        assert!(hits.iter().all(|h| h.is_some_and(|h| h.t == 4.0)));
+    }
+    // The bounds callback runs on Embree's build threads: its panic comes back from
+    // the build.
+    inject::panic_next(Callback::Bounds);
+    let caught = catch_unwind(|| EmbreeAccel::build(&s)).expect_err("the build panics");
+    assert_eq!(
+        panic_text(caught),
+        "the Embree bounds callback of the spheres panicked: injected panic"
+    );
+    assert!(build(&s).intersect(&r).is_some());
 }

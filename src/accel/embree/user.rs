@@ -1,11 +1,25 @@
 //! User geometry: one Embree geometry per analytic shape kind, holding all primitives of
 //! that kind. Its callbacks call the same `geometry::` intersectors as the pure-Rust BVH,
-//! so both backends give the same hits for spheres and cones, bit for bit.
+//! so both backends give the same hits for every analytic kind, bit for bit.
 //!
-//! The callbacks are panic-free by construction (a panic across `extern "C"` aborts):
-//! no indexing that can fail (`get`), no allocation, no locks, only float arithmetic in
-//! the intersectors. They keep no shared counters (a shared atomic costs ~30% at two
-//! threads).
+//! A panic must not unwind out of an `extern "C"` callback into Embree (Rust aborts the
+//! process there). Every callback therefore runs the Rust intersector inside
+//! [`std::panic::catch_unwind`]; a caught panic is recorded and the primitive reported
+//! as missed (empty bounds for the bounds callback), and the panic is raised again on
+//! the Rust side once Embree has returned:
+//! - ray queries (`rtcIntersect1/4/8/16`, `rtcOccluded1/4/8/16`) run their traversal, and
+//!   so the intersect and occluded callbacks, on the thread that calls them (Embree 3
+//!   and 4 alike: the callbacks are "invoked by `rtcIntersect`-type ray queries", and
+//!   only scene builds use Embree's worker threads), so the panic is kept in a
+//!   thread-local slot and [`rethrow_caught`] raises it right after the query returns;
+//! - the bounds callback runs during `rtcCommitScene`, on Embree's build threads, so its
+//!   panic is kept in the geometry's user data and raised after the commit
+//!   ([`UserGeometry::bounds_panic`]).
+//!
+//! The re-raised panic names the callback and the primitive kind and carries the
+//! original message. Otherwise the callbacks avoid failing: no indexing that can fail
+//! (`get`), no allocation, no locks. They keep no shared counters (a shared atomic costs
+//! ~30% at two threads).
 //!
 //! Embree 3 and 4 differ here in two ways, bridged below:
 //! - the `context` member of the argument structs is an `RTCIntersectContext` (3) or an
@@ -18,17 +32,14 @@
 //! We register no intersection filters, so the callbacks do not invoke them
 //! (`rtcFilterIntersection` in 3, `rtcInvokeIntersectFilterFromGeometry` in 4).
 
+use std::cell::{Cell, RefCell};
 use std::ffi::c_void;
+use std::panic::{AssertUnwindSafe, catch_unwind};
+use std::sync::OnceLock;
 
 use super::sys;
-use crate::geometry::Intersect;
+use crate::geometry::Analytic;
 use crate::math::{Aabb, Ray, Vec3};
-
-/// An analytic shape the user-geometry callbacks can intersect: any
-/// [`Intersect`] implementor that can be shared across threads.
-pub(super) trait UserShape: Intersect + Clone + Send + Sync + 'static {}
-
-impl<T: Intersect + Clone + Send + Sync + 'static> UserShape for T {}
 
 /// The user data of one user geometry: its primitives, indexed by Embree's `primID`.
 /// Lives in a `Box` owned by the `EmbreeAccel`, so the pointer Embree holds stays valid
@@ -38,12 +49,153 @@ pub(super) struct UserPrims<T> {
     pub(super) items: Box<[T]>,
     /// The primitive id reported for each item (its index in the scene's list).
     pub(super) ids: Box<[u32]>,
+    /// The first panic caught in the bounds callback (set from Embree's build threads).
+    bounds_panic: OnceLock<String>,
+    /// Test hook: the bounds callback panics.
+    #[cfg(test)]
+    panic_in_bounds: bool,
 }
 
 impl<T> UserPrims<T> {
+    /// The user data of `items`, reported as primitives `ids`.
+    pub(super) fn new(items: Box<[T]>, ids: Box<[u32]>) -> Self {
+        UserPrims {
+            items,
+            ids,
+            bounds_panic: OnceLock::new(),
+            #[cfg(test)]
+            panic_in_bounds: inject::take(Callback::Bounds),
+        }
+    }
+
     /// The pointer registered with `rtcSetGeometryUserData`.
     pub(super) fn as_user_ptr(&self) -> *mut c_void {
         std::ptr::from_ref(self).cast_mut().cast()
+    }
+}
+
+/// The user data of a user geometry as the scene keeps it alive, whatever its kind.
+pub(super) trait UserGeometry: Send + Sync + std::fmt::Debug {
+    /// The message of a panic caught in the bounds callback during the last commit
+    /// (naming the callback and the kind), if there was one.
+    fn bounds_panic(&self) -> Option<String>;
+}
+
+impl<T: Analytic> UserGeometry for UserPrims<T> {
+    fn bounds_panic(&self) -> Option<String> {
+        self.bounds_panic
+            .get()
+            .map(|m| caught_message(Callback::Bounds, T::KIND.name(), m))
+    }
+}
+
+/// The callbacks, to name them in messages (and, in tests, to make one panic).
+#[derive(Clone, Copy, Debug, PartialEq, Eq)]
+pub(super) enum Callback {
+    /// `RTCBoundsFunction`.
+    Bounds,
+    /// `RTCIntersectFunctionN`.
+    Intersect,
+    /// `RTCOccludedFunctionN`.
+    Occluded,
+}
+
+impl Callback {
+    fn name(self) -> &'static str {
+        match self {
+            Callback::Bounds => "bounds",
+            Callback::Intersect => "intersect",
+            Callback::Occluded => "occluded",
+        }
+    }
+}
+
+thread_local! {
+    /// Whether a callback of the current query on this thread caught a panic.
+    static PENDING: Cell<bool> = const { Cell::new(false) };
+    /// The message of the first panic caught since the last [`rethrow_caught`].
+    static CAUGHT: RefCell<Option<String>> = const { RefCell::new(None) };
+}
+
+/// The text of a panic's payload (`panic!` gives a `&str` or a `String`).
+fn payload_text(payload: &(dyn std::any::Any + Send)) -> String {
+    if let Some(s) = payload.downcast_ref::<&str>() {
+        (*s).to_string()
+    } else if let Some(s) = payload.downcast_ref::<String>() {
+        s.clone()
+    } else {
+        "(a panic without a message)".to_string()
+    }
+}
+
+fn caught_message(callback: Callback, kind: &str, message: &str) -> String {
+    format!(
+        "the Embree {} callback of the {kind} panicked: {message}",
+        callback.name()
+    )
+}
+
+/// Keep the first panic caught in a query's callback on this thread (never unwinds).
+#[cold]
+#[inline(never)]
+fn record_query_panic(callback: Callback, kind: &str, payload: &(dyn std::any::Any + Send)) {
+    if !PENDING.get() {
+        let message = caught_message(callback, kind, &payload_text(payload));
+        CAUGHT.set(Some(message));
+        PENDING.set(true);
+    }
+}
+
+/// Raise, on the Rust side, a panic that a callback of the query that just returned on
+/// this thread caught (call right after every `rtcIntersect*`/`rtcOccluded*`).
+#[inline(always)]
+pub(super) fn rethrow_caught() {
+    if PENDING.get() {
+        rethrow_pending();
+    }
+}
+
+#[cold]
+#[inline(never)]
+fn rethrow_pending() -> ! {
+    PENDING.set(false);
+    let message = CAUGHT.take().unwrap_or_default();
+    panic!("{message}");
+}
+
+/// Test hooks: make the next callback of one kind panic.
+#[cfg(test)]
+pub(super) mod inject {
+    use super::Callback;
+    use std::cell::Cell;
+
+    thread_local! {
+        static NEXT: Cell<Option<Callback>> = const { Cell::new(None) };
+    }
+
+    /// Make the next `callback` on this thread panic with "injected panic"; for
+    /// [`Callback::Bounds`], the bounds callbacks of the next user geometry attached on
+    /// this thread (they run on Embree's build threads).
+    pub(in crate::accel::embree) fn panic_next(callback: Callback) {
+        NEXT.set(Some(callback));
+    }
+
+    /// Whether the next `callback` should panic (consumes the request).
+    pub(super) fn take(callback: Callback) -> bool {
+        let hit = NEXT.get() == Some(callback);
+        if hit {
+            NEXT.set(None);
+        }
+        hit
+    }
+}
+
+/// Test hook: panic when [`inject`] asks `callback` to.
+#[cfg(test)]
+#[inline(always)]
+fn maybe_injected_panic(callback: Callback) {
+    if inject::take(callback) {
+        panic!("injected panic");
     }
 }
 
@@ -214,18 +366,32 @@ unsafe fn prims<'a, T>(user_ptr: *mut c_void) -> Option<&'a UserPrims<T>> {
     unsafe { user_ptr.cast::<UserPrims<T>>().as_ref() }
 }
 
-/// `RTCBoundsFunction`: the shape's own bounds.
-pub(super) unsafe extern "C" fn bounds<T: UserShape>(args: *const sys::RTCBoundsFunctionArguments) {
+/// `RTCBoundsFunction`: the shape's own bounds (empty, which Embree skips, for an
+/// unknown primitive or when the shape's `bounds` panics).
+pub(super) unsafe extern "C" fn bounds<T: Analytic>(args: *const sys::RTCBoundsFunctionArguments) {
     // SAFETY: Embree passes a valid argument struct for the duration of the call.
     let Some(args) = (unsafe { args.as_ref() }) else {
         return;
     };
     // SAFETY: this callback is only registered on geometries whose user data is a
     // `UserPrims<T>` (see `scene::attach_user`).
-    let prim =
-        unsafe { prims::<T>(args.geometryUserPtr) }.and_then(|p| p.items.get(args.primID as usize));
-    // An unknown primitive gets empty bounds, which Embree skips.
-    let b = prim.map_or(Aabb::EMPTY, Intersect::bounds);
+    let user = unsafe { prims::<T>(args.geometryUserPtr) };
+    let prim = user.and_then(|p| p.items.get(args.primID as usize));
+    let b = match catch_unwind(AssertUnwindSafe(|| {
+        #[cfg(test)]
+        if user.is_some_and(|u| u.panic_in_bounds) {
+            panic!("injected panic");
+        }
+        prim.map_or(Aabb::EMPTY, T::bounds)
+    })) {
+        Ok(b) => b,
+        Err(payload) => {
+            if let Some(user) = user {
+                let _ = user.bounds_panic.set(payload_text(&*payload));
+            }
+            Aabb::EMPTY
+        }
+    };
     // SAFETY: `bounds_o` points to the output `RTCBounds` Embree provides for this call.
     if let Some(out) = unsafe { args.bounds_o.as_mut() } {
         out.lower_x = b.min.x;
@@ -239,7 +405,7 @@ pub(super) unsafe extern "C" fn bounds<T: UserShape>(args: *const sys::RTCBounds
 
 /// `RTCIntersectFunctionN`: nearest hit with primitive `primID` for each active ray; on
 /// a hit, writes `tfar`, `u`, `v`, `Ng`, `primID`, `geomID` and `instID`.
-pub(super) unsafe extern "C" fn intersect<T: UserShape>(
+pub(super) unsafe extern "C" fn intersect<T: Analytic>(
     args: *const sys::RTCIntersectFunctionNArguments,
 ) {
     // SAFETY: Embree passes a valid argument struct for the duration of the call.
@@ -270,7 +436,16 @@ pub(super) unsafe extern "C" fn intersect<T: UserShape>(
         }
         // SAFETY: `rayhit` is a live `RTCRayHitN` packet of `N` rays and `i < N`.
         let ray = unsafe { packet.ray(i) };
-        match prim.and_then(|p| p.intersect(&ray)) {
+        let hit = catch_unwind(AssertUnwindSafe(|| {
+            #[cfg(test)]
+            maybe_injected_panic(Callback::Intersect);
+            prim.and_then(|p| p.intersect(&ray))
+        }))
+        .unwrap_or_else(|payload| {
+            record_query_panic(Callback::Intersect, T::KIND.name(), &*payload);
+            None
+        });
+        match hit {
             Some(h) => {
                 // SAFETY: ray `i` is active; Embree expects the callback to write its
                 // `tfar` and hit members on a hit. All offsets are inside the packet.
@@ -301,7 +476,7 @@ pub(super) unsafe extern "C" fn intersect<T: UserShape>(
 
 /// `RTCOccludedFunctionN`: for each active ray that primitive `primID` occludes, sets
 /// `tfar = -inf`.
-pub(super) unsafe extern "C" fn occluded<T: UserShape>(
+pub(super) unsafe extern "C" fn occluded<T: Analytic>(
     args: *const sys::RTCOccludedFunctionNArguments,
 ) {
     // SAFETY: Embree passes a valid argument struct for the duration of the call.
@@ -323,7 +498,16 @@ pub(super) unsafe extern "C" fn occluded<T: UserShape>(
         }
         // SAFETY: `ray` is a live `RTCRayN` packet of `N` rays and `i < N`.
         let ray = unsafe { packet.ray(i) };
-        if prim.is_some_and(|p| p.occluded(&ray)) {
+        let occluded = catch_unwind(AssertUnwindSafe(|| {
+            #[cfg(test)]
+            maybe_injected_panic(Callback::Occluded);
+            prim.is_some_and(|p| p.occluded(&ray))
+        }))
+        .unwrap_or_else(|payload| {
+            record_query_panic(Callback::Occluded, T::KIND.name(), &*payload);
+            false
+        });
+        if occluded {
             // SAFETY: ray `i` is active; Embree reads `tfar = -inf` as "occluded".
             unsafe { packet.set_f32(soa::TFAR, i, f32::NEG_INFINITY) };
         } else {

@@ -23,8 +23,8 @@ use super::{MAX_SIDE, SceneSettings, Source, suggest};
 use crate::geometry::bezier::{BezierPatch, teapot_patches, tessellate};
 use crate::geometry::polygon::Triangulator;
 use crate::geometry::{
-    AaBox, CappedCone, Cone, Csg, CsgOp, CsgTree, OBox, Plane, Polyhedron, QuadUv, Quadric, Shape,
-    Sphere, Torus, Triangle,
+    AaBox, CappedCone, Cone, Csg, CsgOp, CsgTree, OBox, Plane, Polyhedron, Primitive, QuadUv,
+    Quadric, Shape, Sphere, Torus, Triangle,
 };
 use crate::load::{LoadError, nff, obj};
 use crate::math::{Aabb, Vec3, Xform};
@@ -487,7 +487,8 @@ fn bake(shape: &Shape, m: &DAffine3) -> Option<Shape> {
 
 /// A primitive constructor's message, prefixed with the object type unless it names
 /// the primitive already.
-fn from_constructor(ty: Ty, e: String) -> String {
+fn from_constructor(ty: Ty, e: impl std::fmt::Display) -> String {
+    let e = e.to_string();
     const NAMES: [&str; 9] = [
         "box",
         "oriented box",
@@ -671,8 +672,10 @@ impl<'a, 's> Builder<'a, 's> {
             (None, Some(f), Some(a)) => (f.span(), a.span()),
             _ => (cam.span(), cam.span()),
         };
-        range::check_point("the camera `from`", f32v(from)).map_err(|e| self.err(from_span, e))?;
-        range::check_point("the camera `at`", f32v(at)).map_err(|e| self.err(at_span, e))?;
+        range::check_point("the camera `from`", f32v(from))
+            .map_err(|e| self.err(from_span, e.to_string()))?;
+        range::check_point("the camera `at`", f32v(at))
+            .map_err(|e| self.err(at_span, e.to_string()))?;
         Ok(Camera {
             from: f32v(from),
             at: f32v(at),
@@ -701,7 +704,7 @@ impl<'a, 's> Builder<'a, 's> {
                     .unwrap_or(Path::new(""))
                     .join(e.get_ref());
                 self.environment =
-                    Some(Environment::load(&path).map_err(|m| self.err(e.span(), m))?);
+                    Some(Environment::load(&path).map_err(|m| self.err(e.span(), m.to_string()))?);
             }
             if let Some(a) = &r.ambient {
                 ambient = self.non_negative3(a, "`ambient`")?;
@@ -774,7 +777,8 @@ impl<'a, 's> Builder<'a, 's> {
                     .parent()
                     .unwrap_or(Path::new(""))
                     .join(file.get_ref());
-                let mut img = Image::load(&path, srgb).map_err(|e| self.err(file.span(), e))?;
+                let mut img =
+                    Image::load(&path, srgb).map_err(|e| self.err(file.span(), e.to_string()))?;
                 img.wrap = match t.wrap.as_ref().map(|w| (w.get_ref().as_str(), w.span())) {
                     None | Some(("repeat", _)) => Wrap::Repeat,
                     Some(("clamp", _)) => Wrap::Clamp,
@@ -840,7 +844,7 @@ impl<'a, 's> Builder<'a, 's> {
         let t = weight(&d.transmittance, "transmittance", 0.0)?;
         if let Err(e) = range::check_ior(t, ior) {
             let at = d.ior.as_ref().map_or(def.span(), |v| v.span());
-            return Err(self.err(at, e));
+            return Err(self.err(at, e.to_string()));
         }
         Ok(Material {
             color,
@@ -899,7 +903,7 @@ impl<'a, 's> Builder<'a, 's> {
         }
         let pos = v3(l.position.get_ref());
         range::check_point("the light `position`", f32v(pos))
-            .map_err(|e| self.err(l.position.span(), e))?;
+            .map_err(|e| self.err(l.position.span(), e.to_string()))?;
         let color = match &l.color {
             Some(c) => self.non_negative3(c, "light `color`")?,
             None => Vec3::ONE,
@@ -1202,7 +1206,9 @@ impl<'a, 's> Builder<'a, 's> {
         span: Range<usize>,
     ) -> R<()> {
         let what = format!("this {}", ty.name());
-        let check = |b: &Aabb| range::check_bounds(&what, b).map_err(|e| self.err(span.clone(), e));
+        let check = |b: &Aabb| {
+            range::check_bounds(&what, b).map_err(|e| self.err(span.clone(), e.to_string()))
+        };
         for b in self.geometry.bounds_since(mark) {
             check(&b)?;
         }
@@ -1581,7 +1587,7 @@ impl<'a, 's> Builder<'a, 's> {
                     xform,
                     child: Box::new(CsgTree::leaf(shape)),
                 };
-                let csg = Csg::new(&tree).map_err(|e| self.err(span, e))?;
+                let csg = Csg::new(&tree).map_err(|e| self.err(span, e.to_string()))?;
                 g.add_shape(Shape::Csg(Arc::new(csg)), material);
                 Ok(())
             }
@@ -1683,7 +1689,7 @@ impl<'a, 's> Builder<'a, 's> {
         let rel = if instanced { DAffine3::IDENTITY } else { x };
         let op = ty.csg_op().expect("a CSG type");
         let tree = self.csg_operands(node, ty, op, rel, None, 0)?;
-        let csg = Csg::new(&tree).map_err(|e| self.err(span.clone(), e))?;
+        let csg = Csg::new(&tree).map_err(|e| self.err(span.clone(), e.to_string()))?;
         let shape = Shape::Csg(Arc::new(csg));
         if instanced {
             self.place_shape(shape, &x, material, span, sink)
@@ -2225,17 +2231,9 @@ impl<'a, 's> Builder<'a, 's> {
             }
         }
         let span = o.ty.span();
-        for (i, sphere) in s.spheres.items.iter().enumerate() {
-            let m = mat(s.spheres.material[i]);
-            self.place_shape(Shape::Sphere(*sphere), &x, m, span.clone(), sink)?;
-        }
-        for (i, cone) in s.cones.items.iter().enumerate() {
-            let m = mat(s.cones.material[i]);
-            self.place_shape(Shape::Cone(*cone), &x, m, span.clone(), sink)?;
-        }
-        for (i, shape) in s.shapes.items.iter().enumerate() {
-            let m = mat(s.shapes.material[i]);
-            self.place_shape(shape.clone(), &x, m, span.clone(), sink)?;
+        for entry in s.shapes() {
+            let m = mat(entry.material);
+            self.place_shape(entry.shape, &x, m, span.clone(), sink)?;
         }
         Ok(())
     }
