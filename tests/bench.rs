@@ -3,16 +3,9 @@
 
 use emray::bench::{self, Mode, RunSpec, raw};
 use emray::render::RenderSettings;
-use std::path::Path;
-use std::process::{Command, Output};
 
-fn emray(args: &[&str], cwd: &Path) -> Output {
-    Command::new(env!("CARGO_BIN_EXE_emray"))
-        .args(args)
-        .current_dir(cwd)
-        .output()
-        .expect("emray runs")
-}
+mod common;
+use common::emray;
 
 fn backends() -> &'static str {
     if cfg!(feature = "embree") {
@@ -43,7 +36,7 @@ fn tiny_suite_writes_its_reports_and_compares_with_a_baseline() {
         "--csv",
         "base.csv",
     ];
-    let o = emray(&args, d);
+    let o = emray(d, &args);
     let md = String::from_utf8_lossy(&o.stdout);
     assert!(o.status.success(), "{}", String::from_utf8_lossy(&o.stderr));
     assert!(md.contains("| spd:tetra?size=1 | 4 | bvh | 1 |"), "{md}");
@@ -64,6 +57,7 @@ fn tiny_suite_writes_its_reports_and_compares_with_a_baseline() {
     }
 
     let o = emray(
+        d,
         &[
             "bench",
             "spd:tetra?size=1",
@@ -80,7 +74,6 @@ fn tiny_suite_writes_its_reports_and_compares_with_a_baseline() {
             "--baseline",
             "base.json",
         ],
-        d,
     );
     let md = String::from_utf8_lossy(&o.stdout);
     assert!(o.status.success(), "{}", String::from_utf8_lossy(&o.stderr));
@@ -93,15 +86,15 @@ fn bad_input_is_refused_clearly() {
     let dir = tempfile::tempdir().unwrap();
     let d = dir.path();
     std::fs::write(d.join("bad.json"), "{\"rows\": 3}").unwrap();
-    let o = emray(&["bench", "spd:tetra?size=1", "--baseline", "bad.json"], d);
+    let o = emray(d, &["bench", "spd:tetra?size=1", "--baseline", "bad.json"]);
     assert_eq!(o.status.code(), Some(1));
     let err = String::from_utf8_lossy(&o.stderr);
     assert!(err.contains("bad.json:1:"), "{err}");
     assert!(err.contains("not an `emray bench --json` file"), "{err}");
-    let o = emray(&["bench", "spd:nosuch"], d);
+    let o = emray(d, &["bench", "spd:nosuch"]);
     assert_eq!(o.status.code(), Some(2));
     assert!(String::from_utf8_lossy(&o.stderr).contains("unknown database"));
-    let o = emray(&["bench", "missing.nff", "--no-peer"], d);
+    let o = emray(d, &["bench", "missing.nff", "--no-peer"]);
     assert_eq!(o.status.code(), Some(1));
     assert!(String::from_utf8_lossy(&o.stderr).contains("missing.nff: no such scene file"));
     assert!(!d.join("missing.json").exists());

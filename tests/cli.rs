@@ -1,19 +1,10 @@
 //! The `emray` command: exit codes, messages, and no output left behind on error.
 
 use std::path::Path;
-use std::process::{Command, Output};
+use std::process::Command;
 
-fn emray(args: &[&str], cwd: &Path) -> Output {
-    Command::new(env!("CARGO_BIN_EXE_emray"))
-        .args(args)
-        .current_dir(cwd)
-        .output()
-        .expect("run emray")
-}
-
-fn stderr(o: &Output) -> String {
-    String::from_utf8_lossy(&o.stderr).into_owned()
-}
+mod common;
+use common::{emray, stderr};
 
 const SCENE: &str = "v\nfrom 0 0 10\nat 0 0 0\nup 0 1 0\nangle 30\nhither 1\nresolution 40 30\n\
                      b 0.1 0.2 0.3\nl 3 3 10\nf 1 0 0 1 0 0 0 1\ns 0 0 0 2\n";
@@ -23,6 +14,7 @@ fn renders_a_scene_to_png_with_stats() {
     let dir = tempfile::tempdir().unwrap();
     std::fs::write(dir.path().join("a.nff"), SCENE).unwrap();
     let o = emray(
+        dir.path(),
         &[
             "render",
             "a.nff",
@@ -34,7 +26,6 @@ fn renders_a_scene_to_png_with_stats() {
             "--stats-json",
             "s.jsonl",
         ],
-        dir.path(),
     );
     assert!(o.status.success(), "{}", stderr(&o));
     let img = image::open(dir.path().join("out.png")).unwrap();
@@ -74,8 +65,8 @@ fn res_and_exr_output() {
     let dir = tempfile::tempdir().unwrap();
     std::fs::write(dir.path().join("a.nff"), SCENE).unwrap();
     let o = emray(
-        &["render", "a.nff", "-o", "x.exr", "--res", "16x8", "-q"],
         dir.path(),
+        &["render", "a.nff", "-o", "x.exr", "--res", "16x8", "-q"],
     );
     assert!(o.status.success(), "{}", stderr(&o));
     let meta = exr::meta::MetaData::read_from_file(dir.path().join("x.exr"), false).unwrap();
@@ -86,7 +77,7 @@ fn res_and_exr_output() {
 #[test]
 fn missing_file_is_an_input_error_and_writes_nothing() {
     let dir = tempfile::tempdir().unwrap();
-    let o = emray(&["render", "nope.nff", "-o", "out.png"], dir.path());
+    let o = emray(dir.path(), &["render", "nope.nff", "-o", "out.png"]);
     assert_eq!(o.status.code(), Some(1));
     let e = stderr(&o);
     assert!(e.contains("nope.nff") && e.contains("cannot read"), "{e}");
@@ -99,7 +90,7 @@ fn malformed_scene_reports_path_line_col() {
     let dir = tempfile::tempdir().unwrap();
     let bad = SCENE.replace("s 0 0 0 2", "s 0 0 zero 2");
     std::fs::write(dir.path().join("bad.nff"), bad).unwrap();
-    let o = emray(&["render", "bad.nff", "-o", "out.png"], dir.path());
+    let o = emray(dir.path(), &["render", "bad.nff", "-o", "out.png"]);
     assert_eq!(o.status.code(), Some(1));
     let e = stderr(&o);
     assert!(e.contains("bad.nff:11:7:"), "{e}");
@@ -125,7 +116,7 @@ fn usage_errors_exit_2() {
         vec!["render", "a.nff", "--tile", "4/4", "-o", "part.exr"],
         vec!["render", "a.nff", "--crop", "5,1,0,9", "-o", "part.exr"],
     ] {
-        let o = emray(&args, dir.path());
+        let o = emray(dir.path(), &args);
         assert_eq!(o.status.code(), Some(2), "{args:?}: {}", stderr(&o));
         assert!(!stderr(&o).is_empty());
     }
@@ -139,8 +130,8 @@ fn several_scenes_with_a_template_and_a_failure() {
     std::fs::write(dir.path().join("a.nff"), SCENE).unwrap();
     std::fs::write(dir.path().join("b.nff"), "v\nfrom 0 0 1\n").unwrap();
     let o = emray(
-        &["render", "a.nff", "b.nff", "-o", "{stem}-out.png", "-q"],
         dir.path(),
+        &["render", "a.nff", "b.nff", "-o", "{stem}-out.png", "-q"],
     );
     assert_eq!(o.status.code(), Some(1));
     let e = stderr(&o);
@@ -169,20 +160,20 @@ fn no_arguments_renders_the_default_scene() {
 #[test]
 fn gen_writes_nff_that_renders() {
     let dir = tempfile::tempdir().unwrap();
-    let o = emray(&["gen", "tetra", "-s", "2"], dir.path());
+    let o = emray(dir.path(), &["gen", "tetra", "-s", "2"]);
     assert!(o.status.success(), "{}", stderr(&o));
     let text = String::from_utf8(o.stdout).unwrap();
     let scene = emray::load::nff::parse_str(&text, Path::new("tetra")).unwrap();
     assert_eq!(scene.geometry.triangles.len(), 16, "4^2 triangles");
-    let o = emray(&["gen", "tetra", "-s", "2", "-o", "t.nff"], dir.path());
+    let o = emray(dir.path(), &["gen", "tetra", "-s", "2", "-o", "t.nff"]);
     assert!(o.status.success(), "{}", stderr(&o));
     assert_eq!(
         std::fs::read_to_string(dir.path().join("t.nff")).unwrap(),
         text
     );
     let o = emray(
-        &["render", "spd:tetra?size=2", "--res", "32x32", "-q"],
         dir.path(),
+        &["render", "spd:tetra?size=2", "--res", "32x32", "-q"],
     );
     assert!(o.status.success(), "{}", stderr(&o));
     assert!(dir.path().join("tetra_s2.png").exists());
@@ -198,7 +189,7 @@ fn gen_refuses_bad_databases_and_sizes() {
         vec!["render", "spd:balls?size=1000"],
         vec!["render", "spd:nope"],
     ] {
-        let o = emray(&args, dir.path());
+        let o = emray(dir.path(), &args);
         assert_eq!(o.status.code(), Some(2), "{args:?}: {}", stderr(&o));
         assert!(stderr(&o).contains("emray: error:"), "{}", stderr(&o));
     }
@@ -239,7 +230,7 @@ fn input_errors_exit_1_with_one_line_and_write_nothing() {
             "emray: error: nodir/t.nff: cannot write",
         ),
     ] {
-        let o = emray(&args, dir.path());
+        let o = emray(dir.path(), &args);
         assert_eq!(o.status.code(), Some(1), "{args:?}: {}", stderr(&o));
         let e = stderr(&o);
         assert!(e.contains(wanted), "{args:?}: {e}");
@@ -272,7 +263,7 @@ fn batch_usage_errors_exit_2_before_any_job() {
         ),
         (vec!["batch", "spd:nope"], "unknown database 'nope'"),
     ] {
-        let o = emray(&args, dir.path());
+        let o = emray(dir.path(), &args);
         assert_eq!(o.status.code(), Some(2), "{args:?}: {}", stderr(&o));
         let e = stderr(&o);
         assert!(
@@ -288,14 +279,14 @@ fn an_out_of_range_tile_is_called_a_tile_and_a_shard_a_shard() {
     let dir = tempfile::tempdir().unwrap();
     std::fs::write(dir.path().join("a.nff"), SCENE).unwrap();
     let o = emray(
-        &["render", "a.nff", "--tile", "4/4", "-o", "x.exr"],
         dir.path(),
+        &["render", "a.nff", "--tile", "4/4", "-o", "x.exr"],
     );
     assert_eq!(o.status.code(), Some(2));
     let e = stderr(&o);
     assert!(e.contains("tile '4/4': need 0 <= I < N"), "{e}");
     assert!(!e.contains("shard"), "{e}");
-    let o = emray(&["batch", "a.nff", "--shard", "4/4"], dir.path());
+    let o = emray(dir.path(), &["batch", "a.nff", "--shard", "4/4"]);
     assert_eq!(o.status.code(), Some(2));
     assert!(
         stderr(&o).contains("shard '4/4': need 0 <= I < N"),
@@ -307,7 +298,7 @@ fn an_out_of_range_tile_is_called_a_tile_and_a_shard_a_shard() {
 #[test]
 fn help_names_every_scene_format_and_counts_parts_from_zero() {
     let dir = tempfile::tempdir().unwrap();
-    let help = |args: &[&str]| String::from_utf8(emray(args, dir.path()).stdout).unwrap();
+    let help = |args: &[&str]| String::from_utf8(emray(dir.path(), args).stdout).unwrap();
     let render = help(&["render", "--help"]);
     assert!(
         render.contains("Scene files: NFF, TOML (`.toml`), OBJ (`.obj`), or `spd:NAME[?size=N]`"),

@@ -2,10 +2,11 @@
 //! backends (at size 2 and 64×64, the backends differ on at most one pixel), with
 //! counts per the SPD's formulas at small sizes.
 
-use emray::accel::Backend;
 use emray::render::RenderSettings;
 use emray::spd::Database;
 use std::path::Path;
+
+mod common;
 
 /// (database, size, triangles, spheres, cones) expected after loading: polygons are
 /// triangulated, so a `p n` gives n − 2 triangles.
@@ -57,11 +58,7 @@ fn databases_parse_with_the_expected_counts() {
 
 #[test]
 fn databases_render_on_every_backend() {
-    let backends: &[Backend] = if cfg!(feature = "embree") {
-        &[Backend::Bvh, Backend::Embree]
-    } else {
-        &[Backend::Bvh]
-    };
+    let backends = common::backends();
     for db in Database::ALL {
         let text = db.generate(2);
         let scene = emray::load::nff::parse_str(&text, Path::new(db.name())).unwrap();
@@ -69,7 +66,7 @@ fn databases_render_on_every_backend() {
         st.width = 64;
         st.height = 64;
         let mut films = Vec::new();
-        for &b in backends {
+        for &b in &backends {
             let (film, report) =
                 emray::run::render_scene(db.name(), &scene, b, &st, 0.0, None).unwrap();
             assert!(report.rays["eye_hit"] > 0, "{}: nothing visible", db.name());

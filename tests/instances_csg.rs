@@ -14,13 +14,8 @@ use emray::scene::{Camera, Geometry, Instance, Light, Material};
 use glam::{Affine3A, Quat};
 use std::sync::Arc;
 
-fn backends() -> Vec<Backend> {
-    if cfg!(feature = "embree") {
-        vec![Backend::Bvh, Backend::Embree]
-    } else {
-        vec![Backend::Bvh]
-    }
-}
+mod common;
+use common::backends;
 
 fn base_scene(res: u32) -> Scene {
     let mut s = Scene::new(Camera {

@@ -2,8 +2,9 @@
 //! nesting, unreadable files. Every case exits with status 1, prints one line naming
 //! the file, and writes no output (nor a temporary file).
 
-use std::path::Path;
-use std::process::{Command, Output};
+
+mod common;
+use common::emray;
 
 const CAMERA: &str = "v\nfrom 0 0 5\nat 0 0 0\nup 0 1 0\nangle 40\nhither 1\nresolution 8 8\n";
 
@@ -100,14 +101,6 @@ fn corpus() -> Vec<(&'static str, Option<Vec<u8>>)> {
         ),
         ("directory.nff", None),
     ]
-}
-
-fn emray(dir: &Path, args: &[&str]) -> Output {
-    Command::new(env!("CARGO_BIN_EXE_emray"))
-        .current_dir(dir)
-        .args(args)
-        .output()
-        .expect("run emray")
 }
 
 #[test]

@@ -16,13 +16,8 @@ use emray::scene::{Camera, Light, Material};
 use glam::Quat;
 use std::sync::Arc;
 
-fn backends() -> Vec<Backend> {
-    if cfg!(feature = "embree") {
-        vec![Backend::Bvh, Backend::Embree]
-    } else {
-        vec![Backend::Bvh]
-    }
-}
+mod common;
+use common::backends;
 
 /// One of each analytic kind along the x axis, at x = -7.5 + 1.5 k.
 fn shapes() -> Vec<Shape> {

@@ -14,6 +14,8 @@ use emray::run::{Report, render_scene};
 use std::path::Path;
 use std::process::Command;
 
+mod common;
+
 fn scene(src: &str) -> Scene {
     parse_str(src, Path::new("<test>")).unwrap_or_else(|e| panic!("{e}"))
 }
@@ -246,11 +248,7 @@ fn f32_render_agrees_with_the_f64_reference() {
     assert!(rr.refraction > 0 && rr.reflection > 0);
     let mut st = RenderSettings::for_scene(&s);
     st.spp = 64;
-    let backends = if cfg!(feature = "embree") {
-        vec![Backend::Bvh, Backend::Embree]
-    } else {
-        vec![Backend::Bvh]
-    };
+    let backends = common::backends();
     for b in backends {
         let (f32_film, _) = render_scene("t", &s, b, &st, 0.0, None).unwrap();
         let m = compare(&f32_film, &reference);

@@ -8,6 +8,9 @@ use emray::Scene;
 use emray::accel::Backend;
 use std::path::{Path, PathBuf};
 
+mod common;
+use common::backends;
+
 fn inputs(format: &str) -> Vec<PathBuf> {
     let dir = Path::new(env!("CARGO_MANIFEST_DIR"))
         .join("tests/regressions")
@@ -24,14 +27,6 @@ fn inputs(format: &str) -> Vec<PathBuf> {
         dir.display()
     );
     files
-}
-
-fn backends() -> Vec<Backend> {
-    let mut b = vec![Backend::Bvh];
-    if cfg!(feature = "embree") {
-        b.push(Backend::Embree);
-    }
-    b
 }
 
 /// Render `scene` as the fuzz targets do (6×5, depth ≤ 6, one sample) on every backend.

@@ -8,20 +8,15 @@ use emray::render::{Film, RenderSettings};
 use emray::run::{Report, render_scene};
 use std::path::Path;
 
+mod common;
+use common::backends;
+
 fn scene(src: &str) -> Scene {
     parse_str(src, Path::new("<test>")).unwrap_or_else(|e| panic!("{e}"))
 }
 
 fn render(s: &Scene, backend: Backend, settings: &RenderSettings) -> (Film, Report) {
     render_scene("test", s, backend, settings, 0.0, None).unwrap()
-}
-
-fn backends() -> Vec<Backend> {
-    if cfg!(feature = "embree") {
-        vec![Backend::Bvh, Backend::Embree]
-    } else {
-        vec![Backend::Bvh]
-    }
 }
 
 const VIEW: &str = "v\nfrom 0 0 10\nat 0 0 0\nup 0 1 0\nangle 30\nhither 1\nresolution 400 400\n";

@@ -9,13 +9,8 @@ use emray::math::{Ray, Vec3};
 use emray::quality::stress::{self, acne, convex_scene, differing_share, floor_scene, render};
 use std::path::Path;
 
-fn backends() -> Vec<Backend> {
-    if cfg!(feature = "embree") {
-        vec![Backend::Bvh, Backend::Embree]
-    } else {
-        vec![Backend::Bvh]
-    }
-}
+mod common;
+use common::backends;
 
 #[test]
 fn scaled_scenes_render_the_same_image_without_acne() {

@@ -5,7 +5,7 @@
 
 use emray::Hit;
 use emray::accel::WithAccel;
-use emray::accel::{Accel, Backend};
+use emray::accel::Accel;
 use emray::geometry::{Kind, Sphere, Triangle, inverse_bilinear};
 use emray::load::obj::{MISSING_TEXTURE, load_geometry};
 use emray::math::{Ray, Vec3};
@@ -18,13 +18,8 @@ use std::path::Path;
 use std::sync::Arc;
 use tempfile::TempDir;
 
-fn backends() -> Vec<Backend> {
-    if cfg!(feature = "embree") {
-        vec![Backend::Embree, Backend::Bvh]
-    } else {
-        vec![Backend::Bvh]
-    }
-}
+mod common;
+use common::backends;
 
 /// A 3 × 2 image whose texel (i, j) is (i, j, 1) / 4: every texel distinct.
 fn grid_image() -> Image {
