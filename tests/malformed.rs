@@ -2,7 +2,6 @@
 //! nesting, unreadable files. Every case exits with status 1, prints one line naming
 //! the file, and writes no output (nor a temporary file).
 
-
 mod common;
 use common::emray;
 

@@ -4,8 +4,8 @@
 //! texel behind the camera, OBJ `vt`/MTL maps as documented, and backend agreement.
 
 use emray::Hit;
-use emray::accel::WithAccel;
 use emray::accel::Accel;
+use emray::accel::WithAccel;
 use emray::geometry::{Kind, Sphere, Triangle, inverse_bilinear};
 use emray::load::obj::{MISSING_TEXTURE, load_geometry};
 use emray::math::{Ray, Vec3};

@@ -3,10 +3,10 @@
 //! carries a hash of the scene and the settings; [`merge`] checks that the parts come
 //! from one render and cover the image exactly once.
 
-use crate::Scene;
 use crate::accel::Backend;
 use crate::output::part::{HASH_ATTRIBUTE, PartInfo, read_exr};
 use crate::render::{Film, RenderSettings};
+use crate::scene::Scene;
 use std::fmt::Write as _;
 use std::path::{Path, PathBuf};
 

@@ -216,7 +216,7 @@ struct RawWork<'a> {
 
 impl WithAccel for RawWork<'_> {
     type Output = (f64, raw::RawCast, crate::render::RayCounts, String);
-    fn run<A: crate::Accel>(self, accel: &A, build_ms: f64) -> Self::Output {
+    fn run<A: crate::accel::Accel>(self, accel: &A, build_ms: f64) -> Self::Output {
         let (queries, counts) = raw::record(self.scene, accel, self.settings);
         let cast = raw::cast(accel, &queries);
         (build_ms, cast, counts, accel.stats().detail)

@@ -1,4 +1,4 @@
-//! Scene loaders. They build a [`crate::Scene`] and never render.
+//! Scene loaders. They build a [`crate::scene::Scene`] and never render.
 
 pub mod nff;
 pub mod obj;
@@ -44,7 +44,7 @@ impl std::error::Error for LoadError {}
 /// scene format ([`toml`]), `.obj` a Wavefront OBJ model framed by an automatic camera
 /// and light ([`obj::load`]); anything else is read as NFF (`.nff`, and the classic
 /// benchmark files have no fixed extension).
-pub fn load_path(path: &Path) -> Result<crate::Scene, LoadError> {
+pub fn load_path(path: &Path) -> Result<crate::scene::Scene, LoadError> {
     let ext = |e: &str| path.extension().is_some_and(|x| x.eq_ignore_ascii_case(e));
     if ext("toml") {
         self::toml::load(path)

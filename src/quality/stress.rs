@@ -2,12 +2,13 @@
 //! small counts) and `emray stress` (which prints the measured numbers on full counts).
 
 use crate::accel::Accel;
+use crate::accel::Backend;
 use crate::geometry::reference as r64;
 use crate::load::nff::parse_str;
 use crate::math::{DRay, DVec3, Ray, Rng, Vec3, next_float_down, offset_ray_origin};
 use crate::render::{Film, RayGen, RenderSettings};
 use crate::run::render_scene;
-use crate::{Backend, Scene};
+use crate::scene::Scene;
 use std::path::Path;
 
 /// A convex test scene: one sphere and one light (no other surface can shadow it),

@@ -4,12 +4,12 @@
 //! log-log axes to SVG and PNG (plotters), one curve per knob.
 
 use super::metrics::{Metrics, compare};
-use crate::Scene;
 use crate::accel::{AccelError, Backend};
 use crate::output::OutputError;
 use crate::render::reference::Unsupported;
 use crate::render::{Aa, RenderSettings};
 use crate::run::{render_reference, render_scene};
+use crate::scene::Scene;
 use std::fmt::Write as _;
 use std::path::{Path, PathBuf};
 

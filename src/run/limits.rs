@@ -1,8 +1,8 @@
 //! Memory limits: a render is refused, with the numbers, before its large buffers and
 //! the acceleration structure are allocated, when its estimate exceeds the limit.
 
-use crate::Scene;
 use crate::render::{Region, RenderSettings};
+use crate::scene::Scene;
 use std::path::{Path, PathBuf};
 
 /// Bytes per primitive allowed for the acceleration structure (either backend's nodes
