@@ -58,6 +58,7 @@
 //! Levels are capped at [`MAX_LEVEL`] per direction.
 
 mod curve;
+pub mod newell;
 mod patch;
 mod tessellate;
 
@@ -65,7 +66,7 @@ pub use curve::BezierCurve;
 pub use patch::BezierPatch;
 pub use tessellate::{MAX_LEVEL, TriMesh, tessellate};
 
-/// Newell's teapot (the data of the `teapot` database in [`crate::spd`]) as 32
+/// Newell's teapot ([`newell`], the data of the SPD's `teapot` database) as 32
 /// bicubic patches: rim 0–3, body 4–11, handle 12–15, spout 16–19, lid 20–27, bottom
 /// 28–31.
 ///
@@ -76,8 +77,11 @@ pub use tessellate::{MAX_LEVEL, TriMesh, tessellate};
 /// (the pot's mouth), the lid's `v = 1` edge, and both ends of the handle and of the
 /// spout (`v = 0` and `v = 1` of 12–19).
 pub fn teapot_patches() -> Vec<BezierPatch> {
-    BezierPatch::newell_teapot_control_points()
-        .into_iter()
-        .map(|p| BezierPatch::new(p).transposed())
+    newell::PATCHES
+        .iter()
+        .map(|patch| {
+            let rows = patch.map(|row| row.map(|k| glam::DVec3::from_array(newell::VERTS[k])));
+            BezierPatch::new(rows).transposed()
+        })
         .collect()
 }
