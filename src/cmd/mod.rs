@@ -8,6 +8,8 @@ mod args;
 mod batch;
 mod bench;
 mod compare;
+#[cfg(test)]
+mod docs_commands;
 mod error;
 mod generate;
 mod interrupt;
