@@ -1,5 +1,5 @@
-//! One picture of every SPD database at its default size (the README's thumbnail
-//! sheet): `cargo run --release --example contact_sheet -- docs/spd.png [TILE]`.
+//! One picture of every SPD database at its default size (the picture in docs/nff.md):
+//! `cargo run --release --example contact_sheet -- docs/spd.png [TILE]`.
 
 use emray::accel::Backend;
 use emray::render::RenderSettings;

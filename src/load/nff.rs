@@ -1,4 +1,5 @@
-//! The NFF loader (Eric Haines' Neutral File Format, SPD 3.14; DESIGN.md §3).
+//! The NFF loader (Eric Haines' Neutral File Format, SPD 3.14; the conventions are in
+//! docs/nff.md and docs/architecture.md).
 //!
 //! The file is read as a stream of whitespace-separated tokens, each remembering its
 //! line and column, so an entity's numbers may be spread over lines as the writer

@@ -1,6 +1,6 @@
 //! Eye rays from the NFF viewpoint: a right-handed frame from `from`, `at` and `up`,
 //! `angle` spanning the centres of the top and bottom rows of samples, square pixels
-//! (the README's "NFF conventions").
+//! (docs/nff.md, "NFF conventions"; docs/architecture.md, "Camera").
 
 use crate::math::{Ray, Vec3};
 use crate::scene::Camera;

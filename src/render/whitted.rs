@@ -1,6 +1,6 @@
 //! Whitted shading: ambient, Phong light from point lights with shadow rays, emission
 //! and area lights, mirror reflection and Snell refraction through nested media. The
-//! README's "NFF conventions" state the shading formula.
+//! shading formula is in docs/architecture.md ("NFF semantics") and docs/nff.md.
 
 use super::{GlobalIllumination, RayGen, Region, RenderSettings, area};
 use crate::accel::{Accel, Hit};

@@ -341,7 +341,7 @@ impl Database {
 
     /// The largest size factor emray accepts: the largest whose scene renders in less
     /// than 2 GB (peak resident memory of `emray render spd:NAME?size=N --res 64x64` on
-    /// the BVH backend, which needs more than Embree; measured, see the README).
+    /// the BVH backend, which needs more than Embree; measured, see docs/nff.md).
     pub fn max_size(self) -> u32 {
         match self {
             Database::Balls => 7,
