@@ -29,7 +29,7 @@ use std::time::Instant;
 pub enum SceneError {
     /// An `spd:` spec that names no database or a size it cannot generate.
     #[error("{0}")]
-    Spec(String),
+    Spec(#[from] crate::spd::SpecError),
     /// The file could not be read or does not parse (`path:line:col: message`).
     #[error(transparent)]
     Load(#[from] LoadError),

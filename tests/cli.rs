@@ -314,3 +314,77 @@ fn help_names_every_scene_format_and_counts_parts_from_zero() {
         "{batch}"
     );
 }
+
+#[test]
+fn a_missing_output_folder_is_created() {
+    let dir = tempfile::tempdir().unwrap();
+    std::fs::write(dir.path().join("s.nff"), SCENE).unwrap();
+    let o = emray(
+        dir.path(),
+        &["render", "s.nff", "-o", "new/deeper/s.png", "-q"],
+    );
+    assert!(o.status.success(), "{}", stderr(&o));
+    assert!(dir.path().join("new/deeper/s.png").is_file());
+}
+
+#[test]
+fn an_unwritable_output_fails_before_rendering() {
+    let dir = tempfile::tempdir().unwrap();
+    std::fs::write(dir.path().join("s.nff"), SCENE).unwrap();
+    // A regular file where the output's folder should be: no folder can be made there.
+    std::fs::write(dir.path().join("file"), "").unwrap();
+    let o = emray(
+        dir.path(),
+        &["render", "s.nff", "-o", "file/s.png", "--stats"],
+    );
+    assert_eq!(o.status.code(), Some(1), "{}", stderr(&o));
+    let err = stderr(&o);
+    assert!(err.contains("file/s.png: cannot write"), "{err}");
+    assert!(
+        !err.contains(".tmp"),
+        "the message names the target, not a temporary file: {err}"
+    );
+    // Nothing was rendered: the statistics a render prints are absent.
+    let out = String::from_utf8_lossy(&o.stdout);
+    assert!(!out.contains("rays") && !err.contains("rays"), "{out}{err}");
+}
+
+#[test]
+fn two_scenes_writing_one_file_are_refused_before_rendering() {
+    let dir = tempfile::tempdir().unwrap();
+    for d in ["a", "b"] {
+        std::fs::create_dir(dir.path().join(d)).unwrap();
+        std::fs::write(dir.path().join(d).join("s.nff"), SCENE).unwrap();
+    }
+    let o = emray(
+        dir.path(),
+        &["render", "a/s.nff", "b/s.nff", "-o", "out/{stem}.png"],
+    );
+    assert_eq!(o.status.code(), Some(2), "{}", stderr(&o));
+    assert!(stderr(&o).contains("would both write"), "{}", stderr(&o));
+    assert!(!dir.path().join("out").exists(), "nothing is written");
+}
+
+#[test]
+fn a_closed_standard_output_ends_quietly() {
+    use std::io::{BufRead, BufReader};
+    use std::process::Stdio;
+    let dir = tempfile::tempdir().unwrap();
+    // The teapot's NFF is far larger than a pipe's buffer: emray is still writing
+    // when the reader goes away, as with `emray gen teapot | head -1`.
+    let mut child = Command::new(env!("CARGO_BIN_EXE_emray"))
+        .current_dir(dir.path())
+        .args(["gen", "teapot"])
+        .stdout(Stdio::piped())
+        .stderr(Stdio::piped())
+        .spawn()
+        .expect("run emray");
+    let mut first = String::new();
+    BufReader::new(child.stdout.take().unwrap())
+        .read_line(&mut first)
+        .unwrap();
+    assert!(first.starts_with('b') || first.starts_with('v'), "{first}");
+    let o = child.wait_with_output().unwrap();
+    assert_eq!(o.status.code(), Some(0), "{}", stderr(&o));
+    assert_eq!(stderr(&o), "", "nothing printed on a closed pipe");
+}

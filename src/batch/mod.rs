@@ -84,7 +84,7 @@ pub enum BatchError {
     NoMatch(String),
     /// An `spd:` scene spec that names no database or a size it cannot generate.
     #[error("{0}")]
-    Spec(String),
+    Spec(#[from] crate::spd::SpecError),
     /// An output file of an unsupported format.
     #[error(transparent)]
     Output(#[from] OutputError),

@@ -266,8 +266,12 @@ fn run_job(
         record.wall_ms = t0.elapsed().as_secs_f64() * 1e3;
         return Some(record);
     }
-    if let Some(dir) = job.output.parent().filter(|d| !d.as_os_str().is_empty()) {
-        let _ = std::fs::create_dir_all(dir);
+    // An output that cannot be written fails the job before it renders.
+    if let Err(e) = crate::output::prepare(&job.output) {
+        record.status = JobStatus::Failed;
+        record.error = Some(e.to_string());
+        record.wall_ms = t0.elapsed().as_secs_f64() * 1e3;
+        return Some(record);
     }
     let txp = tx.clone();
     let progress = move |d: usize, t: usize| {

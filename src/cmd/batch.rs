@@ -3,6 +3,7 @@
 //! report of what finished.
 
 use super::args::{BackendArg, EncodingArg, parse_res};
+use super::error::print;
 use super::interrupt::cancel_on_ctrl_c;
 use super::progress::BatchDisplay;
 use super::{Error, init_log};
@@ -100,7 +101,12 @@ pub fn run(b: Args) -> Result<(), Error> {
     };
     if b.list {
         for j in &jobs {
-            println!("{}\t{}\t{}", j.name, j.scene.display(), j.output.display());
+            print(format_args!(
+                "{}\t{}\t{}\n",
+                j.name,
+                j.scene.display(),
+                j.output.display()
+            ))?;
         }
         return Ok(());
     }

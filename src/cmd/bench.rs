@@ -3,6 +3,7 @@
 
 use super::Error;
 use super::args::{BackendArg, QualityArg, packet_width, parse_res};
+use super::error::print;
 use emray::accel::Backend;
 use emray::bench::{self, RunSpec};
 use emray::spd::Database;
@@ -75,7 +76,7 @@ pub fn run(b: Args) -> Result<(), Error> {
         .map_err(|e| Error::failed(format!("cannot find the emray executable: {e}")))?;
     let mut log = |line: &str| eprintln!("{line}");
     let md = bench::bench(&cfg, &outs, &exe, &mut log)?;
-    print!("{md}");
+    print(format_args!("{md}"))?;
     Ok(())
 }
 
@@ -84,10 +85,8 @@ fn child(json: &str) -> Result<(), Error> {
     let spec = serde_json::from_str::<RunSpec>(json)
         .map_err(|e| Error::failed(format!("bad run description: {e}")))?;
     let result = bench::run_child(&spec)?;
-    println!(
-        "{}",
-        serde_json::to_string(&result).expect("result serialises")
-    );
+    let json = serde_json::to_string(&result).expect("result serialises");
+    print(format_args!("{json}\n"))?;
     Ok(())
 }
 

@@ -4,6 +4,7 @@
 
 use super::Error;
 use super::args::EncodingArg;
+use super::error::print;
 use std::path::PathBuf;
 
 /// `emray compare`.
@@ -69,9 +70,10 @@ pub fn run(a: Args) -> Result<(), Error> {
     metrics::check_sizes(&test, &a.test, &reference, &a.reference).map_err(usage)?;
     let m = metrics::compare(&test, &reference);
     if a.json {
-        println!("{}", serde_json::to_string(&m).expect("metrics serialise"));
+        let json = serde_json::to_string(&m).expect("metrics serialise");
+        print(format_args!("{json}\n"))?;
     } else {
-        println!("{}", table(&m));
+        print(format_args!("{}\n", table(&m)))?;
     }
     if let Some(out) = &a.diff {
         let heat = metrics::heat_map(&test, &reference);

@@ -8,6 +8,9 @@
 //! | 1 | [`Error::CheckFailed`]: `compare` over a threshold, `stress` outside a bound |
 //! | 2 | [`Error::Usage`]: bad arguments, found before any work (clap's own errors too); `compare`: an unreadable image |
 //! | 130 | [`Error::Interrupted`]: Ctrl-C stopped a `batch` |
+//!
+//! A command whose standard output is closed early (`emray gen teapot | head`) stops
+//! quietly with status 0, as other command-line tools do.
 
 use std::fmt::Display;
 use std::process::ExitCode;
@@ -40,6 +43,9 @@ impl Error {
 
     /// The process's exit status.
     pub fn exit_code(&self) -> u8 {
+        if self.is_closed_pipe() {
+            return 0;
+        }
         match self {
             Error::Usage(_) => 2,
             Error::Failed(_) | Error::CheckFailed => 1,
@@ -55,8 +61,16 @@ impl Error {
         }
     }
 
+    /// Whether the command stopped because its standard output was closed.
+    pub fn is_closed_pipe(&self) -> bool {
+        self.message().is_some_and(is_closed_pipe)
+    }
+
     /// Print the error (once, one line, no backtrace) and give the exit status.
     pub fn report(&self) -> ExitCode {
+        if self.is_closed_pipe() {
+            return ExitCode::SUCCESS;
+        }
         if let Some(e) = self.message() {
             eprintln!("{}", error_line(e));
         }
@@ -69,6 +83,24 @@ impl<E: std::error::Error + Send + Sync + 'static> From<E> for Error {
     fn from(e: E) -> Self {
         Error::Failed(e.into())
     }
+}
+
+/// Whether `e` comes from writing to a pipe whose reader has gone.
+pub fn is_closed_pipe(e: &anyhow::Error) -> bool {
+    e.chain().any(|cause| {
+        cause
+            .downcast_ref::<std::io::Error>()
+            .is_some_and(|io| io.kind() == std::io::ErrorKind::BrokenPipe)
+    })
+}
+
+/// Write `text` to standard output; unlike `print!`, a closed pipe is an error the
+/// caller returns (and the process then ends quietly) rather than a panic.
+pub fn print(text: std::fmt::Arguments) -> std::io::Result<()> {
+    use std::io::Write;
+    let mut out = std::io::stdout().lock();
+    out.write_fmt(text)?;
+    out.flush()
 }
 
 /// The line an error is printed as: `emray: error: ` and the error with its causes

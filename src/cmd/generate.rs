@@ -2,9 +2,9 @@
 //! called `gen`, a reserved word since edition 2024).
 
 use super::Error;
+use super::error::print;
 use anyhow::Context;
 use emray::spd::Database;
-use std::io::Write;
 
 /// `emray gen`.
 #[derive(clap::Args, Debug, Clone)]
@@ -35,9 +35,7 @@ pub fn run(g: Args) -> Result<(), Error> {
     db.check_size(size).map_err(Error::usage)?;
     let text = db.generate(size);
     match &g.output {
-        None => std::io::stdout()
-            .lock()
-            .write_all(text.as_bytes())
+        None => print(format_args!("{text}"))
             .context("cannot write to standard output")
             .map_err(Error::Failed),
         Some(path) => Ok(emray::output::write_text(path, &text)?),

@@ -2,6 +2,7 @@
 //! the solution.
 
 use super::args::{BackendArg, RadiositySolveArgs, parse_res};
+use super::error::print;
 use super::{Error, append_json_line, init_log, thread_pool};
 use anyhow::{Context, Result};
 use emray::accel::Backend;
@@ -75,7 +76,11 @@ fn solve_and_write(a: &Args) -> Result<()> {
         output::write_text(p, &sol.to_ply(1.0))?;
     }
     if a.stats {
-        println!("scene      {}\n{}", a.scene.display(), report.summary());
+        print(format_args!(
+            "scene      {}\n{}\n",
+            a.scene.display(),
+            report.summary()
+        ))?;
     }
     if let Some(path) = &a.stats_json {
         append_json_line(path, &report)?;

@@ -4,7 +4,7 @@
 use super::args::{
     BackendArg, EncodingArg, QualityArg, RadiositySolveArgs, packet_width, parse_res,
 };
-use super::error::error_line;
+use super::error::{error_line, is_closed_pipe, print};
 use super::progress::TileBar;
 use super::{Error, append_json_line, init_log, thread_pool};
 use anyhow::{Result, anyhow, bail};
@@ -17,6 +17,7 @@ use emray::render::{Aa, Film, RenderSettings};
 use emray::run::{self, Part, RenderRequest, Report, limits};
 use emray::scene::Environment;
 use emray::spd::Database;
+use std::collections::HashMap;
 use std::path::{Path, PathBuf};
 use std::time::Instant;
 
@@ -195,11 +196,16 @@ type Job = (Option<PathBuf>, PathBuf);
 pub fn run(args: Args) -> Result<(), Error> {
     init_log(args.quiet, args.verbose);
     let jobs = plan(&args).map_err(Error::Usage)?;
+    // An output that cannot be written is found before any render (a missing folder
+    // is created, as `batch` does).
+    for (_, out) in &jobs {
+        emray::output::prepare(out).map_err(Error::failed)?;
+    }
     let pool = thread_pool(args.threads).map_err(Error::Failed)?;
     let mut failed = 0usize;
     for (scene, out) in &jobs {
         if let Err(e) = pool.install(|| render_one(&args, scene.as_deref(), out)) {
-            if jobs.len() == 1 {
+            if jobs.len() == 1 || is_closed_pipe(&e) {
                 return Err(Error::Failed(e));
             }
             eprintln!("{}", error_line(&e));
@@ -255,7 +261,25 @@ fn plan(args: &Args) -> Result<Vec<Job>> {
             Database::parse_spec(&s.to_string_lossy()).map_err(anyhow::Error::msg)?;
         }
     }
+    check_outputs(&jobs)?;
     Ok(jobs)
+}
+
+/// Refuse, before any render, two scenes that would write the same file.
+fn check_outputs(jobs: &[Job]) -> Result<()> {
+    let mut seen: HashMap<&Path, &Path> = HashMap::new();
+    for (scene, out) in jobs {
+        let scene = scene.as_deref().unwrap_or(Path::new("the default scene"));
+        if let Some(first) = seen.insert(out, scene) {
+            bail!(
+                "{} and {} would both write {}: use an output template that tells them apart",
+                first.display(),
+                scene.display(),
+                out.display()
+            );
+        }
+    }
+    Ok(())
 }
 
 /// Options that cannot go together, and numbers out of range.
@@ -376,7 +400,11 @@ fn render_one(args: &Args, scene_path: Option<&Path>, out: &Path) -> Result<()> 
         None => output::write_image(out, &film, args.encoding.into())?,
     }
     if args.stats {
-        println!("{}\noutput     {}", report.summary(), out.display());
+        print(format_args!(
+            "{}\noutput     {}\n",
+            report.summary(),
+            out.display()
+        ))?;
     } else if !args.quiet {
         log::info!("wrote {}", out.display());
     }

@@ -3,6 +3,7 @@
 
 use super::Error;
 use super::args::parse_res;
+use super::error::print;
 use std::path::PathBuf;
 
 /// `emray study`.
@@ -41,7 +42,7 @@ pub fn run(a: Args) -> Result<(), Error> {
     let rows =
         emray::quality::study::write(&scene, &name, &a.out, w, h, a.reference_strata, &backends)
             .map_err(|e| Error::failed(format!("{name}: {e}")))?;
-    print!("{}", emray::quality::study::csv(&rows));
+    print(format_args!("{}", emray::quality::study::csv(&rows)))?;
     Ok(())
 }
 

@@ -89,6 +89,53 @@ pub fn write_image(path: &Path, film: &Film, encoding: Encoding) -> Result<(), O
     }
 }
 
+/// The folder `path` goes in (`.` for a bare file name).
+fn folder_of(path: &Path) -> &Path {
+    match path.parent() {
+        Some(d) if !d.as_os_str().is_empty() => d,
+        _ => Path::new("."),
+    }
+}
+
+/// A new temporary file beside `path`, named `.NAME.XXXXXXXX.tmp`; deleted when dropped
+/// unless persisted.
+fn temp_beside(path: &Path) -> std::io::Result<tempfile::NamedTempFile> {
+    let name = path
+        .file_name()
+        .map(|n| n.to_string_lossy().into_owned())
+        .unwrap_or_default();
+    tempfile::Builder::new()
+        .prefix(&format!(".{name}."))
+        .suffix(TEMP_SUFFIX)
+        .rand_bytes(TEMP_RAND)
+        .tempfile_in(folder_of(path))
+}
+
+/// Make sure `path` can be written before any work goes into it: create its folder if
+/// missing, and create (then remove) a temporary file there, as the final write will.
+pub fn prepare(path: &Path) -> Result<(), OutputError> {
+    let err = |message: String| OutputError::Write {
+        path: path.to_path_buf(),
+        message,
+    };
+    std::fs::create_dir_all(folder_of(path)).map_err(|e| err(e.to_string()))?;
+    if path.is_dir() {
+        return Err(err("it is a folder".into()));
+    }
+    temp_beside(path).map_err(|e| err(os_message(&e)))?;
+    Ok(())
+}
+
+/// What an I/O error says, without the temporary file's name that `tempfile` appends
+/// ("... at path \"dir/.x.png.AbCd1234.tmp\""): the message names the target instead.
+fn os_message(e: &std::io::Error) -> String {
+    let text = e.to_string();
+    match text.rfind(" at path \"") {
+        Some(at) => text[..at].to_string(),
+        None => text,
+    }
+}
+
 /// Write `path` through a temporary file beside it (`.NAME.XXXXXX.tmp`, so that the
 /// rename is atomic) that `write` fills, then a rename; on failure the temporary file is
 /// removed and the target left as it was.
@@ -100,21 +147,8 @@ pub(crate) fn write_atomic(
         path: path.to_path_buf(),
         message,
     };
-    let dir = match path.parent() {
-        Some(d) if !d.as_os_str().is_empty() => d,
-        _ => Path::new("."),
-    };
-    let name = path
-        .file_name()
-        .map(|n| n.to_string_lossy().into_owned())
-        .unwrap_or_default();
     // Dropping an unpersisted temporary file deletes it.
-    let tmp = tempfile::Builder::new()
-        .prefix(&format!(".{name}."))
-        .suffix(TEMP_SUFFIX)
-        .rand_bytes(TEMP_RAND)
-        .tempfile_in(dir)
-        .map_err(|e| err(e.to_string()))?;
+    let tmp = temp_beside(path).map_err(|e| err(os_message(&e)))?;
     let file = tmp.reopen().map_err(|e| err(e.to_string()))?;
     write(file).map_err(err)?;
     tmp.persist(path).map_err(|e| err(e.error.to_string()))?;

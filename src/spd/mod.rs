@@ -257,6 +257,45 @@ pub fn compare_nff(ours: &str, theirs: &str) -> NffComparison {
     c
 }
 
+/// A size factor a database cannot be generated at.
+#[derive(Clone, Debug, PartialEq, Eq, thiserror::Error)]
+#[error("size factor {size} out of range for {database} (1 to {max})")]
+pub struct SizeError {
+    /// The database's name.
+    pub database: &'static str,
+    /// The size asked for.
+    pub size: u32,
+    /// The largest size it accepts ([`Database::max_size`]).
+    pub max: u32,
+}
+
+/// An `spd:NAME[?size=N]` scene name that cannot be generated.
+#[derive(Clone, Debug, PartialEq, Eq, thiserror::Error)]
+#[error("{spec}: {reason}")]
+pub struct SpecError {
+    /// The scene name as given.
+    pub spec: String,
+    /// What is wrong with it.
+    pub reason: SpecReason,
+}
+
+/// What is wrong with an `spd:` scene name.
+#[derive(Clone, Debug, PartialEq, Eq, thiserror::Error)]
+pub enum SpecReason {
+    /// No database has this name.
+    #[error("unknown database '{0}' (one of {names})", names = Database::ALL.map(|d| d.name()).join(", "))]
+    UnknownDatabase(String),
+    /// Something other than `?size=N` follows the name.
+    #[error("expected '?size=N' after the database name")]
+    NoSize,
+    /// The size is not a whole number.
+    #[error("size '{0}' is not a whole number")]
+    SizeNotWhole(String),
+    /// The size is out of the database's range.
+    #[error(transparent)]
+    Size(SizeError),
+}
+
 /// The databases.
 #[derive(Clone, Copy, Debug, PartialEq, Eq, Hash)]
 pub enum Database {
@@ -360,7 +399,7 @@ impl Database {
 
     /// Parse a scene name of the form `spd:NAME` or `spd:NAME?size=N`; `Ok(None)` when
     /// `spec` does not start with `spd:`.
-    pub fn parse_spec(spec: &str) -> Result<Option<(Database, u32)>, String> {
+    pub fn parse_spec(spec: &str) -> Result<Option<(Database, u32)>, SpecError> {
         let Some(rest) = spec.strip_prefix("spd:") else {
             return Ok(None);
         };
@@ -368,31 +407,35 @@ impl Database {
             Some((n, q)) => (n, Some(q)),
             None => (rest, None),
         };
-        let names = || Database::ALL.map(|d| d.name()).join(", ");
+        let spec_error = |reason| SpecError {
+            spec: spec.to_string(),
+            reason,
+        };
         let db = Database::from_name(name)
-            .ok_or_else(|| format!("{spec}: unknown database '{name}' (one of {})", names()))?;
+            .ok_or_else(|| spec_error(SpecReason::UnknownDatabase(name.to_string())))?;
         let size = match query {
             None => db.default_size(),
             Some(q) => {
                 let v = q
                     .strip_prefix("size=")
-                    .ok_or_else(|| format!("{spec}: expected '?size=N' after the database name"))?;
+                    .ok_or_else(|| spec_error(SpecReason::NoSize))?;
                 v.parse::<u32>()
-                    .map_err(|_| format!("{spec}: size '{v}' is not a whole number"))?
+                    .map_err(|_| spec_error(SpecReason::SizeNotWhole(v.to_string())))?
             }
         };
-        db.check_size(size).map_err(|e| format!("{spec}: {e}"))?;
+        db.check_size(size)
+            .map_err(|e| spec_error(SpecReason::Size(e)))?;
         Ok(Some((db, size)))
     }
 
     /// Refuse size factors outside `1..=max_size()`.
-    pub fn check_size(self, size: u32) -> Result<(), String> {
+    pub fn check_size(self, size: u32) -> Result<(), SizeError> {
         if size == 0 || size > self.max_size() {
-            return Err(format!(
-                "size factor {size} out of range for {} (1 to {})",
-                self.name(),
-                self.max_size()
-            ));
+            return Err(SizeError {
+                database: self.name(),
+                size,
+                max: self.max_size(),
+            });
         }
         Ok(())
     }
@@ -457,30 +500,29 @@ mod tests {
             Database::parse_spec("spd:tetra?size=3"),
             Ok(Some((Database::Tetra, 3)))
         );
+        let reason = |spec: &str| Database::parse_spec(spec).unwrap_err().reason;
+        assert_eq!(
+            reason("spd:nope"),
+            SpecReason::UnknownDatabase("nope".into())
+        );
+        assert_eq!(
+            reason("spd:balls?size=x"),
+            SpecReason::SizeNotWhole("x".into())
+        );
+        assert!(matches!(reason("spd:balls?size=0"), SpecReason::Size(e) if e.size == 0));
+        assert!(matches!(reason("spd:balls?size=99"), SpecReason::Size(e) if e.max == 7));
+        assert_eq!(reason("spd:balls?depth=2"), SpecReason::NoSize);
+        assert_eq!(
+            Database::parse_spec("spd:balls?size=99")
+                .unwrap_err()
+                .to_string(),
+            "spd:balls?size=99: size factor 99 out of range for balls (1 to 7)"
+        );
         assert!(
             Database::parse_spec("spd:nope")
                 .unwrap_err()
-                .contains("unknown database")
-        );
-        assert!(
-            Database::parse_spec("spd:balls?size=x")
-                .unwrap_err()
-                .contains("whole number")
-        );
-        assert!(
-            Database::parse_spec("spd:balls?size=0")
-                .unwrap_err()
-                .contains("out of range")
-        );
-        assert!(
-            Database::parse_spec("spd:balls?size=99")
-                .unwrap_err()
-                .contains("out of range")
-        );
-        assert!(
-            Database::parse_spec("spd:balls?depth=2")
-                .unwrap_err()
-                .contains("?size=N")
+                .to_string()
+                .starts_with("spd:nope: unknown database 'nope' (one of balls, gears,")
         );
     }
 
