@@ -104,9 +104,21 @@ pub fn print(text: std::fmt::Arguments) -> std::io::Result<()> {
 }
 
 /// The line an error is printed as: `emray: error: ` and the error with its causes
-/// (every error the command prints goes through here).
+/// (every error the command prints goes through here). Control characters, which a
+/// malformed input can put in a message (a garbled keyword, a file name), are
+/// escaped (`\u{1b}`, `\n`), so the message stays one line and cannot drive the
+/// terminal.
 pub fn error_line(e: impl Display) -> String {
-    format!("emray: error: {e:#}")
+    let text = format!("{e:#}");
+    let mut line = String::from("emray: error: ");
+    for c in text.chars() {
+        if c.is_control() {
+            line.extend(c.escape_default());
+        } else {
+            line.push(c);
+        }
+    }
+    line
 }
 
 /// The usage error of a command this build lacks for want of `feature`.
@@ -130,5 +142,24 @@ mod tests {
         assert_eq!(Error::Interrupted(None).exit_code(), 130);
         let e = anyhow::anyhow!("inner").context("outer");
         assert_eq!(error_line(&e), "emray: error: outer: inner");
+    }
+
+    #[test]
+    fn an_error_line_escapes_control_characters() {
+        let e = anyhow::anyhow!("a.nff:1:1: unknown entity 'x\u{1b}[2Jy\nz'");
+        assert_eq!(
+            error_line(&e),
+            "emray: error: a.nff:1:1: unknown entity 'x\\u{1b}[2Jy\\nz'"
+        );
+        assert_eq!(error_line("é ✓"), "emray: error: é ✓");
+    }
+
+    #[test]
+    fn a_closed_pipe_exits_quietly() {
+        let pipe = std::io::Error::from(std::io::ErrorKind::BrokenPipe);
+        let e = Error::Failed(anyhow::Error::new(pipe).context("cannot write"));
+        assert!(e.is_closed_pipe());
+        assert_eq!(e.exit_code(), 0);
+        assert!(!Error::failed("other").is_closed_pipe());
     }
 }
