@@ -72,8 +72,9 @@ pub fn collect(scene: &Scene) -> Vec<AreaLight> {
 
 /// `(irradiance / π)` from `lights` at point `p` (error bound `err`, unit geometric
 /// normal `ng` and shading normal `ns` both facing the viewer), with `n × n`
-/// stratified shadow rays per light, jittered per point (deterministic: the jitter is
-/// a hash of the point's coordinates). Returns the term and the shadow rays cast.
+/// stratified shadow rays per light, jittered by `seed` (the ray-tree path of the hit,
+/// which does not depend on the hit point's rounding, so both backends draw the same
+/// jitter). Returns the term and the shadow rays cast.
 pub fn direct<A: Accel>(
     accel: &A,
     lights: &[AreaLight],
@@ -82,9 +83,9 @@ pub fn direct<A: Accel>(
     ng: Vec3,
     ns: Vec3,
     n: u32,
+    seed: u32,
 ) -> (Vec3, u64) {
     let n = n.max(1);
-    let seed = hash(p.x.to_bits() ^ hash(p.y.to_bits() ^ hash(p.z.to_bits())));
     let mut sum = Vec3::ZERO;
     let mut rays = 0;
     for (li, l) in lights.iter().enumerate() {

@@ -81,6 +81,21 @@ pub(super) struct Tracer<'a, A: Accel> {
     spd: bool,
 }
 
+/// The identity of an eye ray's path through the ray tree, from its film position:
+/// it seeds the area-light jitter at every hit of the tree (see [`children`]). Film
+/// positions are exact, whichever backend traces the rays, so the noise is the same on
+/// both (a seed from the hit point would change with its last bit).
+#[inline]
+fn eye_path(px: f32, py: f32) -> u32 {
+    hash(px.to_bits() ^ hash(py.to_bits()))
+}
+
+/// The paths of the reflection and refraction rays spawned on `path`.
+#[inline]
+fn children(path: u32) -> (u32, u32) {
+    (hash(path ^ 0x2545_f491), hash(path ^ 0x9e37_79b9))
+}
+
 /// Van der Corput radical inverse in base 2.
 #[inline]
 fn radical_inverse(i: u32) -> f32 {
@@ -166,7 +181,7 @@ impl<'a, A: Accel> Tracer<'a, A> {
     /// of its coordinates, so the result does not depend on the thread schedule).
     pub(super) fn pixel(&self, raygen: &RayGen, i: u32, j: u32, counts: &mut RayCounts) -> Vec3 {
         if self.spp == 1 {
-            return self.eye(raygen.ray(i as f32 + 0.5, j as f32 + 0.5), counts);
+            return self.eye(raygen, i as f32 + 0.5, j as f32 + 0.5, counts);
         }
         let seed = hash(i.wrapping_mul(0x9e37_79b9) ^ hash(j));
         let (ox, oy) = (unit(hash(seed)), unit(hash(seed ^ 0x5bd1_e995)));
@@ -175,7 +190,7 @@ impl<'a, A: Accel> Tracer<'a, A> {
         for s in 0..n {
             let sx = ((s as f32 + ox) / n as f32).fract();
             let sy = (radical_inverse(s) + oy).fract();
-            sum += self.eye(raygen.ray(i as f32 + sx, j as f32 + sy), counts);
+            sum += self.eye(raygen, i as f32 + sx, j as f32 + sy, counts);
         }
         sum / n as f32
     }
@@ -199,25 +214,29 @@ impl<'a, A: Accel> Tracer<'a, A> {
             }
             return;
         }
-        let rays: Vec<Ray> = (t.y0..t.y1)
-            .flat_map(|j| (t.x0..t.x1).map(move |i| raygen.ray(i as f32 + 0.5, j as f32 + 0.5)))
+        let centres: Vec<(f32, f32)> = (t.y0..t.y1)
+            .flat_map(|j| (t.x0..t.x1).map(move |i| (i as f32 + 0.5, j as f32 + 0.5)))
             .collect();
+        let rays: Vec<Ray> = centres.iter().map(|&(x, y)| raygen.ray(x, y)).collect();
         let mut hits = vec![None; rays.len()];
         self.accel.intersect_coherent(&rays, &mut hits);
-        for (ray, hit) in rays.iter().zip(hits) {
+        for ((ray, hit), &(x, y)) in rays.iter().zip(hits).zip(&centres) {
             counts.eye += 1;
-            px.push(self.trace_from(ray, hit, 1, Media::AIR, Vec3::ONE, counts));
+            let path = eye_path(x, y);
+            px.push(self.trace_from(ray, hit, 1, path, Media::AIR, Vec3::ONE, counts));
         }
     }
 
     /// The value of the eye ray through continuous film position `(px, py)`.
     pub(super) fn sample(&self, raygen: &RayGen, px: f32, py: f32, counts: &mut RayCounts) -> Vec3 {
-        self.eye(raygen.ray(px, py), counts)
+        self.eye(raygen, px, py, counts)
     }
 
-    fn eye(&self, ray: Ray, counts: &mut RayCounts) -> Vec3 {
+    /// The value of the eye ray through film position `(px, py)`.
+    fn eye(&self, raygen: &RayGen, px: f32, py: f32, counts: &mut RayCounts) -> Vec3 {
         counts.eye += 1;
-        self.trace(&ray, 1, Media::AIR, Vec3::ONE, counts)
+        let path = eye_path(px, py);
+        self.trace(&raygen.ray(px, py), 1, path, Media::AIR, Vec3::ONE, counts)
     }
 
     /// Whether a secondary ray of accumulated `weight` is worth casting.
@@ -233,24 +252,28 @@ impl<'a, A: Accel> Tracer<'a, A> {
     /// Radiance along `ray` at ray-tree depth `depth` (the eye ray is depth 1), which
     /// travels inside `media`; `weight` is the product of the coefficients between this
     /// ray and the eye (what its radiance is multiplied by in the pixel).
+    #[allow(clippy::too_many_arguments)]
     fn trace(
         &self,
         ray: &Ray,
         depth: u32,
+        path: u32,
         media: Media,
         weight: Vec3,
         counts: &mut RayCounts,
     ) -> Vec3 {
         let first = self.accel.intersect(ray);
-        self.trace_from(ray, first, depth, media, weight, counts)
+        self.trace_from(ray, first, depth, path, media, weight, counts)
     }
 
     /// [`Tracer::trace`] given the ray's nearest hit, `first`.
+    #[allow(clippy::too_many_arguments)]
     fn trace_from(
         &self,
         ray: &Ray,
         first: Option<Hit>,
         depth: u32,
+        path: u32,
         media: Media,
         weight: Vec3,
         counts: &mut RayCounts,
@@ -296,7 +319,7 @@ impl<'a, A: Accel> Tracer<'a, A> {
                 counts.eye_hit += 1;
             }
             let gi = self.gi.and_then(|g| g.radiosity_at(&hit, surf.point.p, d));
-            let radiance = self.shade(&surf, d, entering, depth, media, weight, gi, counts);
+            let radiance = self.shade(&surf, d, entering, depth, path, media, weight, gi, counts);
             return saturate(radiance, counts);
         }
     }
@@ -312,6 +335,7 @@ impl<'a, A: Accel> Tracer<'a, A> {
         d: Vec3,
         entering: bool,
         depth: u32,
+        path: u32,
         media: Media,
         weight: Vec3,
         gi: Option<Vec3>,
@@ -331,7 +355,7 @@ impl<'a, A: Accel> Tracer<'a, A> {
 
         let mut color = match gi {
             Some(b) => b,
-            None => self.local_diffuse(surf, m, ng, ns, entering, counts),
+            None => self.local_diffuse(surf, m, ng, ns, entering, path, counts),
         };
         for light in &scene.lights {
             color += self.direct(light, surf, m, &mut origins, ns, d, counts);
@@ -349,6 +373,7 @@ impl<'a, A: Accel> Tracer<'a, A> {
             entering,
             &mut origins,
             depth,
+            path,
             media,
             weight,
             counts,
@@ -378,11 +403,13 @@ impl<'a, A: Accel> Tracer<'a, A> {
         entering: bool,
         origins: &mut RayOrigins,
         depth: u32,
+        path: u32,
         media: Media,
         weight: Vec3,
         counts: &mut RayCounts,
     ) -> Vec3 {
         let scene = self.scene;
+        let (reflected, refracted) = children(path);
         let mut reflect_weight = m.kr;
         let mut total_internal = false;
         if m.t > 0.0 {
@@ -404,7 +431,8 @@ impl<'a, A: Accel> Tracer<'a, A> {
                     if self.worth(weight * w, counts) {
                         counts.refraction += 1;
                         let ray = Ray::new(origins.towards(dir), dir);
-                        color += w * self.trace(&ray, depth + 1, inside, weight * w, counts);
+                        color +=
+                            w * self.trace(&ray, depth + 1, refracted, inside, weight * w, counts);
                     }
                 }
                 None => {
@@ -421,7 +449,7 @@ impl<'a, A: Accel> Tracer<'a, A> {
             if self.worth(w, counts) {
                 counts.reflection += 1;
                 let ray = Ray::new(origins.towards(dir), dir);
-                color += reflect_weight * self.trace(&ray, depth + 1, media, w, counts);
+                color += reflect_weight * self.trace(&ray, depth + 1, reflected, media, w, counts);
             }
         } else if !self.skip || (self.spd && m.t > 0.0) {
             // Cast and thrown away: the SPD reference casts it, or to measure what
@@ -430,6 +458,7 @@ impl<'a, A: Accel> Tracer<'a, A> {
             self.trace(
                 &Ray::new(origins.towards(dir), dir),
                 depth + 1,
+                reflected,
                 media,
                 w,
                 counts,
@@ -496,6 +525,7 @@ impl<A: Accel> Tracer<'_, A> {
         ng: Vec3,
         ns: Vec3,
         entering: bool,
+        path: u32,
         counts: &mut RayCounts,
     ) -> Vec3 {
         let mut color = self.scene.ambient * m.color * m.ka;
@@ -511,6 +541,7 @@ impl<A: Accel> Tracer<'_, A> {
                 ng,
                 ns,
                 self.area_samples,
+                path,
             );
             counts.shadow += rays;
             color += m.color * m.kd * e;
