@@ -478,7 +478,7 @@ fn area_light_sampling_matches_the_form_factor_and_softens_shadows() {
     );
     let accel = Bvh::build(&s);
     let p = Vec3::new(0.1, 0.0, -0.2);
-    let (e, rays) = area::direct(&accel, &lights, p, Vec3::ZERO, Vec3::Y, Vec3::Y, 8);
+    let (e, rays) = area::direct(&accel, &lights, &at(p), 8, 0);
     assert_eq!(rays, 2 * 64);
     // Irradiance/π = E × F(point → light).
     let f = point_to_polygon(p, Vec3::Y, &light);
@@ -501,7 +501,7 @@ fn area_light_sampling_matches_the_form_factor_and_softens_shadows() {
         0,
     );
     let accel = Bvh::build(&blocked);
-    let (h, _) = area::direct(&accel, &lights, p, Vec3::ZERO, Vec3::Y, Vec3::Y, 8);
+    let (h, _) = area::direct(&accel, &lights, &at(p), 8, 0);
     assert!(
         h.x > 0.2 * e.x && h.x < 0.8 * e.x,
         "penumbra {} of {}",
@@ -1025,5 +1025,15 @@ fn adaptive_rounds_go_on_from_the_previous_solution() {
             let d = (*a - *b).abs().max_element();
             assert!(d <= 1e-3 * scale, "{solver:?} element {k}: {a} vs {b}");
         }
+    }
+}
+
+/// A receiver at `p` facing +y.
+fn at(p: Vec3) -> emray::render::area::Receiver {
+    emray::render::area::Receiver {
+        p,
+        err: Vec3::ZERO,
+        ng: Vec3::Y,
+        ns: Vec3::Y,
     }
 }

@@ -70,21 +70,32 @@ pub fn collect(scene: &Scene) -> Vec<AreaLight> {
     out
 }
 
-/// `(irradiance / π)` from `lights` at point `p` (error bound `err`, unit geometric
-/// normal `ng` and shading normal `ns` both facing the viewer), with `n × n`
+/// The point lit by area lights: position `p`, its error bound `err`, the unit
+/// geometric normal `ng` and shading normal `ns`, both facing the viewer.
+#[derive(Clone, Copy, Debug)]
+pub struct Receiver {
+    /// The point.
+    pub p: Vec3,
+    /// A bound on the error of `p`.
+    pub err: Vec3,
+    /// Unit geometric normal facing the viewer.
+    pub ng: Vec3,
+    /// Unit shading normal facing the viewer.
+    pub ns: Vec3,
+}
+
+/// `(irradiance / π)` from `lights` at the point `at`, with `n × n`
 /// stratified shadow rays per light, jittered by `seed` (the ray-tree path of the hit,
 /// which does not depend on the hit point's rounding, so both backends draw the same
 /// jitter). Returns the term and the shadow rays cast.
 pub fn direct<A: Accel>(
     accel: &A,
     lights: &[AreaLight],
-    p: Vec3,
-    err: Vec3,
-    ng: Vec3,
-    ns: Vec3,
+    at: &Receiver,
     n: u32,
     seed: u32,
 ) -> (Vec3, u64) {
+    let Receiver { p, err, ng, ns } = *at;
     let n = n.max(1);
     let mut sum = Vec3::ZERO;
     let mut rays = 0;

@@ -355,7 +355,15 @@ impl<'a, A: Accel> Tracer<'a, A> {
 
         let mut color = match gi {
             Some(b) => b,
-            None => self.local_diffuse(surf, m, ng, ns, entering, path, counts),
+            None => {
+                let at = area::Receiver {
+                    p,
+                    err: surf.point.err,
+                    ng,
+                    ns,
+                };
+                self.local_diffuse(&at, m, entering, path, counts)
+            }
         };
         for light in &scene.lights {
             color += self.direct(light, surf, m, &mut origins, ns, d, counts);
@@ -520,10 +528,8 @@ impl<A: Accel> Tracer<'_, A> {
     /// Ambient, emission (front side) and the area lights' diffuse light.
     fn local_diffuse(
         &self,
-        surf: &Surface,
+        at: &area::Receiver,
         m: &crate::scene::Material,
-        ng: Vec3,
-        ns: Vec3,
         entering: bool,
         path: u32,
         counts: &mut RayCounts,
@@ -533,16 +539,8 @@ impl<A: Accel> Tracer<'_, A> {
             color += m.emission;
         }
         if !self.area_lights.is_empty() && m.kd > 0.0 {
-            let (e, rays) = area::direct(
-                self.accel,
-                &self.area_lights,
-                surf.point.p,
-                surf.point.err,
-                ng,
-                ns,
-                self.area_samples,
-                path,
-            );
+            let (e, rays) =
+                area::direct(self.accel, &self.area_lights, at, self.area_samples, path);
             counts.shadow += rays;
             color += m.color * m.kd * e;
         }
