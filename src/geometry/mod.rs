@@ -143,6 +143,20 @@ pub(crate) fn quadratic_roots(a: f32, b: f32, c: f32, disc: f32) -> (f32, f32) {
     }
 }
 
+/// [`quadratic_roots`] in f64, for intersectors that set their quadratic up in f64
+/// (the cone): the same labelling, the same cancellation-free form.
+#[inline]
+pub(crate) fn quadratic_roots_f64(a: f64, b: f64, c: f64, disc: f64) -> (f64, f64) {
+    let q = -(b + disc.sqrt().copysign(b));
+    let r_qa = q / a;
+    let r_cq = if q != 0.0 { c / q } else { f64::NAN };
+    if b.is_sign_negative() {
+        (r_cq, r_qa)
+    } else {
+        (r_qa, r_cq)
+    }
+}
+
 #[cfg(test)]
 mod tests {
     use super::diff_of_products;
