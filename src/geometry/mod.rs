@@ -26,6 +26,7 @@ pub mod reference;
 mod sphere;
 mod torus;
 mod triangle;
+mod triangle4;
 
 pub use boxes::{AaBox, OBox};
 pub use capped::CappedCone;
@@ -41,6 +42,7 @@ pub use quadric::Quadric;
 pub use sphere::Sphere;
 pub use torus::Torus;
 pub use triangle::{Triangle, WatertightRay};
+pub use triangle4::{Hits4, Triangle4, WatertightRay4};
 
 // A hit point with its error bound: defined in `math`, whose transforms map it.
 pub use crate::math::SurfacePoint;

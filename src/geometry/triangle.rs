@@ -25,10 +25,18 @@ impl WatertightRay {
     /// Precompute the permutation and shear for `ray`.
     #[inline]
     pub fn new(ray: &Ray) -> Self {
-        let d = ray.dir;
-        let kz = d.abs().max_position();
-        let mut kx = (kz + 1) % 3;
-        let mut ky = (kx + 1) % 3;
+        // Arrays, not `Vec3` indexing (a match on the index in glam).
+        let d = ray.dir.to_array();
+        let a = ray.dir.abs();
+        // The first axis of largest magnitude (as `Vec3::max_position` picks it).
+        let (mut kz, mut largest) = (0, a.x);
+        if a.y > largest {
+            (kz, largest) = (1, a.y);
+        }
+        if a.z > largest {
+            kz = 2;
+        }
+        let (mut kx, mut ky) = ([1, 2, 0][kz], [2, 0, 1][kz]);
         if d[kz] < 0.0 {
             std::mem::swap(&mut kx, &mut ky);
         }
@@ -46,6 +54,13 @@ impl WatertightRay {
     #[inline]
     pub fn set_tmax(&mut self, tmax: f32) {
         self.tmax = tmax;
+    }
+
+    /// Origin, axis permutation, shear and interval, for the 4-wide test
+    /// ([`Triangle4`](super::Triangle4)).
+    #[inline]
+    pub(crate) fn parts(&self) -> (Vec3, [usize; 3], Vec3, f32, f32) {
+        (self.org, self.k, self.shear, self.tmin, self.tmax)
     }
 }
 
@@ -70,9 +85,9 @@ impl Triangle {
     #[inline]
     pub fn intersect_wt(&self, r: &WatertightRay) -> Option<ShapeHit> {
         let [kx, ky, kz] = r.k;
-        let a = self.p[0] - r.org;
-        let b = self.p[1] - r.org;
-        let c = self.p[2] - r.org;
+        let a = (self.p[0] - r.org).to_array();
+        let b = (self.p[1] - r.org).to_array();
+        let c = (self.p[2] - r.org).to_array();
         let s = r.shear;
         let ax = a[kx] - s.x * a[kz];
         let ay = a[ky] - s.y * a[kz];
