@@ -71,6 +71,11 @@ impl Unbounded {
         self.entries.len()
     }
 
+    /// Bytes of the list.
+    pub fn memory_bytes(&self) -> usize {
+        self.entries.len() * std::mem::size_of::<Entry>()
+    }
+
     /// The nearest hit in `(ray.tmin, ray.tmax)`; between hits at the same distance,
     /// the first in the list.
     #[inline]

@@ -1,17 +1,23 @@
 //! The pure-Rust backend: a binned-SAH bounding volume hierarchy over every primitive
-//! kind, built binary and collapsed into 4-wide nodes (the four children's boxes stored
-//! axis by axis and tested together). Nearest-hit queries visit the children a ray
-//! reaches nearest entry first and skip pushed ones that lie beyond the nearest hit
+//! kind, built binary then collapsed into 4-wide nodes (the four children's boxes
+//! stored axis by axis and tested together). Nearest-hit queries visit the children a
+//! ray reaches nearest entry first and skip pushed ones that lie beyond the nearest hit
 //! found meanwhile; any-hit (shadow) queries visit them in slot order.
+//!
+//! - `build`: the binary SAH builder;
+//! - `wide`: the 4-wide nodes, the collapse into them and the traversal;
+//! - `leaf`: the leaves' primitives in leaf order, triangles four to a pack.
 
 mod build;
+mod leaf;
 mod wide;
 
 use crate::accel::unbounded::Unbounded;
 use crate::accel::{Accel, AccelStats, Hit, NO_INSTANCE};
-use crate::geometry::{Analytic, Intersect, Kind, Shape, Triangle, WatertightRay};
+use crate::geometry::{Analytic, Intersect, Kind, ShapeHit, WatertightRay, WatertightRay4};
 use crate::math::{Aabb, Ray, Xform};
 use crate::scene::{Geometry, KindVisitor, Prims, Scene};
+use leaf::{Leaf, LeafData, Other, Prim};
 use std::sync::Arc;
 use wide::{Node4, Visit};
 
@@ -30,38 +36,16 @@ struct Node {
     axis: u16,
 }
 
-/// A primitive as stored in the leaves, in traversal order.
-#[derive(Clone, Debug)]
-enum Prim {
-    Triangle(Triangle),
-    Shape(Shape),
-    /// An index into `Bvh::instances`.
-    Instance(u32),
-}
-
-impl Prim {
-    fn bounds(&self, instances: &[PlacedObject]) -> Aabb {
-        match self {
-            Prim::Triangle(t) => t.bounds(),
-            Prim::Shape(s) => s.bounds(),
-            Prim::Instance(i) => instances[*i as usize].bounds,
-        }
-    }
-}
-
-/// Appends every analytic primitive of the lists it visits to `prims`, with its
-/// `(geom_id, prim_id)` in `ids`.
+/// Appends every analytic primitive of the lists it visits to `prims`.
 struct Gather<'a> {
     prims: &'a mut Vec<Prim>,
-    ids: &'a mut Vec<(u32, u32)>,
 }
 
 impl KindVisitor for Gather<'_> {
     type Output = ();
     fn visit<P: Analytic>(&mut self, list: &Prims<P>) {
         for (i, prim, _) in list.iter() {
-            self.prims.push(Prim::Shape(prim.clone().into()));
-            self.ids.push((P::KIND as u32, i));
+            self.prims.push(Prim::Shape(prim.clone().into(), i));
         }
     }
 }
@@ -77,16 +61,14 @@ struct PlacedObject {
 /// leaves hold instances, whose objects have hierarchies of their own).
 pub struct Bvh {
     nodes: Vec<Node4>,
-    /// `(first primitive, count)` of each leaf.
-    leaves: Vec<(u32, u32)>,
     /// Stack depth a traversal needs (see [`wide::collapse`]).
     stack_need: usize,
     /// Bounds of the tree (not of the unbounded primitives).
     tree_bounds: Aabb,
-    prims: Vec<Prim>,
-    /// `(geom_id, prim_id)` of each entry of `prims` (`(u32::MAX, instance)` for
-    /// instances).
-    ids: Vec<(u32, u32)>,
+    /// The leaves and their primitives.
+    leaves: LeafData,
+    /// Primitives in the tree (each triangle once, not the padding lanes of its pack).
+    prim_count: usize,
     /// The scene's primitives with infinite bounds (planes, unbounded quadrics, the
     /// instances' copies of them), kept out of every level's tree and tested against
     /// every ray before the top level's (empty in the objects' levels).
@@ -132,43 +114,31 @@ impl Bvh {
     /// The hierarchy over the bounded primitives of `geometry` and `instances` (an
     /// instance whose object's tree is empty is left out).
     fn build_level(geometry: &Geometry, instances: Vec<PlacedObject>) -> Bvh {
-        let n = geometry.prim_count() + instances.len();
-        let mut prims = Vec::with_capacity(n);
-        let mut ids = Vec::with_capacity(n);
+        let mut prims = Vec::with_capacity(geometry.prim_count() + instances.len());
         for (i, t) in geometry.triangles.items.iter().enumerate() {
-            prims.push(Prim::Triangle(*t));
-            ids.push((Kind::Triangle as u32, i as u32));
+            prims.push(Prim::Triangle(*t, i as u32));
         }
-        geometry.visit_all(&mut Gather {
-            prims: &mut prims,
-            ids: &mut ids,
-        });
-        for i in 0..instances.len() {
-            prims.push(Prim::Instance(i as u32));
-            ids.push((u32::MAX, i as u32));
-        }
-        let all_bounds: Vec<Aabb> = prims.iter().map(|p| p.bounds(&instances)).collect();
+        geometry.visit_all(&mut Gather { prims: &mut prims });
+        prims.extend((0..instances.len() as u32).map(Prim::Instance));
+        let instance_bounds: Vec<Aabb> = instances.iter().map(|i| i.bounds).collect();
         // Unbounded primitives stay out of the tree (see `Unbounded`), and so do empty
         // ones (an instance of an object without bounded primitives).
-        let bounded: Vec<usize> = (0..prims.len())
-            .filter(|&i| all_bounds[i].is_finite())
-            .collect();
-        let bounds: Vec<Aabb> = bounded.iter().map(|&i| all_bounds[i]).collect();
+        let (bounded, bounds): (Vec<usize>, Vec<Aabb>) = prims
+            .iter()
+            .map(|p| p.bounds(&instance_bounds))
+            .enumerate()
+            .filter(|(_, b)| b.is_finite())
+            .unzip();
         let (binary, order) = build::build(&bounds);
         let tree_bounds = binary.first().map_or(Aabb::EMPTY, |n| n.bounds);
-        let (nodes, leaves, stack_need) = wide::collapse(&binary);
-        let out_prims: Vec<Prim> = order
-            .iter()
-            .map(|&k| prims[bounded[k as usize]].clone())
-            .collect();
-        let out_ids: Vec<(u32, u32)> = order.iter().map(|&k| ids[bounded[k as usize]]).collect();
+        let (nodes, ranges, stack_need) = wide::collapse(&binary);
+        let order: Vec<usize> = order.iter().map(|&k| bounded[k as usize]).collect();
         Bvh {
             nodes,
-            leaves,
             stack_need,
             tree_bounds,
-            prims: out_prims,
-            ids: out_ids,
+            leaves: LeafData::new(&ranges, &order, &prims),
+            prim_count: order.len(),
             unbounded: Unbounded::default(),
             instances,
             kinds: Vec::new(),
@@ -180,59 +150,91 @@ impl Bvh {
         self.nodes.len()
     }
 
+    /// Bytes of the structure: the nodes, the leaves with their primitives, the
+    /// unbounded list and the instances, with each instanced object's hierarchy counted
+    /// once however many instances place it.
+    pub fn memory_bytes(&self) -> usize {
+        let own = self.nodes.len() * std::mem::size_of::<Node4>()
+            + self.leaves.memory_bytes()
+            + self.unbounded.memory_bytes()
+            + self.instances.len() * std::mem::size_of::<PlacedObject>();
+        let mut seen = std::collections::HashSet::new();
+        let objects: usize = self
+            .instances
+            .iter()
+            .filter(|i| seen.insert(Arc::as_ptr(&i.object)))
+            .map(|i| i.object.memory_bytes())
+            .sum();
+        own + objects
+    }
+
     /// Walk the tree (see [`wide::traverse`]), ordered for nearest-hit queries.
     #[inline]
-    fn traverse<const ORDERED: bool>(&self, ray: &Ray, leaf: impl FnMut(usize, f32) -> Visit) {
+    fn traverse<const ORDERED: bool>(&self, ray: &Ray, leaf: impl FnMut(&Leaf, f32) -> Visit) {
+        let leaves = &self.leaves.leaves;
         if self.stack_need <= wide::STACK_SMALL {
-            wide::traverse::<ORDERED, { wide::STACK_SMALL }>(&self.nodes, &self.leaves, ray, leaf)
+            wide::traverse::<ORDERED, { wide::STACK_SMALL }>(&self.nodes, leaves, ray, leaf)
         } else {
-            wide::traverse::<ORDERED, { wide::STACK4 }>(&self.nodes, &self.leaves, ray, leaf)
+            wide::traverse::<ORDERED, { wide::STACK4 }>(&self.nodes, leaves, ray, leaf)
         }
     }
 }
 
-impl Bvh {
-    /// The nearest hit of primitive `i` in `(ray.tmin, tmax)`.
-    #[inline]
-    fn hit_prim(&self, i: usize, ray: &Ray, wt: &mut WatertightRay, tmax: f32) -> Option<Hit> {
-        let (geom_id, prim_id) = self.ids[i];
-        let h = match &self.prims[i] {
-            Prim::Triangle(t) => {
-                wt.set_tmax(tmax);
-                t.intersect_wt(wt)
-            }
-            Prim::Shape(s) => s.intersect(&Ray { tmax, ..*ray }),
-            Prim::Instance(k) => {
-                let inst = &self.instances[*k as usize];
-                let local = inst.xform.ray_to_object(&Ray { tmax, ..*ray });
-                return inst.object.nearest(&local).map(|h| Hit {
-                    inst_id: prim_id,
-                    ..h
-                });
-            }
-        }?;
-        Some(Hit {
-            t: h.t,
-            geom_id,
-            prim_id,
-            u: h.u,
-            v: h.v,
-            ng: h.ng,
-            inst_id: NO_INSTANCE,
-        })
-    }
+/// A ray prepared for every primitive kind of a leaf.
+struct LeafRay {
+    ray: Ray,
+    wt: WatertightRay4,
+}
 
-    /// Whether primitive `i` has any hit in the ray's interval.
+impl Bvh {
+    /// The nearest hit among `leaf`'s primitives in `(ray.tmin, tmax)`, if any: its
+    /// triangle packs in order, then its other primitives.
     #[inline]
-    fn occludes(&self, i: usize, ray: &Ray, wt: &WatertightRay) -> bool {
-        match &self.prims[i] {
-            Prim::Triangle(t) => t.intersect_wt(wt).is_some(),
-            Prim::Shape(s) => s.occluded(ray),
-            Prim::Instance(k) => {
-                let inst = &self.instances[*k as usize];
-                inst.object.any(&inst.xform.ray_to_object(ray))
+    fn leaf_nearest(&self, leaf: &Leaf, r: &mut LeafRay, mut tmax: f32) -> Option<Hit> {
+        let mut best = None;
+        for p in leaf.packs() {
+            r.wt.set_tmax(tmax);
+            if let Some((lane, h)) = self.leaves.packs[p].nearest(&r.wt) {
+                let id = self.leaves.pack_ids[p][lane];
+                best = Some(hit(h, Kind::Triangle as u32, id));
+                tmax = h.t;
             }
         }
+        for o in &self.leaves.others[leaf.others()] {
+            if let Some(h) = self.other_nearest(o, &Ray { tmax, ..r.ray }) {
+                tmax = h.t;
+                best = Some(h);
+            }
+        }
+        best
+    }
+
+    /// The nearest hit of a shape or instance in the ray's interval.
+    #[inline]
+    fn other_nearest(&self, o: &Other, ray: &Ray) -> Option<Hit> {
+        match o {
+            Other::Shape(s, id) => s.intersect(ray).map(|h| hit(h, s.kind() as u32, *id)),
+            Other::Instance(k) => {
+                let inst = &self.instances[*k as usize];
+                let local = inst.xform.ray_to_object(ray);
+                inst.object
+                    .nearest(&local)
+                    .map(|h| Hit { inst_id: *k, ..h })
+            }
+        }
+    }
+
+    /// Whether any of `leaf`'s primitives is hit in the ray's interval.
+    #[inline]
+    fn leaf_occluded(&self, leaf: &Leaf, r: &LeafRay) -> bool {
+        leaf.packs().any(|p| self.leaves.packs[p].occluded(&r.wt))
+            || self.leaves.others[leaf.others()].iter().any(|o| match o {
+                Other::Shape(s, _) => s.occluded(&r.ray),
+                Other::Instance(k) => {
+                    let inst = &self.instances[*k as usize];
+                    inst.object.any(&inst.xform.ray_to_object(&r.ray))
+                }
+            })
     }
 
     /// The nearest hit; none for a ray that is not [traceable](Ray::is_traceable).
@@ -241,11 +243,14 @@ impl Bvh {
             return None;
         }
         let mut best = self.unbounded.nearest(ray);
-        let mut wt = WatertightRay::new(ray);
         let tmax = best.map_or(ray.tmax, |h| h.t);
         let ray = Ray { tmax, ..*ray };
-        self.traverse::<true>(&ray, |i, tmax| {
-            match self.hit_prim(i, &ray, &mut wt, tmax) {
+        let mut r = LeafRay {
+            ray,
+            wt: WatertightRay4::new(&WatertightRay::new(&ray)),
+        };
+        self.traverse::<true>(&ray, |leaf, tmax| {
+            match self.leaf_nearest(leaf, &mut r, tmax) {
                 Some(h) => {
                     best = Some(h);
                     Visit::Continue(h.t)
@@ -265,10 +270,13 @@ impl Bvh {
         if self.unbounded.any(ray) {
             return true;
         }
-        let wt = WatertightRay::new(ray);
+        let r = LeafRay {
+            ray: *ray,
+            wt: WatertightRay4::new(&WatertightRay::new(ray)),
+        };
         let mut hit = false;
-        self.traverse::<false>(ray, |i, tmax| {
-            if self.occludes(i, ray, &wt) {
+        self.traverse::<false>(ray, |leaf, tmax| {
+            if self.leaf_occluded(leaf, &r) {
                 hit = true;
                 Visit::Stop
             } else {
@@ -276,6 +284,20 @@ impl Bvh {
             }
         });
         hit
+    }
+}
+
+/// A primitive's hit as the backend reports it (outside any instance).
+#[inline]
+fn hit(h: ShapeHit, geom_id: u32, prim_id: u32) -> Hit {
+    Hit {
+        t: h.t,
+        geom_id,
+        prim_id,
+        u: h.u,
+        v: h.v,
+        ng: h.ng,
+        inst_id: NO_INSTANCE,
     }
 }
 
@@ -311,14 +333,11 @@ impl Accel for Bvh {
     fn stats(&self) -> AccelStats {
         AccelStats {
             backend: "bvh",
-            prims: self.prims.len() + self.unbounded.len(),
+            prims: self.prim_count + self.unbounded.len(),
             nodes: self.nodes.len(),
-            bytes: self.nodes.len() * std::mem::size_of::<Node4>()
-                + self.leaves.len() * std::mem::size_of::<(u32, u32)>()
-                + (self.prims.len() + self.unbounded.len())
-                    * (std::mem::size_of::<Prim>() + std::mem::size_of::<(u32, u32)>()),
+            bytes: self.memory_bytes(),
             detail: format!(
-                "binned SAH, {} bins, max leaf {}, 4-wide nodes",
+                "binned SAH, {} bins, max leaf {}, 4-wide nodes, triangles 4 to a pack",
                 build::BINS,
                 build::MAX_LEAF
             ),
@@ -346,7 +365,7 @@ mod agreement {
     //! exactly the same nearest hit (the same `t`, bit for bit).
     use super::wide::LEAF;
     use super::*;
-    use crate::geometry::{Cone, Sphere};
+    use crate::geometry::{Cone, Sphere, Triangle};
     use crate::math::{Rng, Vec3};
     use crate::scene::{Camera, Material};
 
@@ -446,10 +465,12 @@ mod agreement {
         let scene = random_scene(5000, &mut Rng::new(3));
         let bvh = Bvh::build(&scene);
         // Every primitive in exactly one leaf, every child inside its parent's slot.
-        let mut seen = vec![0u32; bvh.prims.len()];
+        let mut seen_tris = vec![0u32; scene.geometry.triangles.items.len()];
+        let mut seen_others = 0;
         let mut stack = vec![(0usize, 0usize)];
         let mut max_depth = 0;
         let mut slots = 0;
+        let instance_bounds: Vec<Aabb> = bvh.instances.iter().map(|i| i.bounds).collect();
         while let Some((i, depth)) = stack.pop() {
             max_depth = max_depth.max(depth);
             let n = bvh.nodes[i];
@@ -461,13 +482,21 @@ mod agreement {
                 }
                 slots += 1;
                 if child & LEAF != 0 {
-                    let (start, count) = bvh.leaves[(child & !LEAF) as usize];
-                    let range = start as usize..(start + count) as usize;
-                    for (k, prim) in bvh.prims[range.clone()].iter().enumerate() {
-                        seen[range.start + k] += 1;
-                        let pb = prim.bounds(&bvh.instances);
+                    let leaf_index = (child & !LEAF) as usize;
+                    for pb in bvh.leaves.leaf_prim_bounds(leaf_index, &instance_bounds) {
                         assert!(b.contains(pb.min) && b.contains(pb.max));
                     }
+                    let leaf = bvh.leaves.leaves[leaf_index];
+                    for p in leaf.packs() {
+                        let ids = bvh.leaves.pack_ids[p];
+                        // Padding lanes repeat the last triangle.
+                        let mut lanes = ids.to_vec();
+                        lanes.dedup();
+                        for id in lanes {
+                            seen_tris[id as usize] += 1;
+                        }
+                    }
+                    seen_others += leaf.others().len();
                 } else {
                     let c = bvh.nodes[child as usize];
                     for cs in 0..4 {
@@ -478,6 +507,12 @@ mod agreement {
                 }
             }
         }
+        let seen: Vec<u32> = seen_tris;
+        assert_eq!(
+            seen.len() + seen_others,
+            scene.geometry.prim_count(),
+            "every primitive in a leaf"
+        );
         assert!(seen.iter().all(|&c| c == 1));
         assert!(bvh.stack_need <= wide::STACK4, "stack {}", bvh.stack_need);
         assert!(bvh.stack_need >= max_depth, "stack {}", bvh.stack_need);

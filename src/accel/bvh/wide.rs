@@ -3,6 +3,7 @@
 //! plane) so that one node's four slab tests are plain loops over fixed arrays that the
 //! compiler turns into vector instructions.
 
+use super::leaf::Leaf;
 use super::{Node, STACK};
 use crate::math::{Aabb, Ray};
 use glam::Vec4;
@@ -138,7 +139,8 @@ pub(super) enum Visit {
 }
 
 /// Walk `nodes` with a stack of `DEPTH` entries (at least the tree's
-/// [`stack_need`]); `leaf` is called for each primitive index of every leaf the ray reaches.
+/// [`stack_need`]); `leaf` is called for every leaf the ray reaches, with the current far
+/// end of the interval.
 /// With `ORDERED`, the children a node's box tests hit are visited nearest entry first,
 /// the others pushed with their entry distance and dropped when they come off the stack
 /// if a hit nearer than that was found meanwhile. Without it (any-hit queries, where
@@ -146,9 +148,9 @@ pub(super) enum Visit {
 #[inline(always)]
 pub(super) fn traverse<const ORDERED: bool, const DEPTH: usize>(
     nodes: &[Node4],
-    leaves: &[(u32, u32)],
+    leaves: &[Leaf],
     ray: &Ray,
-    mut leaf: impl FnMut(usize, f32) -> Visit,
+    mut leaf: impl FnMut(&Leaf, f32) -> Visit,
 ) {
     if nodes.is_empty() {
         return;
@@ -209,12 +211,9 @@ pub(super) fn traverse<const ORDERED: bool, const DEPTH: usize>(
                 continue;
             }
         } else {
-            let (start, count) = leaves[(cur & !LEAF) as usize];
-            for i in start as usize..(start + count) as usize {
-                match leaf(i, tmax) {
-                    Visit::Continue(t) => tmax = t,
-                    Visit::Stop => return,
-                }
+            match leaf(&leaves[(cur & !LEAF) as usize], tmax) {
+                Visit::Continue(t) => tmax = t,
+                Visit::Stop => return,
             }
         }
         // Next: the nearest pushed child that may still hold a nearer hit.
