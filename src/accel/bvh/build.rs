@@ -2,7 +2,7 @@
 //! split with the lowest surface-area cost taken, a leaf made when no split beats
 //! intersecting everything.
 
-use super::{Node, STACK};
+use super::{MAX_DEPTH, Node};
 use crate::math::Aabb;
 
 /// Bins per axis.
@@ -10,8 +10,8 @@ pub const BINS: usize = 16;
 /// Largest leaf the builder makes while a split still helps.
 pub const MAX_LEAF: usize = 8;
 /// Below this depth, median splits take over from SAH so that pathological
-/// distributions (SAH peeling one primitive at a time) still give a tree that fits the
-/// traversal stack: 40 + log2(n / MAX_LEAF) < 64 for any n < 2^24.
+/// distributions (SAH peeling one primitive at a time) still give a shallow tree:
+/// 40 + log2(n / MAX_LEAF) < [`MAX_DEPTH`] for any n < 2^24.
 const SAH_DEPTH: usize = 40;
 /// Cost of a node traversal step relative to one primitive test.
 const TRAVERSAL_COST: f32 = 1.0;
@@ -140,7 +140,7 @@ impl Builder<'_> {
         depth: usize,
     ) -> usize {
         let n = end - start;
-        if n <= MAX_LEAF || (depth + 2 >= STACK && n <= u16::MAX as usize) {
+        if n <= MAX_LEAF || (depth + 2 >= MAX_DEPTH && n <= u16::MAX as usize) {
             self.leaf(at, bounds, start, end);
             return at;
         }

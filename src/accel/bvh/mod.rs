@@ -5,11 +5,13 @@
 //! found meanwhile; any-hit (shadow) queries visit them in slot order.
 //!
 //! - `build`: the binary SAH builder;
-//! - `wide`: the 4-wide nodes, the collapse into them and the traversal;
+//! - `wide`: the 4-wide nodes and the collapse into them;
+//! - `traverse`: the walk down the 4-wide nodes;
 //! - `leaf`: the leaves' primitives in leaf order, triangles four to a pack.
 
 mod build;
 mod leaf;
+mod traverse;
 mod wide;
 
 use crate::accel::unbounded::Unbounded;
@@ -19,7 +21,8 @@ use crate::math::{Aabb, Ray, Xform};
 use crate::scene::{Geometry, KindVisitor, Prims, Scene};
 use leaf::{Leaf, LeafData, Other, Prim};
 use std::sync::Arc;
-use wide::{Node4, Visit};
+use traverse::Visit;
+use wide::Node4;
 
 /// One node of the binary tree the builder makes (then collapsed into [`Node4`]s): 32
 /// bytes.
@@ -61,8 +64,6 @@ struct PlacedObject {
 /// leaves hold instances, whose objects have hierarchies of their own).
 pub struct Bvh {
     nodes: Vec<Node4>,
-    /// Stack depth a traversal needs (see [`wide::collapse`]).
-    stack_need: usize,
     /// Bounds of the tree (not of the unbounded primitives).
     tree_bounds: Aabb,
     /// The leaves and their primitives.
@@ -79,8 +80,9 @@ pub struct Bvh {
     kinds: Vec<(Kind, usize)>,
 }
 
-/// Traversal stack depth; the builder caps the tree depth below it.
-const STACK: usize = 64;
+/// Depth the builder keeps the binary tree below (see `build::SAH_DEPTH`): a bound on
+/// the work of one traversal however the primitives lie.
+const MAX_DEPTH: usize = 64;
 
 impl Bvh {
     /// Build over every primitive of `scene`: a hierarchy per instanced object, and a
@@ -131,11 +133,10 @@ impl Bvh {
             .unzip();
         let (binary, order) = build::build(&bounds);
         let tree_bounds = binary.first().map_or(Aabb::EMPTY, |n| n.bounds);
-        let (nodes, ranges, stack_need) = wide::collapse(&binary);
+        let (nodes, ranges) = wide::collapse(&binary);
         let order: Vec<usize> = order.iter().map(|&k| bounded[k as usize]).collect();
         Bvh {
             nodes,
-            stack_need,
             tree_bounds,
             leaves: LeafData::new(&ranges, &order, &prims),
             prim_count: order.len(),
@@ -168,22 +169,37 @@ impl Bvh {
         own + objects
     }
 
-    /// Walk the tree (see [`wide::traverse`]), ordered for nearest-hit queries.
+    /// Walk the tree (see [`traverse::traverse`]), ordered for nearest-hit queries.
     #[inline]
     fn traverse<const ORDERED: bool>(&self, ray: &Ray, leaf: impl FnMut(&Leaf, f32) -> Visit) {
-        let leaves = &self.leaves.leaves;
-        if self.stack_need <= wide::STACK_SMALL {
-            wide::traverse::<ORDERED, { wide::STACK_SMALL }>(&self.nodes, leaves, ray, leaf)
-        } else {
-            wide::traverse::<ORDERED, { wide::STACK4 }>(&self.nodes, leaves, ray, leaf)
-        }
+        traverse::traverse::<ORDERED>(&self.nodes, &self.leaves.leaves, ray, leaf)
     }
 }
 
-/// A ray prepared for every primitive kind of a leaf.
+/// A ray prepared for every primitive kind of a leaf. The 4-wide triangle form is made
+/// at the first triangle pack the ray reaches: a ray through analytic shapes alone
+/// never pays for it.
 struct LeafRay {
     ray: Ray,
-    wt: WatertightRay4,
+    wt: Option<WatertightRay4>,
+}
+
+impl LeafRay {
+    #[inline]
+    fn new(ray: Ray) -> LeafRay {
+        LeafRay { ray, wt: None }
+    }
+
+    /// The ray for triangle packs, with the far end of its interval at `tmax`.
+    #[inline]
+    fn watertight(&mut self, tmax: f32) -> &WatertightRay4 {
+        let ray = &self.ray;
+        let wt = self
+            .wt
+            .get_or_insert_with(|| WatertightRay4::new(&WatertightRay::new(ray)));
+        wt.set_tmax(tmax);
+        wt
+    }
 }
 
 impl Bvh {
@@ -193,8 +209,7 @@ impl Bvh {
     fn leaf_nearest(&self, leaf: &Leaf, r: &mut LeafRay, mut tmax: f32) -> Option<Hit> {
         let mut best = None;
         for p in leaf.packs() {
-            r.wt.set_tmax(tmax);
-            if let Some((lane, h)) = self.leaves.packs[p].nearest(&r.wt) {
+            if let Some((lane, h)) = self.leaves.packs[p].nearest(r.watertight(tmax)) {
                 let id = self.leaves.pack_ids[p][lane];
                 best = Some(hit(h, Kind::Triangle as u32, id));
                 tmax = h.t;
@@ -226,8 +241,10 @@ impl Bvh {
 
     /// Whether any of `leaf`'s primitives is hit in the ray's interval.
     #[inline]
-    fn leaf_occluded(&self, leaf: &Leaf, r: &LeafRay) -> bool {
-        leaf.packs().any(|p| self.leaves.packs[p].occluded(&r.wt))
+    fn leaf_occluded(&self, leaf: &Leaf, r: &mut LeafRay) -> bool {
+        let tmax = r.ray.tmax;
+        leaf.packs()
+            .any(|p| self.leaves.packs[p].occluded(r.watertight(tmax)))
             || self.leaves.others[leaf.others()].iter().any(|o| match o {
                 Other::Shape(s, _) => s.occluded(&r.ray),
                 Other::Instance(k) => {
@@ -245,10 +262,7 @@ impl Bvh {
         let mut best = self.unbounded.nearest(ray);
         let tmax = best.map_or(ray.tmax, |h| h.t);
         let ray = Ray { tmax, ..*ray };
-        let mut r = LeafRay {
-            ray,
-            wt: WatertightRay4::new(&WatertightRay::new(&ray)),
-        };
+        let mut r = LeafRay::new(ray);
         self.traverse::<true>(&ray, |leaf, tmax| {
             match self.leaf_nearest(leaf, &mut r, tmax) {
                 Some(h) => {
@@ -270,13 +284,10 @@ impl Bvh {
         if self.unbounded.any(ray) {
             return true;
         }
-        let r = LeafRay {
-            ray: *ray,
-            wt: WatertightRay4::new(&WatertightRay::new(ray)),
-        };
+        let mut r = LeafRay::new(*ray);
         let mut hit = false;
         self.traverse::<false>(ray, |leaf, tmax| {
-            if self.leaf_occluded(leaf, &r) {
+            if self.leaf_occluded(leaf, &mut r) {
                 hit = true;
                 Visit::Stop
             } else {
@@ -514,11 +525,9 @@ mod agreement {
             "every primitive in a leaf"
         );
         assert!(seen.iter().all(|&c| c == 1));
-        assert!(bvh.stack_need <= wide::STACK4, "stack {}", bvh.stack_need);
-        assert!(bvh.stack_need >= max_depth, "stack {}", bvh.stack_need);
         // Collapsing fills the nodes: far fewer than one per two children.
         assert!(slots as f64 > 3.0 * bvh.nodes.len() as f64, "{slots} slots");
-        assert!(max_depth < STACK, "depth {max_depth}");
+        assert!(max_depth < MAX_DEPTH, "depth {max_depth}");
         // A SAH tree over 5000 scattered primitives is far shallower than a list.
         assert!(max_depth < 40, "depth {max_depth}");
     }
