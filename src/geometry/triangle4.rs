@@ -65,8 +65,7 @@ impl WatertightRay4 {
 pub struct Hits4 {
     /// Accepted lanes.
     pub mask: u32,
-    /// Distances.
-    pub t: [f32; 4],
+    t: Vec4,
     u: Vec4,
     v: Vec4,
 }
@@ -74,7 +73,7 @@ pub struct Hits4 {
 impl Hits4 {
     const NONE: Hits4 = Hits4 {
         mask: 0,
-        t: [0.0; 4],
+        t: Vec4::ZERO,
         u: Vec4::ZERO,
         v: Vec4::ZERO,
     };
@@ -83,22 +82,27 @@ impl Hits4 {
     /// one a scalar loop over the lanes in order would keep).
     #[inline]
     pub fn nearest(&self) -> Option<usize> {
-        let mut mask = self.mask;
-        let mut best: Option<usize> = None;
-        while mask != 0 {
-            let i = mask.trailing_zeros() as usize;
-            mask &= mask - 1;
-            if best.is_none_or(|b| self.t[i] < self.t[b]) {
-                best = Some(i);
-            }
+        let mask = self.mask;
+        if mask & mask.wrapping_sub(1) == 0 {
+            // None or one lane: the common case.
+            return (mask != 0).then(|| mask.trailing_zeros() as usize);
         }
-        best
+        // Accepted distances are finite (inside the interval), so the minimum over
+        // them, the others set to +∞, is one of theirs.
+        let accepted = BVec4A::new(mask & 1 != 0, mask & 2 != 0, mask & 4 != 0, mask & 8 != 0);
+        let t = Vec4::select(accepted, self.t, Vec4::INFINITY);
+        let nearest = t.cmpeq(Vec4::splat(t.min_element())).bitmask() & mask;
+        Some(nearest.trailing_zeros() as usize)
     }
 
     /// `(t, u, v)` of lane `i`, as [`ShapeHit`] reports them.
     #[inline]
     pub fn lane(&self, i: usize) -> (f32, f32, f32) {
-        (self.t[i], self.u.to_array()[i], self.v.to_array()[i])
+        (
+            self.t.to_array()[i],
+            self.u.to_array()[i],
+            self.v.to_array()[i],
+        )
     }
 }
 
@@ -121,6 +125,22 @@ impl Triangle4 {
         Triangle4 { p }
     }
 
+    /// The geometric normal of lane `i`'s triangle, [`Triangle::normal`] bit for bit
+    /// (the same differences and cross product, lane-wise).
+    #[inline]
+    pub fn normal(&self, i: usize) -> glam::Vec3 {
+        let [p0, p1, p2] = &self.p;
+        let e1 = [0, 1, 2].map(|a| p1[a] - p0[a]);
+        let e2 = [0, 1, 2].map(|a| p2[a] - p0[a]);
+        // `Vec3::cross`: (y·z' − y'·z, z·x' − z'·x, x·y' − x'·y).
+        let n = [
+            e1[1] * e2[2] - e2[1] * e1[2],
+            e1[2] * e2[0] - e2[2] * e1[0],
+            e1[0] * e2[1] - e2[0] * e1[1],
+        ];
+        glam::Vec3::new(n[0].to_array()[i], n[1].to_array()[i], n[2].to_array()[i])
+    }
+
     /// The triangle of lane `i`.
     #[inline]
     pub fn triangle(&self, i: usize) -> Triangle {
@@ -132,7 +152,7 @@ impl Triangle4 {
     }
 
     /// The four watertight tests ([`Triangle::intersect_wt`], lane by lane).
-    #[inline]
+    #[inline(always)]
     pub fn intersect(&self, r: &WatertightRay4) -> Hits4 {
         let [kx, ky, kz] = r.k;
         let [sx, sy, sz] = r.shear;
@@ -193,7 +213,7 @@ impl Triangle4 {
         mask &= !t.cmple(delta_t).bitmask();
         Hits4 {
             mask,
-            t: t.to_array(),
+            t,
             u: v * inv,
             v: w * inv,
         }
@@ -212,7 +232,7 @@ impl Triangle4 {
                 t,
                 u,
                 v,
-                ng: self.triangle(i).normal(),
+                ng: self.normal(i),
             },
         ))
     }
