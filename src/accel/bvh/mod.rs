@@ -131,7 +131,11 @@ impl Bvh {
             .enumerate()
             .filter(|(_, b)| b.is_finite())
             .unzip();
-        let (binary, order) = build::build(&bounds);
+        let triangle: Vec<bool> = bounded
+            .iter()
+            .map(|&i| matches!(prims[i], Prim::Triangle(..)))
+            .collect();
+        let (binary, order) = build::build(&bounds, &triangle);
         let tree_bounds = binary.first().map_or(Aabb::EMPTY, |n| n.bounds);
         let (nodes, ranges) = wide::collapse(&binary);
         let order: Vec<usize> = order.iter().map(|&k| bounded[k as usize]).collect();
