@@ -198,6 +198,10 @@ pub struct RunResult {
     pub peak_kib: Option<u64>,
     /// The backend's description (Embree version and ISA, BVH nodes).
     pub accel: String,
+    /// Bytes of the backend's structure ([`AccelStats::bytes`](crate::accel::AccelStats::bytes);
+    /// 0 when unknown).
+    #[serde(default)]
+    pub accel_bytes: usize,
 }
 
 fn backend_named(name: &str) -> Result<Backend, BenchError> {
@@ -215,11 +219,16 @@ struct RawWork<'a> {
 }
 
 impl WithAccel for RawWork<'_> {
-    type Output = (f64, raw::RawCast, crate::render::RayCounts, String);
+    type Output = (
+        f64,
+        raw::RawCast,
+        crate::render::RayCounts,
+        crate::accel::AccelStats,
+    );
     fn run<A: crate::accel::Accel>(self, accel: &A, build_ms: f64) -> Self::Output {
         let (queries, counts) = raw::record(self.scene, accel, self.settings);
         let cast = raw::cast(accel, &queries);
-        (build_ms, cast, counts, accel.stats().detail)
+        (build_ms, cast, counts, accel.stats())
     }
 }
 
@@ -260,7 +269,7 @@ pub fn run_child(spec: &RunSpec) -> Result<RunResult, BenchError> {
         embree_robust: false,
         packet_width: spec.packet_width,
     };
-    let (build_ms, ms, rays, accel) = pool.install(|| match spec.mode {
+    let (build_ms, ms, rays, (accel, accel_bytes)) = pool.install(|| match spec.mode {
         Mode::Render => {
             let (_, rep) =
                 crate::run::render_scene(&spec.scene, &scene, options, &settings, load_ms, None)?;
@@ -272,15 +281,25 @@ pub fn run_child(spec: &RunSpec) -> Result<RunResult, BenchError> {
                 shadow: r("shadow"),
                 total: r("total"),
             };
-            Ok::<_, AccelError>((rep.time_ms.build, rep.time_ms.render, rays, rep.accel))
+            Ok::<_, AccelError>((
+                rep.time_ms.build,
+                rep.time_ms.render,
+                rays,
+                (rep.accel, rep.accel_bytes),
+            ))
         }
         Mode::Raw => {
             let work = RawWork {
                 scene: &scene,
                 settings: &settings,
             };
-            let (build_ms, cast, counts, detail) = crate::accel::build(&scene, &options, work)?;
-            Ok((build_ms, cast.ms, Rays::from(counts), detail))
+            let (build_ms, cast, counts, stats) = crate::accel::build(&scene, &options, work)?;
+            Ok((
+                build_ms,
+                cast.ms,
+                Rays::from(counts),
+                (stats.detail, stats.bytes),
+            ))
         }
     })?;
     let accel = match (backend, spec.packet_width) {
@@ -296,6 +315,7 @@ pub fn run_child(spec: &RunSpec) -> Result<RunResult, BenchError> {
         rays,
         peak_kib: peak_rss_kib(),
         accel,
+        accel_bytes,
     })
 }
 

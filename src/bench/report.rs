@@ -36,6 +36,11 @@ pub struct Row {
     pub mrays_per_s: f64,
     /// Largest peak resident memory over the render runs, MiB.
     pub peak_mib: Option<f64>,
+    /// Bytes of the backend's structure per primitive of the scene (nodes and leaves
+    /// with their primitive data; see [`AccelStats::bytes`](crate::accel::AccelStats::bytes)),
+    /// when the backend says.
+    #[serde(default)]
+    pub bytes_per_prim: Option<f64>,
     /// This row's render time ÷ Embree's for the same scene and threads.
     pub vs_embree: Option<f64>,
     /// Repetitions.
@@ -131,6 +136,9 @@ pub fn rows(samples: &[Sample]) -> Vec<Row> {
                     .filter_map(|s| s.result.peak_kib)
                     .max()
                     .map(|k| k as f64 / 1024.0),
+                bytes_per_prim: first
+                    .filter(|r| r.accel_bytes > 0 && r.prims > 0)
+                    .map(|r| r.accel_bytes as f64 / r.prims as f64),
                 vs_embree: None,
                 reps: render.len(),
                 accel: first.map(|r| r.accel.clone()).unwrap_or_default(),
@@ -305,16 +313,16 @@ pub fn markdown(
     );
     let _ = writeln!(
         o,
-        "| scene | prims | backend | thr | load ms | build ms | render ms | spread | raw ms | render/raw | rays | Mrays/s | peak MiB | ÷ embree |"
+        "| scene | prims | backend | thr | load ms | build ms | render ms | spread | raw ms | render/raw | rays | Mrays/s | peak MiB | bytes/prim | ÷ embree |"
     );
     let _ = writeln!(
         o,
-        "|---|---:|---|---:|---:|---:|---:|---:|---:|---:|---:|---:|---:|---:|"
+        "|---|---:|---|---:|---:|---:|---:|---:|---:|---:|---:|---:|---:|---:|---:|"
     );
     for r in rows {
         let _ = writeln!(
             o,
-            "| {} | {} | {} | {} | {:.1} | {:.1} | {:.1} | {:.0}% | {} | {} | {} | {:.2} | {} | {} |",
+            "| {} | {} | {} | {} | {:.1} | {:.1} | {:.1} | {:.0}% | {} | {} | {} | {:.2} | {} | {} | {} |",
             r.scene,
             r.prims,
             r.backend,
@@ -328,6 +336,7 @@ pub fn markdown(
             r.rays.total,
             r.mrays_per_s,
             opt(r.peak_mib, 0),
+            opt(r.bytes_per_prim, 0),
             opt(r.vs_embree, 2),
         );
     }
@@ -403,13 +412,13 @@ pub fn markdown(
 /// The rows as CSV, one line per row.
 pub fn csv(rows: &[Row]) -> String {
     let mut o = String::from(
-        "scene,prims,backend,threads,reps,load_ms,build_ms,render_ms,spread_pct,raw_ms,render_over_raw,eye,reflection,refraction,shadow,total_rays,mrays_per_s,peak_mib,vs_embree\n",
+        "scene,prims,backend,threads,reps,load_ms,build_ms,render_ms,spread_pct,raw_ms,render_over_raw,eye,reflection,refraction,shadow,total_rays,mrays_per_s,peak_mib,bytes_per_prim,vs_embree\n",
     );
     let f = |v: Option<f64>| v.map_or(String::new(), |x| format!("{x:.4}"));
     for r in rows {
         let _ = writeln!(
             o,
-            "{},{},{},{},{},{:.3},{:.3},{:.3},{:.2},{},{},{},{},{},{},{},{:.4},{},{}",
+            "{},{},{},{},{},{:.3},{:.3},{:.3},{:.2},{},{},{},{},{},{},{},{:.4},{},{},{}",
             r.scene,
             r.prims,
             r.backend,
@@ -428,6 +437,7 @@ pub fn csv(rows: &[Row]) -> String {
             r.rays.total,
             r.mrays_per_s,
             f(r.peak_mib),
+            f(r.bytes_per_prim),
             f(r.vs_embree),
         );
     }
@@ -531,6 +541,7 @@ mod tests {
                 },
                 peak_kib: Some(2048),
                 accel: backend.into(),
+                accel_bytes: 50 * prims,
             },
         }
     }
@@ -567,6 +578,7 @@ mod tests {
         assert_eq!(r[0].overhead(), Some(11.0 / 8.0));
         assert_eq!(r[1].vs_embree, Some(22.0 / 11.0));
         assert_eq!(r[0].peak_mib, Some(2.0));
+        assert_eq!(r[0].bytes_per_prim, Some(50.0));
         let sum = summary(&r);
         assert_eq!(sum.bvh_vs_embree.get(&1), Some(&2.0));
         assert_eq!(sum.scaling_min["embree"], (2.0, "spd:balls".to_string()));

@@ -537,6 +537,32 @@ mod agreement {
     }
 
     #[test]
+    fn memory_counts_an_instanced_object_once() {
+        use crate::scene::Instance;
+        let mut rng = Rng::new(5);
+        let mut scene = random_scene(200, &mut rng);
+        let flat = Bvh::build(&scene);
+        let own = flat.memory_bytes();
+        // Packs and shapes alone take more than 30 bytes a primitive.
+        assert!(own > 200 * 30, "{own}");
+        assert_eq!(flat.stats().bytes, own);
+        scene.objects.push(random_scene(300, &mut rng).geometry);
+        let place = |x: f32| Instance {
+            object: 0,
+            xform: Xform::new(glam::Affine3A::from_translation(Vec3::X * x)).unwrap(),
+            material: 0,
+        };
+        scene.instances.push(place(20.0));
+        let once = Bvh::build(&scene).memory_bytes();
+        scene.instances.push(place(40.0));
+        let twice = Bvh::build(&scene).memory_bytes();
+        let object = Bvh::build_level(&scene.objects[0], Vec::new()).memory_bytes();
+        assert!(once > own + object, "{once} vs {own} + {object}");
+        // A second instance adds its place in the top level, not the object again.
+        assert!(twice - once < object / 4, "{twice} − {once} vs {object}");
+    }
+
+    #[test]
     fn coincident_primitives_still_build() {
         // 10 000 identical spheres: no split separates them; median splits must.
         let mut s = random_scene(0, &mut Rng::new(1));
