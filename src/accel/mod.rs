@@ -46,16 +46,15 @@ pub(crate) fn add_kind(kinds: &mut Vec<(Kind, usize)>, kind: Kind, n: usize) {
     }
 }
 
-/// `sphere×12, cone×3` for [`AccelStats::kinds`] (`none` when empty).
+/// The names of the kinds of [`AccelStats::kinds`], `spheres, cones` (`none` when
+/// empty). The counts are left out: the backend holds each instanced object once, so
+/// they are not the number of primitives a ray can meet, which `--stats` gives.
 pub fn kinds_summary(kinds: &[(Kind, usize)]) -> String {
     if kinds.is_empty() {
         return "none".into();
     }
-    let parts: Vec<String> = kinds
-        .iter()
-        .map(|(k, n)| format!("{}×{n}", k.name()))
-        .collect();
-    parts.join(", ")
+    let names: Vec<&str> = kinds.iter().map(|(k, _)| k.name()).collect();
+    names.join(", ")
 }
 
 /// A ray-query structure built over a [`Scene`].
