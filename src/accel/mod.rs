@@ -112,8 +112,8 @@ pub struct BackendOptions {
     pub backend: Backend,
     /// Embree's build quality.
     pub embree_quality: EmbreeQuality,
-    /// Embree's `RTC_SCENE_FLAG_ROBUST` on every scene it commits (the BVH is
-    /// watertight anyway).
+    /// Embree's `RTC_SCENE_FLAG_ROBUST` on every scene it commits (on by default: no
+    /// pinholes between triangles sharing an edge; the BVH is watertight anyway).
     pub embree_robust: bool,
     /// Coherent rays (a tile's eye rays with one sample per pixel) are cast in packets
     /// of this many (4, 8 or 16: Embree's `rtcIntersect4/8/16`); 0 casts them one by
@@ -126,13 +126,13 @@ pub struct BackendOptions {
 pub const DEFAULT_PACKET_WIDTH: u32 = 8;
 
 impl BackendOptions {
-    /// `backend` with the default options: medium build quality, fast traversal,
-    /// packets of [`DEFAULT_PACKET_WIDTH`].
+    /// `backend` with the default options: medium build quality, robust (watertight)
+    /// traversal, packets of [`DEFAULT_PACKET_WIDTH`].
     pub fn new(backend: Backend) -> Self {
         BackendOptions {
             backend,
             embree_quality: EmbreeQuality::default(),
-            embree_robust: false,
+            embree_robust: true,
             packet_width: DEFAULT_PACKET_WIDTH,
         }
     }

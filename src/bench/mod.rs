@@ -257,7 +257,8 @@ pub fn run_child(spec: &RunSpec) -> Result<RunResult, BenchError> {
     let options = BackendOptions {
         backend,
         embree_quality: spec.embree_quality,
-        embree_robust: false,
+        // The renderer's default traversal.
+        embree_robust: true,
         packet_width: spec.packet_width,
     };
     let (build_ms, ms, rays, accel) = pool.install(|| match spec.mode {
