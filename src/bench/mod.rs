@@ -146,6 +146,9 @@ pub struct RunSpec {
     /// Eye rays per packet (see [`RenderSettings::packet_width`]).
     #[serde(default = "default_packet_width")]
     pub packet_width: u32,
+    /// Embree without `RTC_SCENE_FLAG_ROBUST` (the renderer's default sets it).
+    #[serde(default)]
+    pub embree_fast: bool,
 }
 
 /// What runs recorded before `packet_width` existed are read with: the renderer's
@@ -257,8 +260,7 @@ pub fn run_child(spec: &RunSpec) -> Result<RunResult, BenchError> {
     let options = BackendOptions {
         backend,
         embree_quality: spec.embree_quality,
-        // The renderer's default traversal.
-        embree_robust: true,
+        embree_robust: !spec.embree_fast,
         packet_width: spec.packet_width,
     };
     let (build_ms, ms, rays, accel) = pool.install(|| match spec.mode {
@@ -363,6 +365,8 @@ pub struct Config {
     pub embree_quality: crate::accel::EmbreeQuality,
     /// Eye rays per packet (see [`RenderSettings::packet_width`]).
     pub packet_width: u32,
+    /// Embree without `RTC_SCENE_FLAG_ROBUST`.
+    pub embree_fast: bool,
 }
 
 /// The default suite: the eight SPD scenes at their default sizes, then balls and jacks
@@ -501,6 +505,7 @@ pub fn run_suite(
                             mode,
                             embree_quality: cfg.embree_quality,
                             packet_width: cfg.packet_width,
+                            embree_fast: cfg.embree_fast,
                         };
                         let result = run_in_child(exe, &spec)?;
                         log(&format!(
@@ -671,6 +676,7 @@ mod tests {
             mode: Mode::Render,
             embree_quality: Default::default(),
             packet_width: 8,
+            embree_fast: false,
         };
         let r = run_child(&spec).unwrap();
         assert_eq!(r.rays.eye, 17 * 17);

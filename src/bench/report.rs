@@ -517,6 +517,7 @@ mod tests {
                 mode,
                 embree_quality: Default::default(),
                 packet_width: 8,
+                embree_fast: false,
             },
             rep: 0,
             result: RunResult {

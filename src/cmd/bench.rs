@@ -38,6 +38,9 @@ pub struct Args {
     /// Eye rays per Embree packet (0, 4, 8 or 16; 0 casts them one by one).
     #[arg(long, value_name = "N", default_value_t = 8, value_parser = packet_width)]
     pub packet_width: u32,
+    /// Embree's fast traversal, without RTC_SCENE_FLAG_ROBUST (as `render --embree-fast`).
+    #[arg(long)]
+    pub embree_fast: bool,
     /// Skip the raw-casting runs.
     #[arg(long)]
     pub no_raw: bool,
@@ -122,5 +125,6 @@ fn config(b: &Args) -> bench::Config {
         peer: !b.no_peer,
         embree_quality: b.embree_quality.into(),
         packet_width: b.packet_width,
+        embree_fast: b.embree_fast,
     }
 }

@@ -286,6 +286,7 @@ impl Scene {
     /// The surface at a hit reported by a backend for `ray` (world space).
     pub fn surface(&self, hit: &Hit, ray: &Ray) -> Surface {
         if hit.inst_id == NO_INSTANCE {
+            let hit = &self.geometry.exact_hit(hit, ray);
             let mut surf = self.geometry.surface(hit, ray);
             if self.textured(surf.material) {
                 surf.param = Some(self.geometry.param(hit, &surf));
@@ -294,7 +295,9 @@ impl Scene {
         }
         let inst = &self.instances[hit.inst_id as usize];
         let object = &self.objects[inst.object as usize];
-        let local = object.surface(hit, &inst.xform.ray_to_object(ray));
+        let local_ray = inst.xform.ray_to_object(ray);
+        let hit = &object.exact_hit(hit, &local_ray);
+        let local = object.surface(hit, &local_ray);
         let point = inst.xform.surface_to_world(&local.point);
         let ns = inst.xform.normal_to_world(local.ns).normalize_or(point.ng);
         let material = if local.material == INHERIT {

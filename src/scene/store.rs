@@ -308,6 +308,34 @@ impl Geometry {
         }
     }
 
+    /// `hit` with a triangle's barycentrics and distance computed by emray's own
+    /// watertight test ([`Triangle::intersect`]) on the triangle the backend reported,
+    /// so that a hit is the same point whichever backend found it (Embree's triangle
+    /// arithmetic differs from the BVH's in the last bits, and reflections between
+    /// curved meshes magnify that into visible differences a few bounces down). When
+    /// the test does not confirm the hit (a ray within rounding of the triangle's edge,
+    /// which the backend gave to this triangle and the test to its neighbour), the
+    /// backend's values stay. Other kinds are computed by emray's intersectors on both
+    /// backends already.
+    #[inline]
+    pub fn exact_hit(&self, hit: &Hit, ray: &Ray) -> Hit {
+        if hit.geom_id != Kind::Triangle as u32 {
+            return *hit;
+        }
+        let Some(tri) = self.triangles.items.get(hit.prim_id as usize) else {
+            return *hit;
+        };
+        match tri.intersect(ray) {
+            Some(h) => Hit {
+                t: h.t,
+                u: h.u,
+                v: h.v,
+                ..*hit
+            },
+            None => *hit,
+        }
+    }
+
     fn triangle_surface(&self, i: usize, hit: &Hit) -> Surface {
         let tri = &self.triangles.items[i];
         let point = tri.surface(hit.u, hit.v);
