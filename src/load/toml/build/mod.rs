@@ -15,11 +15,19 @@
 //!   every instance shares; an `instance` inside a `define` copies the other define's
 //!   content in place (following the same rules), which is where cycles are caught.
 
-use super::format::{
-    LightDef, MaterialDef, ObjectDef, Real, Scale, SceneFile, Spanned, TextureDef, TransformList,
-    TransformStep, V3,
-};
-use super::{MAX_SIDE, SceneSettings, Source, suggest};
+mod bake;
+mod camera;
+mod lights;
+mod materials;
+mod settings;
+mod transforms;
+mod values;
+
+use bake::bake;
+use transforms::similarity_scale;
+
+use super::format::{ObjectDef, SceneFile, Spanned, V3};
+use super::{SceneSettings, Source, suggest};
 use crate::geometry::bezier::{BezierPatch, teapot_patches, tessellate};
 use crate::geometry::polygon::Triangulator;
 use crate::geometry::{
@@ -27,13 +35,12 @@ use crate::geometry::{
     Quadric, Shape, Sphere, Torus, Triangle,
 };
 use crate::load::{LoadError, nff, obj};
-use crate::math::{Aabb, Vec3, Xform};
-use crate::scene::texture::{Image, Wrap};
+use crate::math::{Aabb, Vec3};
 use crate::scene::{
-    Camera, Environment, Geometry, GeometryMark, INHERIT, Instance, Light, LoadStats, Maps,
-    Material, Scene, Spot, Texture, range,
+    Environment, Geometry, GeometryMark, Instance, Light, LoadStats, Material, Scene, Spot,
+    Texture, range,
 };
-use glam::{Affine3A, DAffine3, DMat3, DMat4, DQuat, DVec3, Quat};
+use glam::{DAffine3, DQuat, DVec3, Quat};
 use std::collections::HashMap;
 use std::ops::Range;
 use std::path::{Path, PathBuf};
@@ -44,23 +51,9 @@ type R<T> = Result<T, LoadError>;
 
 /// Deepest nesting of objects (groups, CSG, instances copied into defines).
 const MAX_NESTING: usize = 256;
-/// Largest accepted `max_depth`.
-const MAX_RAY_DEPTH: u32 = 64;
-/// Largest accepted `spp`.
-const MAX_SPP: u32 = 65_536;
-/// Ambient light when `[render]` gives none.
-const DEFAULT_AMBIENT: f32 = 0.1;
-/// Image size when `[camera]` gives none.
-const DEFAULT_RESOLUTION: [u32; 2] = [640, 480];
-/// Field of view when `[camera]` gives none.
-const DEFAULT_FOV: f64 = 45.0;
-/// Phong exponent when a material gives none.
-const DEFAULT_SHININESS: f64 = 32.0;
 /// A bezier's default tessellation tolerance, relative to the diagonal of its control
 /// points' bounding box.
 const BEZIER_RELATIVE_TOLERANCE: f64 = 1e-3;
-/// Spot cutoff half-angle when a light gives none.
-const DEFAULT_CUTOFF: f64 = 45.0;
 
 /// The object types.
 #[derive(Clone, Copy, Debug, PartialEq, Eq)]
@@ -254,19 +247,8 @@ pub(super) fn build(file: &SceneFile, src: &Source) -> R<(Scene, SceneSettings)>
     };
     let camera = b.camera()?;
     let (background, ambient, settings) = b.render()?;
-    // Materials are numbered in file order (the map itself is sorted by name).
-    let mut materials: Vec<_> = file.materials.iter().collect();
-    materials.sort_by_key(|(_, d)| d.span().start);
-    for (name, def) in materials {
-        let mut m = b.material(def)?;
-        m.maps = b.maps(def)?;
-        b.material_names.insert(name, b.materials.len() as u32);
-        b.materials.push(m);
-    }
-    for l in &file.lights {
-        let light = b.light(l)?;
-        b.lights.push(light);
-    }
+    b.named_materials()?;
+    b.file_lights()?;
     for obj in &file.objects {
         b.walk(obj, Ctx::ROOT, &mut Sink::Top)?;
     }
@@ -330,161 +312,6 @@ fn f32v(v: DVec3) -> Vec3 {
     v.as_vec3()
 }
 
-/// `m` in single precision.
-fn affine_f32(m: &DAffine3) -> Affine3A {
-    Affine3A::from_mat3_translation(m.matrix3.as_mat3(), m.translation.as_vec3())
-}
-
-/// The uniform scale factor of `m` if its linear part is a rotation (or mirror) times
-/// that factor, to a relative 1e-6.
-fn similarity_scale(m: &DAffine3) -> Option<f64> {
-    let l = m.matrix3;
-    let g = l.transpose() * l;
-    let s2 = (g.x_axis.x + g.y_axis.y + g.z_axis.z) / 3.0;
-    if !(s2 > 0.0 && s2.is_finite()) {
-        return None;
-    }
-    let dev = g - DMat3::from_diagonal(DVec3::splat(s2));
-    let worst = [dev.x_axis, dev.y_axis, dev.z_axis]
-        .iter()
-        .map(|c| c.abs().max_element())
-        .fold(0.0f64, f64::max);
-    (worst <= 1e-6 * s2).then(|| s2.sqrt())
-}
-
-/// `shape` under `m` as a shape of the same kind, when that is exact.
-fn bake(shape: &Shape, m: &DAffine3) -> Option<Shape> {
-    match shape {
-        Shape::Sphere(s) => {
-            let k = similarity_scale(m)?;
-            let r = (s.radius as f64 * k) as f32;
-            Some(Shape::Sphere(Sphere {
-                center: f32v(m.transform_point3(s.center.as_dvec3())),
-                radius: r,
-                inside_only: s.inside_only,
-            }))
-        }
-        Shape::Cone(c) => {
-            let k = similarity_scale(m)?;
-            let sign = if c.inside_only { -1.0 } else { 1.0 };
-            Some(Shape::Cone(Cone::new(
-                f32v(m.transform_point3(c.base.as_dvec3())),
-                sign * (c.base_radius as f64 * k) as f32,
-                f32v(m.transform_point3(c.apex.as_dvec3())),
-                sign * (c.apex_radius as f64 * k) as f32,
-            )))
-        }
-        Shape::Box(b) => {
-            // Axis-aligned stays axis-aligned under a diagonal linear part.
-            let l = m.matrix3;
-            let diagonal = l.x_axis.y == 0.0
-                && l.x_axis.z == 0.0
-                && l.y_axis.x == 0.0
-                && l.y_axis.z == 0.0
-                && l.z_axis.x == 0.0
-                && l.z_axis.y == 0.0;
-            if !diagonal {
-                return None;
-            }
-            let a = m.transform_point3(b.min().as_dvec3());
-            let c = m.transform_point3(b.max().as_dvec3());
-            AaBox::new(f32v(a.min(c)), f32v(a.max(c)))
-                .ok()
-                .map(Shape::Box)
-        }
-        Shape::OBox(b) => {
-            let k = similarity_scale(m)?;
-            let axes = b.axes().map(|a| f32v((m.matrix3 * a.as_dvec3()) / k));
-            OBox::from_axes(
-                f32v(m.transform_point3(b.center().as_dvec3())),
-                f32v(b.half_extents().as_dvec3() * k),
-                axes,
-            )
-            .ok()
-            .map(|b| Shape::OBox(Arc::new(b)))
-        }
-        Shape::CappedCone(c) => {
-            let k = similarity_scale(m)?;
-            CappedCone::new(
-                f32v(m.transform_point3(c.base().as_dvec3())),
-                f32v(m.matrix3 * c.axis().as_dvec3()),
-                (c.height() as f64 * k) as f32,
-                (c.base_radius() as f64 * k) as f32,
-                (c.top_radius() as f64 * k) as f32,
-            )
-            .ok()
-            .map(|c| Shape::CappedCone(Arc::new(c)))
-        }
-        Shape::Polyhedron(p) => {
-            // Half-spaces n·x ≤ d map to n'·y ≤ d + n'·t with n' = M⁻ᵀn.
-            let inv_t = m.matrix3.inverse().transpose();
-            let planes = p
-                .world_planes()
-                .into_iter()
-                .map(|(n, d)| {
-                    let n2 = inv_t * n;
-                    (f32v(n2), (d + n2.dot(m.translation)) as f32)
-                })
-                .collect();
-            Polyhedron::new(planes)
-                .ok()
-                .map(|p| Shape::Polyhedron(Arc::new(p)))
-        }
-        Shape::Quadric(q) if q.clip().is_none() => {
-            // F(L⁻¹(y − t)) about the origin t: the coefficients through L⁻¹ alone.
-            let [a, b, c, d, e, f, g, h, i, j] = q.coefficients();
-            let qm = DMat4::from_cols_array_2d(&[
-                [a, d, e, g],
-                [d, b, f, h],
-                [e, f, c, i],
-                [g, h, i, j],
-            ]);
-            let inv = DMat4::from_mat3(m.matrix3.inverse());
-            let r = inv.transpose() * qm * inv;
-            let k = |x: usize, y: usize| 0.5 * (r.col(x)[y] + r.col(y)[x]);
-            let coeffs = [
-                k(0, 0),
-                k(1, 1),
-                k(2, 2),
-                k(0, 1),
-                k(0, 2),
-                k(1, 2),
-                k(0, 3),
-                k(1, 3),
-                k(2, 3),
-                k(3, 3),
-            ];
-            let t = m.translation;
-            if !t.is_finite() {
-                return None;
-            }
-            Quadric::about(f32v(t), coeffs, None)
-                .ok()
-                .map(|q| Shape::Quadric(Arc::new(q)))
-        }
-        Shape::Plane(p) => {
-            let n = p.normal().as_dvec3();
-            let point = m.transform_point3(n * p.offset());
-            let normal = m.matrix3.inverse().transpose() * n;
-            Plane::from_point_normal(f32v(point), f32v(normal))
-                .ok()
-                .map(Shape::Plane)
-        }
-        Shape::Torus(t) => {
-            let k = similarity_scale(m)?;
-            Torus::new(
-                f32v(m.transform_point3(t.center().as_dvec3())),
-                f32v(m.matrix3 * t.axis().as_dvec3()),
-                (t.major_radius() as f64 * k) as f32,
-                (t.minor_radius() as f64 * k) as f32,
-            )
-            .ok()
-            .map(|t| Shape::Torus(Arc::new(t)))
-        }
-        Shape::Csg(_) | Shape::Quadric(_) => None,
-    }
-}
-
 /// A primitive constructor's message, prefixed with the object type unless it names
 /// the primitive already.
 fn from_constructor(ty: Ty, e: impl std::fmt::Display) -> String {
@@ -521,6 +348,11 @@ fn did_you_mean<'c>(word: &str, candidates: impl IntoIterator<Item = &'c str>) -
 }
 
 impl<'a, 's> Builder<'a, 's> {
+    /// The path of `name`, a file named in the scene file, relative to its folder.
+    fn relative_path(&self, name: &str) -> PathBuf {
+        self.src.path.parent().unwrap_or(Path::new("")).join(name)
+    }
+
     /// An error at the start of `span` in the scene file.
     fn at(&self, span: Range<usize>) -> LoadError {
         self.src.err(span, "")
@@ -528,585 +360,6 @@ impl<'a, 's> Builder<'a, 's> {
 
     fn err(&self, span: Range<usize>, message: impl Into<String>) -> LoadError {
         self.src.err(span, message)
-    }
-
-    // ---- numbers -------------------------------------------------------------------
-
-    fn positive(&self, v: &Spanned<Real>, what: &str) -> R<f64> {
-        let x = v.get_ref().0;
-        if x > 0.0 {
-            Ok(x)
-        } else {
-            Err(self.err(v.span(), format!("{what} must be positive, found {x}")))
-        }
-    }
-
-    fn non_negative(&self, v: &Spanned<Real>, what: &str) -> R<f64> {
-        let x = v.get_ref().0;
-        if x >= 0.0 {
-            Ok(x)
-        } else {
-            Err(self.err(v.span(), format!("{what} must not be negative, found {x}")))
-        }
-    }
-
-    fn non_negative3(&self, v: &Spanned<V3>, what: &str) -> R<Vec3> {
-        let x = v3(v.get_ref());
-        if x.min_element() >= 0.0 {
-            Ok(f32v(x))
-        } else {
-            Err(self.err(
-                v.span(),
-                format!("{what} must not have negative components, found {x}"),
-            ))
-        }
-    }
-
-    fn positive3(&self, v: &Spanned<V3>, what: &str) -> R<Vec3> {
-        let x = v3(v.get_ref());
-        if x.min_element() > 0.0 {
-            Ok(f32v(x))
-        } else {
-            Err(self.err(
-                v.span(),
-                format!("{what} must have positive components, found {x}"),
-            ))
-        }
-    }
-
-    /// A non-zero vector, normalised.
-    fn direction(&self, v: &Spanned<V3>, what: &str) -> R<DVec3> {
-        let x = v3(v.get_ref());
-        let scaled = x / x.abs().max_element();
-        match scaled.try_normalize() {
-            Some(u) if x != DVec3::ZERO => Ok(u),
-            _ => Err(self.err(v.span(), format!("{what} must not be zero"))),
-        }
-    }
-
-    // ---- camera, render, materials, lights ------------------------------------------
-
-    fn camera(&self) -> R<Camera> {
-        let cam = &self.file.camera;
-        let c = cam.get_ref();
-        let fov = match &c.fov {
-            Some(f) => {
-                let a = f.get_ref().0;
-                if !(a > 0.0 && a < 180.0) {
-                    return Err(self.err(
-                        f.span(),
-                        format!("`fov` must be between 0 and 180 degrees (exclusive), found {a}"),
-                    ));
-                }
-                a
-            }
-            None => DEFAULT_FOV,
-        };
-        let hither = match &c.hither {
-            Some(h) => self.non_negative(h, "`hither`")?,
-            None => 0.0,
-        };
-        let [width, height] = match &c.resolution {
-            Some(r) => {
-                let [w, h] = *r.get_ref();
-                for (n, name) in [(w, "width"), (h, "height")] {
-                    if n == 0 || n > MAX_SIDE {
-                        return Err(self.err(
-                            r.span(),
-                            format!("image {name} must be between 1 and {MAX_SIDE}, found {n}"),
-                        ));
-                    }
-                }
-                [w, h]
-            }
-            None => DEFAULT_RESOLUTION,
-        };
-        let (from, at, up, up_span) = match &c.matrix {
-            Some(m) => {
-                if let Some((k, span)) = [("from", &c.from), ("at", &c.at), ("up", &c.up)]
-                    .into_iter()
-                    .find_map(|(k, v)| v.as_ref().map(|v| (k, v.span())))
-                {
-                    return Err(self.err(
-                        span,
-                        format!("the camera has a `matrix`, so `{k}` cannot be given too"),
-                    ));
-                }
-                let x = self.matrix(m)?;
-                let from = x.translation;
-                let forward = x.matrix3 * DVec3::NEG_Z;
-                let up = x.matrix3 * DVec3::Y;
-                (from, from + forward, up, m.span())
-            }
-            None => {
-                let (Some(from), Some(at)) = (&c.from, &c.at) else {
-                    return Err(self.err(
-                        cam.span(),
-                        "the camera needs `from` and `at` (or a `matrix`)",
-                    ));
-                };
-                let up = c.up.as_ref().map_or(DVec3::Y, |u| v3(u.get_ref()));
-                let up_span = c.up.as_ref().map_or(cam.span(), |u| u.span());
-                let (f, a) = (v3(from.get_ref()), v3(at.get_ref()));
-                if f == a {
-                    return Err(self.err(at.span(), "camera `at` equals `from`"));
-                }
-                (f, a, up, up_span)
-            }
-        };
-        let fwd = at - from;
-        let fwd = (fwd / fwd.abs().max_element()).normalize();
-        let upn = if up == DVec3::ZERO {
-            up
-        } else {
-            up / up.abs().max_element()
-        };
-        if fwd.cross(upn).try_normalize().is_none() {
-            return Err(self.err(
-                up_span,
-                "the camera's up vector is zero or parallel to the viewing direction",
-            ));
-        }
-        let (from_span, at_span) = match (&c.matrix, &c.from, &c.at) {
-            (Some(m), _, _) => (m.span(), m.span()),
-            (None, Some(f), Some(a)) => (f.span(), a.span()),
-            _ => (cam.span(), cam.span()),
-        };
-        range::check_point("the camera `from`", f32v(from))
-            .map_err(|e| self.err(from_span, e.to_string()))?;
-        range::check_point("the camera `at`", f32v(at))
-            .map_err(|e| self.err(at_span, e.to_string()))?;
-        Ok(Camera {
-            from: f32v(from),
-            at: f32v(at),
-            up: f32v(up),
-            angle_deg: fov as f32,
-            hither: hither as f32,
-            width,
-            height,
-        })
-    }
-
-    fn render(&mut self) -> R<(Vec3, Vec3, SceneSettings)> {
-        let mut background = Vec3::ZERO;
-        let mut ambient = Vec3::splat(DEFAULT_AMBIENT);
-        let mut settings = SceneSettings::default();
-        if let Some(r) = &self.file.render {
-            let r = r.get_ref();
-            if let Some(b) = &r.background {
-                background = self.non_negative3(b, "`background`")?;
-            }
-            if let Some(e) = &r.environment {
-                let path = self
-                    .src
-                    .path
-                    .parent()
-                    .unwrap_or(Path::new(""))
-                    .join(e.get_ref());
-                self.environment =
-                    Some(Environment::load(&path).map_err(|m| self.err(e.span(), m.to_string()))?);
-            }
-            if let Some(a) = &r.ambient {
-                ambient = self.non_negative3(a, "`ambient`")?;
-            }
-            if let Some(d) = &r.max_depth {
-                let n = *d.get_ref();
-                if !(1..=MAX_RAY_DEPTH).contains(&n) {
-                    return Err(self.err(
-                        d.span(),
-                        format!("`max_depth` must be between 1 and {MAX_RAY_DEPTH}, found {n}"),
-                    ));
-                }
-                settings.max_depth = Some(n);
-            }
-            if let Some(s) = &r.spp {
-                let n = *s.get_ref();
-                if !(1..=MAX_SPP).contains(&n) {
-                    return Err(self.err(
-                        s.span(),
-                        format!("`spp` must be between 1 and {MAX_SPP}, found {n}"),
-                    ));
-                }
-                settings.spp = Some(n);
-            }
-        }
-        Ok((background, ambient, settings))
-    }
-
-    /// The texture maps of a material definition (images read now).
-    fn maps(&mut self, def: &Spanned<MaterialDef>) -> R<Maps> {
-        let d = def.get_ref();
-        let mut maps = Maps::NONE;
-        for (t, slot, srgb) in [
-            (&d.texture, &mut maps.color, true),
-            (&d.specular_map, &mut maps.specular, true),
-            (&d.bump, &mut maps.bump, false),
-            (&d.normal_map, &mut maps.normal, false),
-        ] {
-            if let Some(t) = t {
-                let tex = self.texture(t, srgb)?;
-                self.textures.push(tex);
-                *slot = self.textures.len() as u32 - 1;
-            }
-        }
-        if let Some(s) = &d.bump_scale {
-            maps.bump_scale = s.get_ref().0 as f32;
-        }
-        if let Some(s) = &d.uv_scale {
-            let [a, b] = s.get_ref();
-            if !(a.0 != 0.0 && b.0 != 0.0) {
-                return Err(self.err(s.span(), "`uv_scale` must not be zero"));
-            }
-            maps.uv_scale = [a.0 as f32, b.0 as f32];
-        }
-        Ok(maps)
-    }
-
-    fn texture(&self, def: &Spanned<TextureDef>, srgb: bool) -> R<Texture> {
-        let t = def.get_ref();
-        let colour = |v: &Option<Spanned<V3>>, default: Vec3| -> R<Vec3> {
-            v.as_ref()
-                .map_or(Ok(default), |c| self.non_negative3(c, "a texture colour"))
-        };
-        let ty = t.ty.as_ref().map(|s| (s.get_ref().as_str(), s.span()));
-        match (ty, &t.file) {
-            (None | Some(("image", _)), Some(file)) => {
-                let path = self
-                    .src
-                    .path
-                    .parent()
-                    .unwrap_or(Path::new(""))
-                    .join(file.get_ref());
-                let mut img =
-                    Image::load(&path, srgb).map_err(|e| self.err(file.span(), e.to_string()))?;
-                img.wrap = match t.wrap.as_ref().map(|w| (w.get_ref().as_str(), w.span())) {
-                    None | Some(("repeat", _)) => Wrap::Repeat,
-                    Some(("clamp", _)) => Wrap::Clamp,
-                    Some((w, span)) => {
-                        return Err(self.err(
-                            span,
-                            format!("unknown wrap mode `{w}` (expected `repeat` or `clamp`)"),
-                        ));
-                    }
-                };
-                Ok(Texture::Image(Arc::new(img)))
-            }
-            (Some((kind @ ("checker" | "marble"), _)), None) => {
-                let a = colour(&t.a, Vec3::ONE)?;
-                let b = colour(&t.b, Vec3::ZERO)?;
-                let default = if kind == "checker" { 8.0 } else { 4.0 };
-                let scale = match &t.scale {
-                    Some(s) => self.positive(s, "`scale`")? as f32,
-                    None => default,
-                };
-                Ok(if kind == "checker" {
-                    Texture::Checker { a, b, scale }
-                } else {
-                    Texture::Marble { a, b, scale }
-                })
-            }
-            (None | Some(("image", _)), None) => {
-                Err(self.err(def.span(), "an image texture needs a `file`"))
-            }
-            (Some((other, span)), _) if !matches!(other, "image" | "checker" | "marble") => {
-                Err(self.err(
-                    span,
-                    format!(
-                        "unknown texture type `{other}` (expected `image`, `checker` or `marble`)"
-                    ),
-                ))
-            }
-            (_, Some(file)) => Err(self.err(
-                file.span(),
-                "`file` is for image textures (remove `type` or set it to \"image\")",
-            )),
-            (Some((_, span)), None) => Err(self.err(span, "an image texture needs a `file`")),
-        }
-    }
-
-    fn material(&self, def: &Spanned<MaterialDef>) -> R<Material> {
-        let d = def.get_ref();
-        let weight = |v: &Option<Spanned<Real>>, name: &str, default: f64| -> R<f32> {
-            match v {
-                Some(v) => Ok(self.non_negative(v, &format!("`{name}`"))? as f32),
-                None => Ok(default as f32),
-            }
-        };
-        let color = match &d.color {
-            Some(c) => self.non_negative3(c, "`color`")?,
-            None => Vec3::ONE,
-        };
-        let kd = weight(&d.diffuse, "diffuse", 1.0)?;
-        let ior = match &d.ior {
-            Some(v) => self.positive(v, "`ior`")? as f32,
-            None => 1.0,
-        };
-        let t = weight(&d.transmittance, "transmittance", 0.0)?;
-        if let Err(e) = range::check_ior(t, ior) {
-            let at = d.ior.as_ref().map_or(def.span(), |v| v.span());
-            return Err(self.err(at, e.to_string()));
-        }
-        Ok(Material {
-            color,
-            ka: weight(&d.ambient, "ambient", kd as f64)?,
-            kd,
-            ks: weight(&d.specular, "specular", 0.0)?,
-            shine: weight(&d.shininess, "shininess", DEFAULT_SHININESS)?,
-            kr: weight(&d.reflectance, "reflectance", 0.0)?,
-            t,
-            ior,
-            filter: match &d.filter {
-                Some(f) => self.non_negative3(f, "`filter`")?,
-                None => Vec3::ONE,
-            },
-            priority: d.priority.as_ref().map_or(0, |p| *p.get_ref()),
-            emission: match &d.emission {
-                Some(e) => self.non_negative3(e, "`emission`")?,
-                None => Vec3::ZERO,
-            },
-            ..Material::DEFAULT
-        })
-    }
-
-    fn light(&self, def: &Spanned<LightDef>) -> R<Light> {
-        let l = def.get_ref();
-        let spot = match &l.ty {
-            None => false,
-            Some(t) => match t.get_ref().as_str() {
-                "point" => false,
-                "spot" => true,
-                other => {
-                    return Err(self.err(
-                        t.span(),
-                        format!(
-                            "unknown light type `{other}`{}; light types: point, spot",
-                            did_you_mean(other, ["point", "spot"])
-                        ),
-                    ));
-                }
-            },
-        };
-        if !spot {
-            for (k, v) in [
-                ("direction", l.direction.as_ref().map(|v| v.span())),
-                ("target", l.target.as_ref().map(|v| v.span())),
-                ("cutoff", l.cutoff.as_ref().map(|v| v.span())),
-                ("exponent", l.exponent.as_ref().map(|v| v.span())),
-            ] {
-                if let Some(span) = v {
-                    return Err(self.err(
-                        span,
-                        format!("`{k}` is for spot lights (add `type = \"spot\"`)"),
-                    ));
-                }
-            }
-        }
-        let pos = v3(l.position.get_ref());
-        range::check_point("the light `position`", f32v(pos))
-            .map_err(|e| self.err(l.position.span(), e.to_string()))?;
-        let color = match &l.color {
-            Some(c) => self.non_negative3(c, "light `color`")?,
-            None => Vec3::ONE,
-        };
-        let intensity = match &l.intensity {
-            Some(i) => self.non_negative(i, "light `intensity`")? as f32,
-            None => 1.0,
-        };
-        let attenuation = match &l.attenuation {
-            Some(a) => {
-                let v = self.non_negative3(a, "`attenuation`")?;
-                if v == Vec3::ZERO {
-                    return Err(self.err(a.span(), "`attenuation` must not be all zero"));
-                }
-                v
-            }
-            None => Vec3::X,
-        };
-        let spot = if spot {
-            let dir = match (&l.direction, &l.target) {
-                (Some(d), None) => self.direction(d, "spot `direction`")?,
-                (None, Some(t)) => {
-                    let d = v3(t.get_ref()) - pos;
-                    if d == DVec3::ZERO {
-                        return Err(self.err(t.span(), "spot `target` equals its `position`"));
-                    }
-                    (d / d.abs().max_element()).normalize()
-                }
-                (Some(_), Some(t)) => {
-                    return Err(self.err(
-                        t.span(),
-                        "a spot light takes `direction` or `target`, not both",
-                    ));
-                }
-                (None, None) => {
-                    return Err(self.err(def.span(), "a spot light needs `direction` or `target`"));
-                }
-            };
-            let cutoff = match &l.cutoff {
-                Some(c) => {
-                    let a = c.get_ref().0;
-                    if !(a > 0.0 && a < 180.0) {
-                        return Err(self.err(
-                            c.span(),
-                            format!(
-                                "`cutoff` must be between 0 and 180 degrees (exclusive), found {a}"
-                            ),
-                        ));
-                    }
-                    a
-                }
-                None => DEFAULT_CUTOFF,
-            };
-            let exponent = match &l.exponent {
-                Some(e) => self.non_negative(e, "`exponent`")?,
-                None => 0.0,
-            };
-            Some(Spot {
-                dir: f32v(dir),
-                cos_cutoff: cutoff.to_radians().cos() as f32,
-                exponent: exponent as f32,
-            })
-        } else {
-            None
-        };
-        Ok(Light {
-            pos: f32v(pos),
-            color: color * intensity,
-            spot,
-            attenuation,
-        })
-    }
-
-    fn material_ref(&self, name: &Spanned<String>) -> R<u32> {
-        let n = name.get_ref().as_str();
-        self.material_names.get(n).copied().ok_or_else(|| {
-            let hint = if self.material_names.is_empty() {
-                " (the file defines no `[materials.NAME]`)".to_string()
-            } else {
-                did_you_mean(n, self.file.materials.keys().map(String::as_str))
-            };
-            self.err(name.span(), format!("unknown material `{n}`{hint}"))
-        })
-    }
-
-    /// The material of primitives given none: inherited inside a define, else the
-    /// default material (added on first use).
-    fn fallback_material(&mut self, sink: &Sink) -> u32 {
-        if sink.in_define() {
-            return INHERIT;
-        }
-        match self.default_material {
-            Some(m) => m,
-            None => {
-                let m = self.materials.len() as u32;
-                let def = Spanned::new(0..0, MaterialDef::default());
-                let mat = self.material(&def).expect("the default material is valid");
-                self.materials.push(mat);
-                self.default_material = Some(m);
-                m
-            }
-        }
-    }
-
-    // ---- transforms ------------------------------------------------------------------
-
-    /// An affine matrix given as 4 rows of 4.
-    fn matrix(&self, m: &Spanned<[[Real; 4]; 4]>) -> R<DAffine3> {
-        let r = m.get_ref().map(|row| row.map(|x| x.0));
-        if r[3] != [0.0, 0.0, 0.0, 1.0] {
-            return Err(self.err(
-                m.span(),
-                format!(
-                    "the last row of a matrix must be [0, 0, 0, 1] (only affine transforms), \
-                     found {:?}",
-                    r[3]
-                ),
-            ));
-        }
-        let col = |i: usize| DVec3::new(r[0][i], r[1][i], r[2][i]);
-        let x = DAffine3::from_mat3_translation(DMat3::from_cols(col(0), col(1), col(2)), col(3));
-        self.check_invertible(&x, m.span())?;
-        Ok(x)
-    }
-
-    fn check_invertible(&self, m: &DAffine3, span: Range<usize>) -> R<Xform> {
-        Xform::new(affine_f32(m)).map_err(|e| self.err(span, format!("bad transform: {e}")))
-    }
-
-    fn step(&self, st: &Spanned<TransformStep>) -> R<DAffine3> {
-        let t = st.get_ref();
-        let ops: Vec<&str> = [
-            ("translate", t.translate.is_some()),
-            ("rotate", t.rotate.is_some()),
-            ("scale", t.scale.is_some()),
-            ("matrix", t.matrix.is_some()),
-        ]
-        .into_iter()
-        .filter_map(|(k, p)| p.then_some(k))
-        .collect();
-        if ops.len() != 1 {
-            let found = if ops.is_empty() {
-                "none".to_string()
-            } else {
-                ops.join(", ")
-            };
-            return Err(self.err(
-                st.span(),
-                format!(
-                    "a transform step takes exactly one of `translate`, `rotate` (with \
-                     `angle`), `scale` or `matrix`; found {found}"
-                ),
-            ));
-        }
-        if let (Some(a), None) = (&t.angle, &t.rotate) {
-            return Err(self.err(a.span(), "`angle` goes with `rotate`"));
-        }
-        if let Some(v) = &t.translate {
-            return Ok(DAffine3::from_translation(v3(v.get_ref())));
-        }
-        if let Some(axis) = &t.rotate {
-            let u = self.direction(axis, "the rotation axis")?;
-            let Some(angle) = &t.angle else {
-                return Err(self.err(st.span(), "`rotate` needs `angle` (degrees)"));
-            };
-            return Ok(DAffine3::from_axis_angle(u, angle.get_ref().0.to_radians()));
-        }
-        if let Some(s) = &t.scale {
-            let k = match s.get_ref() {
-                Scale::Uniform(k) => DVec3::splat(k.0),
-                Scale::Axes(v) => v3(v),
-            };
-            if k.min_element() * k.max_element() == 0.0 || k.abs().min_element() == 0.0 {
-                return Err(self.err(
-                    s.span(),
-                    format!("scale factors must not be zero, found {k}"),
-                ));
-            }
-            let x = DAffine3::from_scale(k);
-            self.check_invertible(&x, s.span())?;
-            return Ok(x);
-        }
-        match &t.matrix {
-            Some(m) => self.matrix(m),
-            None => unreachable!("one operation is present"),
-        }
-    }
-
-    /// The composition of a transform list: the first step applied first.
-    fn transform_list(&self, list: &Spanned<TransformList>) -> R<DAffine3> {
-        let mut m = DAffine3::IDENTITY;
-        for st in list.get_ref() {
-            m = self.step(st)? * m;
-        }
-        self.check_invertible(&m, list.span())?;
-        Ok(m)
-    }
-
-    fn local_xform(&self, o: &ObjectDef) -> R<DAffine3> {
-        match &o.transform {
-            Some(t) => self.transform_list(t),
-            None => Ok(DAffine3::IDENTITY),
-        }
     }
 
     // ---- objects -----------------------------------------------------------------------
@@ -1246,25 +499,16 @@ impl<'a, 's> Builder<'a, 's> {
             }
             Ty::Instance => self.instance(node, inner, sink),
             Ty::Union | Ty::Intersection | Ty::Difference => {
-                let m = match inherited {
-                    Some(m) => m,
-                    None => self.fallback_material(sink),
-                };
+                let m = self.material_or_fallback(inherited, sink);
                 self.csg(node, ty, x, m, sink)
             }
             Ty::Include => self.include(node, x, explicit, sink),
             Ty::Triangle | Ty::Polygon | Ty::Mesh => {
-                let m = match inherited {
-                    Some(m) => m,
-                    None => self.fallback_material(sink),
-                };
+                let m = self.material_or_fallback(inherited, sink);
                 self.polygons(node, ty, &x, m, sink)
             }
             Ty::Bezier => {
-                let m = match inherited {
-                    Some(m) => m,
-                    None => self.fallback_material(sink),
-                };
+                let m = self.material_or_fallback(inherited, sink);
                 self.bezier(node, &x, m, sink)
             }
             Ty::Sphere
@@ -1277,10 +521,7 @@ impl<'a, 's> Builder<'a, 's> {
             | Ty::Quadric
             | Ty::Plane
             | Ty::Torus => {
-                let m = match inherited {
-                    Some(m) => m,
-                    None => self.fallback_material(sink),
-                };
+                let m = self.material_or_fallback(inherited, sink);
                 let shape = self.analytic(node, ty)?;
                 self.place_shape(shape, &x, m, node.get_ref().ty.span(), sink)
             }
@@ -1659,10 +900,7 @@ impl<'a, 's> Builder<'a, 's> {
         };
         if let Some(object) = object {
             let xform = self.check_invertible(&inner.xform, node.get_ref().ty.span())?;
-            let material = match inner.material {
-                Some(m) => m,
-                None => self.fallback_material(sink),
-            };
+            let material = self.material_or_fallback(inner.material, sink);
             self.instances.push(Instance {
                 object,
                 xform,
@@ -2243,40 +1481,6 @@ impl<'a, 's> Builder<'a, 's> {
 mod tests {
     use super::*;
     use std::collections::BTreeSet;
-
-    #[test]
-    fn similarity_detection() {
-        let r = DAffine3::from_axis_angle(DVec3::new(1.0, 2.0, 3.0).normalize(), 0.7);
-        assert_eq!(similarity_scale(&r).map(|s| (s * 1e9).round()), Some(1e9));
-        let s = DAffine3::from_translation(DVec3::X) * DAffine3::from_scale(DVec3::splat(-2.5)) * r;
-        assert!((similarity_scale(&s).unwrap() - 2.5).abs() < 1e-12);
-        let ns = DAffine3::from_scale(DVec3::new(1.0, 2.0, 1.0)) * r;
-        assert_eq!(similarity_scale(&ns), None);
-        let shear = DAffine3::from_mat3(DMat3::from_cols(
-            DVec3::X,
-            DVec3::new(0.1, 1.0, 0.0),
-            DVec3::Z,
-        ));
-        assert_eq!(similarity_scale(&shear), None);
-    }
-
-    #[test]
-    fn spheres_bake_under_similarities_only() {
-        let s = Shape::Sphere(Sphere::new(Vec3::new(1.0, 0.0, 0.0), 2.0));
-        let m = DAffine3::from_translation(DVec3::new(0.0, 5.0, 0.0))
-            * DAffine3::from_scale(DVec3::splat(3.0))
-            * DAffine3::from_axis_angle(DVec3::Z, std::f64::consts::FRAC_PI_2);
-        let Some(Shape::Sphere(b)) = bake(&s, &m) else {
-            panic!("not baked")
-        };
-        assert!(
-            (b.center - Vec3::new(0.0, 8.0, 0.0)).length() < 1e-5,
-            "{}",
-            b.center
-        );
-        assert!((b.radius - 6.0).abs() < 1e-5);
-        assert!(bake(&s, &DAffine3::from_scale(DVec3::new(1.0, 2.0, 3.0))).is_none());
-    }
 
     #[test]
     fn every_type_has_distinct_keys() {
