@@ -20,27 +20,26 @@ mod camera;
 mod lights;
 mod materials;
 mod settings;
+mod shapes;
 mod transforms;
+mod types;
 mod values;
 
 use bake::bake;
-use transforms::similarity_scale;
+use types::Ty;
 
 use super::format::{ObjectDef, SceneFile, Spanned, V3};
 use super::{SceneSettings, Source, suggest};
 use crate::geometry::bezier::{BezierPatch, teapot_patches, tessellate};
 use crate::geometry::polygon::Triangulator;
-use crate::geometry::{
-    AaBox, CappedCone, Cone, Csg, CsgOp, CsgTree, OBox, Plane, Polyhedron, Primitive, QuadUv,
-    Quadric, Shape, Sphere, Torus, Triangle,
-};
+use crate::geometry::{Csg, CsgOp, CsgTree, Primitive, QuadUv, Shape, Triangle};
 use crate::load::{LoadError, nff, obj};
 use crate::math::{Aabb, Vec3};
 use crate::scene::{
     Environment, Geometry, GeometryMark, Instance, Light, LoadStats, Material, Scene, Spot,
     Texture, range,
 };
-use glam::{DAffine3, DQuat, DVec3, Quat};
+use glam::{DAffine3, DVec3};
 use std::collections::HashMap;
 use std::ops::Range;
 use std::path::{Path, PathBuf};
@@ -49,99 +48,9 @@ use std::sync::Arc;
 
 type R<T> = Result<T, LoadError>;
 
-/// Deepest nesting of objects (groups, CSG, instances copied into defines).
-const MAX_NESTING: usize = 256;
 /// A bezier's default tessellation tolerance, relative to the diagonal of its control
 /// points' bounding box.
 const BEZIER_RELATIVE_TOLERANCE: f64 = 1e-3;
-
-/// The object types.
-#[derive(Clone, Copy, Debug, PartialEq, Eq)]
-enum Ty {
-    Sphere,
-    Cone,
-    Cylinder,
-    CappedCone,
-    Box,
-    OBox,
-    Polyhedron,
-    Quadric,
-    Plane,
-    Torus,
-    Triangle,
-    Polygon,
-    Mesh,
-    Bezier,
-    Include,
-    Group,
-    Instance,
-    Union,
-    Intersection,
-    Difference,
-}
-
-/// Each type's name and the keys it takes besides `type`, `material` and `transform`.
-const TYPES: &[(&str, Ty, &[&str])] = &[
-    ("sphere", Ty::Sphere, &["center", "radius"]),
-    (
-        "cone",
-        Ty::Cone,
-        &["base", "base_radius", "apex", "apex_radius"],
-    ),
-    (
-        "cylinder",
-        Ty::Cylinder,
-        &["base", "axis", "height", "radius"],
-    ),
-    (
-        "capped_cone",
-        Ty::CappedCone,
-        &["base", "axis", "height", "base_radius", "top_radius"],
-    ),
-    ("box", Ty::Box, &["min", "max"]),
-    (
-        "obox",
-        Ty::OBox,
-        &["center", "size", "half_size", "rotation", "axes"],
-    ),
-    (
-        "polyhedron",
-        Ty::Polyhedron,
-        &["planes", "preset", "center", "radius", "sides", "height"],
-    ),
-    ("quadric", Ty::Quadric, &["coefficients", "clip"]),
-    ("plane", Ty::Plane, &["point", "normal"]),
-    (
-        "torus",
-        Ty::Torus,
-        &["center", "axis", "major_radius", "minor_radius"],
-    ),
-    ("triangle", Ty::Triangle, &["vertices", "normals"]),
-    ("polygon", Ty::Polygon, &["vertices", "normals"]),
-    ("mesh", Ty::Mesh, &["vertices", "faces", "normals"]),
-    ("bezier", Ty::Bezier, &["patches", "builtin", "tolerance"]),
-    ("include", Ty::Include, &["file", "lights"]),
-    ("group", Ty::Group, &["children"]),
-    ("instance", Ty::Instance, &["of"]),
-    ("union", Ty::Union, &["children"]),
-    ("intersection", Ty::Intersection, &["children"]),
-    ("difference", Ty::Difference, &["children"]),
-];
-
-impl Ty {
-    fn name(self) -> &'static str {
-        TYPES.iter().find(|t| t.1 == self).map_or("?", |t| t.0)
-    }
-
-    fn csg_op(self) -> Option<CsgOp> {
-        match self {
-            Ty::Union => Some(CsgOp::Union),
-            Ty::Intersection => Some(CsgOp::Intersection),
-            Ty::Difference => Some(CsgOp::Difference),
-            _ => None,
-        }
-    }
-}
 
 /// Where primitives go: the scene's top level, or an object being compiled from a
 /// `define`.
@@ -312,28 +221,6 @@ fn f32v(v: DVec3) -> Vec3 {
     v.as_vec3()
 }
 
-/// A primitive constructor's message, prefixed with the object type unless it names
-/// the primitive already.
-fn from_constructor(ty: Ty, e: impl std::fmt::Display) -> String {
-    let e = e.to_string();
-    const NAMES: [&str; 9] = [
-        "box",
-        "oriented box",
-        "capped cone",
-        "cylinder",
-        "polyhedron",
-        "prism",
-        "quadric",
-        "plane",
-        "torus",
-    ];
-    if NAMES.iter().any(|n| e.starts_with(n)) {
-        e
-    } else {
-        format!("{}: {e}", ty.name())
-    }
-}
-
 /// "a sphere", "an include".
 fn article(name: &str) -> String {
     let vowel = name.starts_with(['a', 'e', 'i', 'o', 'u']);
@@ -363,57 +250,6 @@ impl<'a, 's> Builder<'a, 's> {
     }
 
     // ---- objects -----------------------------------------------------------------------
-
-    /// The node's type, after checking that it takes every key it has.
-    fn ty(&self, node: &Spanned<ObjectDef>, depth: usize) -> R<Ty> {
-        let o = node.get_ref();
-        if depth > MAX_NESTING {
-            return Err(self.err(
-                node.span(),
-                format!("objects nested deeper than {MAX_NESTING} levels"),
-            ));
-        }
-        let name = o.ty.get_ref().as_str();
-        let Some(&(_, ty, keys)) = TYPES.iter().find(|t| t.0 == name) else {
-            let all: Vec<&str> = TYPES.iter().map(|t| t.0).collect();
-            return Err(self.err(
-                o.ty.span(),
-                format!(
-                    "unknown object type `{name}`{}; types: {}",
-                    did_you_mean(name, all.iter().copied()),
-                    all.join(", ")
-                ),
-            ));
-        };
-        for (key, span) in o.keys() {
-            if key != "material" && key != "transform" && !keys.contains(&key) {
-                return Err(self.err(
-                    span,
-                    format!(
-                        "`{key}` does not apply to {} (its keys: {}material, transform)",
-                        article(name),
-                        keys.iter().map(|k| format!("{k}, ")).collect::<String>()
-                    ),
-                ));
-            }
-        }
-        Ok(ty)
-    }
-
-    fn need<'o, T>(
-        &self,
-        field: &'o Option<Spanned<T>>,
-        key: &str,
-        node: &Spanned<ObjectDef>,
-        ty: Ty,
-    ) -> R<&'o Spanned<T>> {
-        field.as_ref().ok_or_else(|| {
-            self.err(
-                node.span(),
-                format!("missing key `{key}` for {}", article(ty.name())),
-            )
-        })
-    }
 
     fn geometry<'g>(top: &'g mut Geometry, sink: &'g mut Sink<'_>) -> &'g mut Geometry {
         match sink {
@@ -498,9 +334,9 @@ impl<'a, 's> Builder<'a, 's> {
                 Ok(())
             }
             Ty::Instance => self.instance(node, inner, sink),
-            Ty::Union | Ty::Intersection | Ty::Difference => {
+            Ty::Csg(op) => {
                 let m = self.material_or_fallback(inherited, sink);
-                self.csg(node, ty, x, m, sink)
+                self.csg(node, op, x, m, sink)
             }
             Ty::Include => self.include(node, x, explicit, sink),
             Ty::Triangle | Ty::Polygon | Ty::Mesh => {
@@ -511,272 +347,11 @@ impl<'a, 's> Builder<'a, 's> {
                 let m = self.material_or_fallback(inherited, sink);
                 self.bezier(node, &x, m, sink)
             }
-            Ty::Sphere
-            | Ty::Cone
-            | Ty::Cylinder
-            | Ty::CappedCone
-            | Ty::Box
-            | Ty::OBox
-            | Ty::Polyhedron
-            | Ty::Quadric
-            | Ty::Plane
-            | Ty::Torus => {
+            Ty::Analytic(t) => {
                 let m = self.material_or_fallback(inherited, sink);
-                let shape = self.analytic(node, ty)?;
+                let shape = self.analytic(node, t)?;
                 self.place_shape(shape, &x, m, node.get_ref().ty.span(), sink)
             }
-        }
-    }
-
-    /// An analytic primitive in its own coordinates (before its transform).
-    fn analytic(&self, node: &Spanned<ObjectDef>, ty: Ty) -> R<Shape> {
-        let o = node.get_ref();
-        match ty {
-            Ty::Sphere => {
-                let c = v3(self.need(&o.center, "center", node, ty)?.get_ref());
-                let r =
-                    self.positive(self.need(&o.radius, "radius", node, ty)?, "sphere `radius`")?;
-                Ok(Shape::Sphere(Sphere::new(f32v(c), r as f32)))
-            }
-            Ty::Cone => {
-                let base = self.need(&o.base, "base", node, ty)?;
-                let rb = self.need(&o.base_radius, "base_radius", node, ty)?;
-                let apex = self.need(&o.apex, "apex", node, ty)?;
-                let rb_v = self.non_negative(rb, "cone `base_radius`")?;
-                let ra_v = match &o.apex_radius {
-                    Some(ra) => self.non_negative(ra, "cone `apex_radius`")?,
-                    None => 0.0,
-                };
-                if rb_v == 0.0 && ra_v == 0.0 {
-                    return Err(self.err(rb.span(), "cone radii must not both be zero"));
-                }
-                let (b, a) = (v3(base.get_ref()), v3(apex.get_ref()));
-                if f32v(b) == f32v(a) {
-                    return Err(self.err(apex.span(), "cone `apex` equals its `base`"));
-                }
-                Ok(Shape::Cone(Cone::new(
-                    f32v(b),
-                    rb_v as f32,
-                    f32v(a),
-                    ra_v as f32,
-                )))
-            }
-            Ty::Box => {
-                let min = self.need(&o.min, "min", node, ty)?;
-                let max = self.need(&o.max, "max", node, ty)?;
-                let b = AaBox::new(f32v(v3(min.get_ref())), f32v(v3(max.get_ref())))
-                    .map_err(|e| self.err(max.span(), from_constructor(ty, e)))?;
-                Ok(Shape::Box(b))
-            }
-            Ty::OBox => {
-                let center = f32v(v3(self.need(&o.center, "center", node, ty)?.get_ref()));
-                let half = match (&o.size, &o.half_size) {
-                    (Some(s), None) => self.positive3(s, "obox `size`")? * 0.5,
-                    (None, Some(h)) => self.positive3(h, "obox `half_size`")?,
-                    (Some(_), Some(h)) => {
-                        return Err(
-                            self.err(h.span(), "an obox takes `size` or `half_size`, not both")
-                        );
-                    }
-                    (None, None) => {
-                        return Err(self.err(
-                            node.span(),
-                            "missing key `size` (or `half_size`) for an obox",
-                        ));
-                    }
-                };
-                let b = match (&o.rotation, &o.axes) {
-                    (Some(r), None) => {
-                        let m = self.transform_list(r)?;
-                        let det = m.matrix3.determinant();
-                        if m.translation != DVec3::ZERO
-                            || !similarity_scale(&m).is_some_and(|s| (s - 1.0).abs() <= 1e-6)
-                            || det < 0.0
-                        {
-                            return Err(self.err(
-                                r.span(),
-                                "an obox `rotation` must be made of rotations only",
-                            ));
-                        }
-                        let q = DQuat::from_mat3(&m.matrix3).as_quat();
-                        OBox::new(center, half, q)
-                            .map_err(|e| self.err(r.span(), from_constructor(ty, e)))?
-                    }
-                    (None, Some(a)) => {
-                        let axes = a.get_ref().map(|v| f32v(v3(&v)));
-                        OBox::from_axes(center, half, axes)
-                            .map_err(|e| self.err(a.span(), from_constructor(ty, e)))?
-                    }
-                    (None, None) => OBox::new(center, half, Quat::IDENTITY)
-                        .map_err(|e| self.err(node.span(), from_constructor(ty, e)))?,
-                    (Some(_), Some(a)) => {
-                        return Err(
-                            self.err(a.span(), "an obox takes `rotation` or `axes`, not both")
-                        );
-                    }
-                };
-                Ok(Shape::OBox(Arc::new(b)))
-            }
-            Ty::Cylinder | Ty::CappedCone => {
-                let base = f32v(v3(self.need(&o.base, "base", node, ty)?.get_ref()));
-                let axis = f32v(self.direction(self.need(&o.axis, "axis", node, ty)?, "`axis`")?);
-                let height =
-                    self.positive(self.need(&o.height, "height", node, ty)?, "`height`")? as f32;
-                let c = if ty == Ty::Cylinder {
-                    let r = self.need(&o.radius, "radius", node, ty)?;
-                    let r = self.positive(r, "cylinder `radius`")? as f32;
-                    CappedCone::cylinder(base, axis, height, r)
-                } else {
-                    let rb = self.need(&o.base_radius, "base_radius", node, ty)?;
-                    let rt = self.need(&o.top_radius, "top_radius", node, ty)?;
-                    let (b, t) = (
-                        self.non_negative(rb, "`base_radius`")? as f32,
-                        self.non_negative(rt, "`top_radius`")? as f32,
-                    );
-                    if b == 0.0 && t == 0.0 {
-                        return Err(self.err(rt.span(), "capped cone radii must not both be zero"));
-                    }
-                    CappedCone::new(base, axis, height, b, t)
-                };
-                Ok(Shape::CappedCone(Arc::new(c.map_err(|e| {
-                    self.err(node.span(), from_constructor(ty, e))
-                })?)))
-            }
-            Ty::Polyhedron => {
-                let center = o
-                    .center
-                    .as_ref()
-                    .map_or(Vec3::ZERO, |c| f32v(v3(c.get_ref())));
-                let p = match (&o.planes, &o.preset, &o.sides) {
-                    (Some(planes), None, None) => {
-                        if let Some((k, span)) = [
-                            ("center", o.center.as_ref().map(|v| v.span())),
-                            ("radius", o.radius.as_ref().map(|v| v.span())),
-                            ("height", o.height.as_ref().map(|v| v.span())),
-                        ]
-                        .into_iter()
-                        .find_map(|(k, s)| s.map(|s| (k, s)))
-                        {
-                            return Err(self.err(span, format!("`{k}` is for a preset or a prism, not a polyhedron given by `planes`")));
-                        }
-                        let mut list = Vec::with_capacity(planes.get_ref().len());
-                        for p in planes.get_ref() {
-                            let [a, b, c, d] = p.get_ref().map(|x| x.0);
-                            let n = DVec3::new(a, b, c);
-                            if n == DVec3::ZERO {
-                                return Err(self.err(p.span(), "a plane's normal must not be zero"));
-                            }
-                            list.push((f32v(n), d as f32));
-                        }
-                        Polyhedron::new(list)
-                            .map_err(|e| self.err(planes.span(), from_constructor(ty, e)))?
-                    }
-                    (None, Some(name), None) => {
-                        if let Some(h) = &o.height {
-                            return Err(self
-                                .err(h.span(), "`height` is for a prism (`sides`), not a preset"));
-                        }
-                        let n = name.get_ref().as_str();
-                        if !Polyhedron::PRESETS
-                            .iter()
-                            .any(|p| p.eq_ignore_ascii_case(n))
-                        {
-                            return Err(self.err(
-                                name.span(),
-                                format!(
-                                    "unknown polyhedron preset `{n}`{}; presets: {}",
-                                    did_you_mean(n, Polyhedron::PRESETS.iter().copied()),
-                                    Polyhedron::PRESETS.join(", ")
-                                ),
-                            ));
-                        }
-                        let r = self.need(&o.radius, "radius", node, ty)?;
-                        let r = self.positive(r, "polyhedron `radius`")? as f32;
-                        Polyhedron::preset(n, center, r)
-                            .map_err(|e| self.err(node.span(), from_constructor(ty, e)))?
-                    }
-                    (None, None, Some(sides)) => {
-                        let r = self.need(&o.radius, "radius", node, ty)?;
-                        let r = self.positive(r, "prism `radius`")? as f32;
-                        let h = self.need(&o.height, "height", node, ty)?;
-                        let h = self.positive(h, "prism `height`")? as f32;
-                        Polyhedron::prism(center, *sides.get_ref(), r, h)
-                            .map_err(|e| self.err(sides.span(), from_constructor(ty, e)))?
-                    }
-                    (None, None, None) => {
-                        return Err(self.err(
-                            node.span(),
-                            "missing key `planes`, `preset` or `sides` for a polyhedron",
-                        ));
-                    }
-                    _ => {
-                        let second = [
-                            o.planes.as_ref().map(|v| v.span()),
-                            o.preset.as_ref().map(|v| v.span()),
-                            o.sides.as_ref().map(|v| v.span()),
-                        ]
-                        .into_iter()
-                        .flatten()
-                        .nth(1)
-                        .unwrap_or(node.span());
-                        return Err(self.err(
-                            second,
-                            "a polyhedron takes one of `planes`, `preset` or `sides`",
-                        ));
-                    }
-                };
-                Ok(Shape::Polyhedron(Arc::new(p)))
-            }
-            Ty::Quadric => {
-                let c = self.need(&o.coefficients, "coefficients", node, ty)?;
-                let coeffs = c.get_ref().map(|x| x.0);
-                let clip = match &o.clip {
-                    Some(b) => {
-                        let (lo, hi) =
-                            (v3(b.get_ref().min.get_ref()), v3(b.get_ref().max.get_ref()));
-                        if !lo.cmplt(hi).all() {
-                            return Err(self.err(
-                                b.span(),
-                                format!("the clip box's `min` {lo} must be below its `max` {hi} on every axis"),
-                            ));
-                        }
-                        Some(Aabb::from_points(f32v(lo), f32v(hi)))
-                    }
-                    None => None,
-                };
-                let q = Quadric::new(coeffs, clip)
-                    .map_err(|e| self.err(c.span(), from_constructor(ty, e)))?;
-                Ok(Shape::Quadric(Arc::new(q)))
-            }
-            Ty::Plane => {
-                let p = self.need(&o.point, "point", node, ty)?;
-                let n = self.need(&o.normal, "normal", node, ty)?;
-                let n = self.direction(n, "plane `normal`")?;
-                let plane = Plane::from_point_normal(f32v(v3(p.get_ref())), f32v(n))
-                    .map_err(|e| self.err(node.span(), from_constructor(ty, e)))?;
-                Ok(Shape::Plane(plane))
-            }
-            Ty::Torus => {
-                let c = self.need(&o.center, "center", node, ty)?;
-                let axis = self.direction(self.need(&o.axis, "axis", node, ty)?, "torus `axis`")?;
-                let major = self.positive(
-                    self.need(&o.major_radius, "major_radius", node, ty)?,
-                    "`major_radius`",
-                )?;
-                let minor = self.positive(
-                    self.need(&o.minor_radius, "minor_radius", node, ty)?,
-                    "`minor_radius`",
-                )?;
-                let t = Torus::new(
-                    f32v(v3(c.get_ref())),
-                    f32v(axis),
-                    major as f32,
-                    minor as f32,
-                )
-                .map_err(|e| self.err(node.span(), from_constructor(ty, e)))?;
-                Ok(Shape::Torus(Arc::new(t)))
-            }
-            _ => unreachable!("{ty:?} is not an analytic primitive"),
         }
     }
 
@@ -915,7 +490,7 @@ impl<'a, 's> Builder<'a, 's> {
     fn csg(
         &mut self,
         node: &'a Spanned<ObjectDef>,
-        ty: Ty,
+        op: CsgOp,
         x: DAffine3,
         material: u32,
         sink: &mut Sink,
@@ -925,8 +500,7 @@ impl<'a, 's> Builder<'a, 's> {
         // transform goes into the tree.
         let instanced = !sink.in_define() && x != DAffine3::IDENTITY;
         let rel = if instanced { DAffine3::IDENTITY } else { x };
-        let op = ty.csg_op().expect("a CSG type");
-        let tree = self.csg_operands(node, ty, op, rel, None, 0)?;
+        let tree = self.csg_operands(node, op, rel, None, 0)?;
         let csg = Csg::new(&tree).map_err(|e| self.err(span.clone(), e.to_string()))?;
         let shape = Shape::Csg(Arc::new(csg));
         if instanced {
@@ -941,32 +515,32 @@ impl<'a, 's> Builder<'a, 's> {
     fn csg_operands(
         &mut self,
         node: &'a Spanned<ObjectDef>,
-        ty: Ty,
         op: CsgOp,
         rel: DAffine3,
         material: Option<u32>,
         depth: usize,
     ) -> R<CsgTree> {
+        let ty = Ty::Csg(op);
         let children = self.need(&node.get_ref().children, "children", node, ty)?;
-        if children.get_ref().len() < 2 {
-            return Err(self.err(
-                children.span(),
-                format!(
-                    "{} needs at least 2 children, found {}",
-                    article(ty.name()),
-                    children.get_ref().len()
-                ),
-            ));
-        }
-        let mut acc: Option<CsgTree> = None;
-        for c in children.get_ref() {
+        let (first, rest) = match children.get_ref().split_first() {
+            Some((first, rest)) if !rest.is_empty() => (first, rest),
+            _ => {
+                return Err(self.err(
+                    children.span(),
+                    format!(
+                        "{} needs at least 2 children, found {}",
+                        article(ty.name()),
+                        children.get_ref().len()
+                    ),
+                ));
+            }
+        };
+        let mut acc = self.csg_operand(first, rel, material, depth + 1)?;
+        for c in rest {
             let t = self.csg_operand(c, rel, material, depth + 1)?;
-            acc = Some(match acc {
-                None => t,
-                Some(a) => CsgTree::op(op, a, t),
-            });
+            acc = CsgTree::op(op, acc, t);
         }
-        Ok(acc.expect("at least two children"))
+        Ok(acc)
     }
 
     /// One CSG operand. `rel` maps the parent's space to the CSG root's; `material` is
@@ -986,10 +560,7 @@ impl<'a, 's> Builder<'a, 's> {
             None => material,
         };
         match ty {
-            Ty::Union | Ty::Intersection | Ty::Difference => {
-                let op = ty.csg_op().expect("a CSG type");
-                self.csg_operands(node, ty, op, rel, material, depth)
-            }
+            Ty::Csg(op) => self.csg_operands(node, op, rel, material, depth),
             Ty::Instance => {
                 let of = self.need(&o.of, "of", node, ty)?;
                 let (name, def) = self.lookup_define(of)?;
@@ -998,17 +569,8 @@ impl<'a, 's> Builder<'a, 's> {
                 self.define_stack.pop();
                 t
             }
-            Ty::Sphere
-            | Ty::Cone
-            | Ty::Cylinder
-            | Ty::CappedCone
-            | Ty::Box
-            | Ty::OBox
-            | Ty::Polyhedron
-            | Ty::Quadric
-            | Ty::Plane
-            | Ty::Torus => {
-                let shape = self.analytic(node, ty)?;
+            Ty::Analytic(t) => {
+                let shape = self.analytic(node, t)?;
                 if !shape.is_solid() {
                     return Err(self.err(
                         o.ty.span(),
@@ -1474,24 +1036,5 @@ impl<'a, 's> Builder<'a, 's> {
             self.place_shape(entry.shape, &x, m, span.clone(), sink)?;
         }
         Ok(())
-    }
-}
-
-#[cfg(test)]
-mod tests {
-    use super::*;
-    use std::collections::BTreeSet;
-
-    #[test]
-    fn every_type_has_distinct_keys() {
-        for (name, _, keys) in TYPES {
-            let set: BTreeSet<_> = keys.iter().collect();
-            assert_eq!(set.len(), keys.len(), "{name}");
-            for k in *keys {
-                assert!(super::super::format::OBJECT_KEYS.contains(k), "{name}.{k}");
-            }
-        }
-        let names: BTreeSet<_> = TYPES.iter().map(|t| t.0).collect();
-        assert_eq!(names.len(), TYPES.len());
     }
 }
