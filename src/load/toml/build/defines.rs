@@ -6,7 +6,7 @@
 use super::super::format::{ObjectDef, Spanned};
 use super::objects::{Ctx, Sink};
 use super::types::Ty;
-use super::{Builder, DisplayPrefix, R, did_you_mean};
+use super::{Builder, DisplayPrefix, LOG_TARGET, R, did_you_mean};
 use crate::scene::{Geometry, Instance};
 
 impl<'a> Builder<'a, '_> {
@@ -92,6 +92,7 @@ impl<'a> Builder<'a, '_> {
         self.define_stack.pop();
         let o = if g.prim_count() == 0 {
             log::warn!(
+                target: LOG_TARGET,
                 "{}: define `{name}` holds no primitive; its instances are left out",
                 self.at(def.span()).display_prefix()
             );
@@ -113,6 +114,7 @@ impl<'a> Builder<'a, '_> {
         for (name, def) in defines {
             if !self.compiled.contains_key(name.as_str()) {
                 log::warn!(
+                    target: LOG_TARGET,
                     "{}: define `{name}` is never instanced",
                     self.at(def.span()).display_prefix()
                 );

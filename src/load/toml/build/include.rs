@@ -8,7 +8,7 @@
 use super::super::format::{ObjectDef, Spanned};
 use super::objects::Sink;
 use super::types::Ty;
-use super::{Builder, R, f32v};
+use super::{Builder, LOG_TARGET, R, f32v};
 use crate::geometry::{QuadUv, Triangle};
 use crate::load::{LoadError, nff, obj};
 use crate::math::Vec3;
@@ -153,7 +153,7 @@ impl Builder<'_, '_> {
         let from = self.included_from(file);
         let data = obj::load_geometry(path).map_err(|e| located(e, &from))?;
         for w in &data.warnings {
-            log::warn!("{w}{from}");
+            log::warn!(target: LOG_TARGET, "{w}{from}");
         }
         // The model's maps index its own textures: move them past the scene's.
         let base = self.textures.len() as u32;

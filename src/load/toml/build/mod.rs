@@ -47,6 +47,10 @@ use std::rc::Rc;
 
 type R<T> = Result<T, LoadError>;
 
+/// The target of the builder's warnings, one for all its files: the module's path,
+/// which the log lines show and `RUST_LOG` filters on.
+const LOG_TARGET: &str = module_path!();
+
 /// The scene being built, and what building it needs to remember.
 struct Builder<'a, 's> {
     file: &'a SceneFile,
@@ -181,6 +185,7 @@ impl<'a, 's> Builder<'a, 's> {
     fn warn_degenerate(&self) {
         if let Some(span) = &self.first_degenerate {
             log::warn!(
+                target: LOG_TARGET,
                 "{}: dropped {} degenerate polygon(s) (fewer than 3 distinct vertices or zero \
                  area), the first here",
                 self.at(span.clone()).display_prefix(),
