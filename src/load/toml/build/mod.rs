@@ -10,10 +10,15 @@
 //! - any other analytic primitive under a non-identity transform becomes, at the top
 //!   level, an object of its own placed by an instance; inside a `define` (which is
 //!   itself an object), a closed solid is wrapped in a one-leaf CSG with a
-//!   [`CsgTree::Transform`], and an open surface is an error;
+//!   [`CsgTree::Transform`](crate::geometry::CsgTree::Transform), and an open surface
+//!   is an error;
 //! - a `define` placed by a top-level `instance` is compiled once into an object that
 //!   every instance shares; an `instance` inside a `define` copies the other define's
 //!   content in place (following the same rules), which is where cycles are caught.
+//!
+//! This file holds the [`Builder`] and the order of the steps; each other file of the
+//! folder builds one part of the scene (its own notes say which), and `shapes/` has one
+//! file per analytic object type.
 
 mod bake;
 mod bezier;

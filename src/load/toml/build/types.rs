@@ -6,7 +6,7 @@
 //! cone, `union`, `intersection` and `difference` build the one CSG kind, a
 //! `polyhedron` may be a preset or a prism, and meshes, Bézier patches, includes,
 //! groups and instances are not primitives of their own. The analytic types come
-//! first, from [`ANALYTIC`](super::shapes::ANALYTIC).
+//! first, from [`ANALYTIC`].
 
 use super::super::format::{ObjectDef, Spanned};
 use super::shapes::{ANALYTIC, AnalyticType};
