@@ -132,7 +132,7 @@ impl<'a> Builder<'a, '_> {
             }
         };
         let color = match &d.color {
-            Some(c) => self.non_negative3(c, "`color`")?,
+            Some(c) => self.colour(c, "`color`")?,
             None => Vec3::ONE,
         };
         let kd = weight(&d.diffuse, "diffuse", 1.0)?;
@@ -155,7 +155,7 @@ impl<'a> Builder<'a, '_> {
             t,
             ior,
             filter: match &d.filter {
-                Some(f) => self.non_negative3(f, "`filter`")?,
+                Some(f) => self.colour(f, "`filter`")?,
                 None => Vec3::ONE,
             },
             priority: d.priority.as_ref().map_or(0, |p| *p.get_ref()),

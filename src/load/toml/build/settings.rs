@@ -24,13 +24,13 @@ impl Builder<'_, '_> {
         if let Some(r) = &self.file.render {
             let r = r.get_ref();
             if let Some(b) = &r.background {
-                background = self.non_negative3(b, "`background`")?;
+                background = self.colour(b, "`background`")?;
             }
             if let Some(e) = &r.environment {
                 self.environment = Some(self.environment_map(e)?);
             }
             if let Some(a) = &r.ambient {
-                ambient = self.non_negative3(a, "`ambient`")?;
+                ambient = self.colour(a, "`ambient`")?;
             }
             if let Some(d) = &r.max_depth {
                 settings.max_depth = Some(self.count_up_to(d, "max_depth", MAX_RAY_DEPTH)?);

@@ -3,7 +3,7 @@
 //! error is at the value's span and names it.
 
 use super::super::format::{Real, Spanned, V3};
-use super::{Builder, R, f32v, v3};
+use super::{Builder, DisplayPrefix, R, f32v, v3};
 use crate::math::Vec3;
 use glam::DVec3;
 
@@ -36,6 +36,26 @@ impl Builder<'_, '_> {
                 format!("{what} must not have negative components, found {x}"),
             ))
         }
+    }
+
+    /// A reflectance-like colour (a material's `color` or `filter`, the background, the
+    /// ambient light): not negative, and a warning when a channel is above 1, the sign
+    /// of colours written on a 0–255 scale.
+    pub(super) fn colour(&self, v: &Spanned<V3>, what: &str) -> R<Vec3> {
+        let c = self.non_negative3(v, what)?;
+        if c.max_element() > 1.0 {
+            log::warn!(
+                target: super::LOG_TARGET,
+                "{}: {what} {} has channels above 1; colours are linear, 1 is full \
+                 intensity (a colour on a 0-255 scale is divided by 255)",
+                self.at(v.span()).display_prefix(),
+                {
+                    let x = v3(v.get_ref());
+                    format!("[{}, {}, {}]", x.x, x.y, x.z)
+                }
+            );
+        }
+        Ok(c)
     }
 
     pub(super) fn positive3(&self, v: &Spanned<V3>, what: &str) -> R<Vec3> {
