@@ -1,9 +1,11 @@
 //! Transforms: the steps of a `transform` list (`translate`, `rotate`, `scale`,
-//! `matrix`) composed into one affine map, checked to be invertible in the single
+//! `mirror`, `matrix`) composed into one affine map, checked to be invertible in the single
 //! precision the renderer uses, and the test for a similarity (rotation, mirror and
 //! uniform scale), under which some primitives keep their kind.
 
-use super::super::format::{ObjectDef, Real, Scale, Spanned, TransformList, TransformStep};
+use super::super::format::{
+    MirrorDef, ObjectDef, Real, Scale, Spanned, TransformList, TransformStep,
+};
 use super::{Builder, R, v3};
 use crate::math::Xform;
 use glam::{Affine3A, DAffine3, DMat3, DVec3};
@@ -76,6 +78,9 @@ impl Builder<'_, '_> {
         if let Some(s) = &t.scale {
             return self.scale(s);
         }
+        if let Some(m) = &t.mirror {
+            return self.mirror(m.get_ref());
+        }
         match &t.matrix {
             Some(m) => self.matrix(m),
             None => unreachable!("one operation is present"),
@@ -89,6 +94,7 @@ impl Builder<'_, '_> {
             ("translate", t.translate.is_some()),
             ("rotate", t.rotate.is_some()),
             ("scale", t.scale.is_some()),
+            ("mirror", t.mirror.is_some()),
             ("matrix", t.matrix.is_some()),
         ]
         .into_iter()
@@ -106,9 +112,18 @@ impl Builder<'_, '_> {
             st.span(),
             format!(
                 "a transform step takes exactly one of `translate`, `rotate` (with \
-                 `angle`), `scale` or `matrix`; found {found}"
+                 `angle`), `scale`, `mirror` or `matrix`; found {found}"
             ),
         ))
+    }
+
+    /// A `mirror` step: the reflection `p ↦ p − 2((p − q)·n) n` about the plane through
+    /// `q` with unit normal `n`.
+    fn mirror(&self, m: &MirrorDef) -> R<DAffine3> {
+        let n = self.direction(&m.normal, "the mirror's normal")?;
+        let q = m.point.as_ref().map_or(DVec3::ZERO, |p| v3(p.get_ref()));
+        let linear = DMat3::IDENTITY - 2.0 * DMat3::from_cols(n * n.x, n * n.y, n * n.z);
+        Ok(DAffine3::from_mat3_translation(linear, 2.0 * q.dot(n) * n))
     }
 
     /// A `scale` step: one factor for all axes or one per axis, none zero.
