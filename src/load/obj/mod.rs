@@ -51,10 +51,12 @@
 //! # Materials
 //!
 //! Material libraries (`mtllib`) are read relative to the OBJ file's directory; several
-//! may be given, on one line or many. Materials are matched to `usemtl` by name after
-//! every library has been read (a later definition of a name wins). Problems with
-//! materials never stop the load; each becomes a warning naming the file, and the faces
-//! concerned get [`DEFAULT_MATERIAL`], a mid-grey diffuse:
+//! may be given, on one line or many (`mtllib a.mtl b.mtl` names one file when a file
+//! of that whole name exists, else one per word). The name of an `mtllib` or `usemtl`
+//! is the rest of the line after its first space, trimmed. Materials are matched to
+//! `usemtl` by name after every library has been read (a later definition of a name
+//! wins). Problems with materials never stop the load; each becomes a warning naming
+//! the file, and the faces concerned get [`DEFAULT_MATERIAL`], a mid-grey diffuse:
 //!
 //! - a library that cannot be read (its faces' materials are then missing);
 //! - a `usemtl` naming a material no library defines (one warning per name);
@@ -261,7 +263,9 @@ pub fn load_geometry(path: &Path) -> Result<ObjData, LoadError> {
     let t_parse = t0.elapsed();
 
     let libs = libs::read(path, &obj.mtllibs);
+    let t_libs = t0.elapsed();
     runs::check(&mut obj, &libs.names_read_at()).map_err(|e| e.at(path))?;
+    let t_checks = t0.elapsed();
     let mut warnings = libs.warnings;
     let mut materials = Materials::new(path, &libs.materials, &mut warnings);
     materials.load_maps(&libs.maps, &mut warnings);
@@ -278,13 +282,15 @@ pub fn load_geometry(path: &Path) -> Result<ObjData, LoadError> {
     let mut b = Builder::new(path);
     b.build(&obj, &slots, &mut materials)?;
     let t_build = t0.elapsed();
-    let ms = |a: Duration, b: Duration| (b.saturating_sub(a)).as_secs_f64() * 1e3;
+    let ms = |a: Duration, b: Duration| b.saturating_sub(a).as_secs_f64() * 1e3;
     log::info!(
-        "{}: read {:.0} ms, parse {:.0} ms, materials {:.0} ms, conversion {:.0} ms",
+        "{}: read {:.0} ms, parse {:.0} ms, index checks {:.0} ms, materials {:.0} ms, \
+         conversion {:.0} ms",
         path.display(),
         ms(Duration::ZERO, t_read),
         ms(t_read, t_parse),
-        ms(t_parse, t_materials),
+        ms(t_libs, t_checks),
+        ms(t_parse, t_libs) + ms(t_checks, t_materials),
         ms(t_materials, t_build)
     );
     warnings.extend(summary_warnings(path, &b, obj.lines));
