@@ -112,17 +112,17 @@ fn check_value(kind: Element, name: &str, v: f32, tok: &str) -> Option<String> {
         });
     }
     if kind == Element::Vertex {
-        return out_of_range(&format!("vertex {name}"), v);
+        return out_of_range(|| format!("vertex {name}"), v);
     }
     None
 }
 
-/// The message for a coordinate beyond emray's range, if `v` is.
-fn out_of_range(what: &str, v: f32) -> Option<String> {
+/// The message for a coordinate beyond emray's range, if `v` is; `what` names it.
+fn out_of_range(what: impl FnOnce() -> String, v: f32) -> Option<String> {
     if v.abs() <= range::MAX_COORDINATE {
         return None;
     }
-    range::check_coordinate(what, v)
+    range::check_coordinate(&what(), v)
         .err()
         .map(|e| e.to_string())
 }
@@ -172,7 +172,7 @@ fn weight_problem(xyz: [f32; 3], w: f32, w_tok: &str) -> Option<String> {
     }
     xyz.iter()
         .zip(XYZ)
-        .find_map(|(c, name)| out_of_range(&format!("vertex {name} / w ="), c / w))
+        .find_map(|(c, name)| out_of_range(|| format!("vertex {name} / w ="), c / w))
 }
 
 /// How many of the colour components `r g b` are numbers, up to the first that is not.
