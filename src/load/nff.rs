@@ -9,7 +9,10 @@
 //! Entities: `v` (viewpoint: `from`, `at`, `up`, `angle`, `hither`, `resolution` in
 //! that order), `b` (background), `l x y z [r g b]` (point light), `f` (material),
 //! `c` (open cone/cylinder), `s` (sphere), `p` (polygon), `pp` (polygon with vertex
-//! normals). Everything is validated here, so the renderer can trust the scene: every
+//! normals). Points (`from`, `at`, light positions, sphere centres, cone ends, polygon
+//! vertices) are read in double precision and moved into the scene's frame, whose
+//! origin is the eye (see [`Scene::origin`]), before they become single precision.
+//! Everything is validated here, so the renderer can trust the scene: every
 //! number is finite, sizes are positive where they must be, the resolution is sane, and
 //! degenerate polygons are dropped with one warning per file and counted in
 //! [`LoadStats::degenerate_dropped`](crate::scene::LoadStats).
@@ -17,7 +20,7 @@
 use super::LoadError;
 use crate::geometry::polygon::Triangulator;
 use crate::geometry::{Cone, Sphere, Triangle};
-use crate::math::Vec3;
+use crate::math::{Aabb, DVec3, Vec3};
 use crate::scene::{Camera, Light, Material, Scene, default_light_intensity, range};
 use std::path::Path;
 
@@ -49,9 +52,19 @@ pub fn load(path: &Path) -> Result<Scene, LoadError> {
 /// offending token (1-based; a column counts characters), or `path: no viewpoint ('v')
 /// in file` when there is no `v`.
 pub fn parse_str(src: &str, path: &Path) -> Result<Scene, LoadError> {
+    parse_str_at(src, path, eye_of(src).unwrap_or(DVec3::ZERO))
+}
+
+/// [`parse_str`] in the frame whose origin is the world point `origin`: every point of
+/// the file, `p`, becomes `p − origin` (computed in double precision) in the scene.
+///
+/// # Errors
+/// As [`parse_str`].
+pub fn parse_str_at(src: &str, path: &Path, origin: DVec3) -> Result<Scene, LoadError> {
     let mut p = Parser {
         lex: Lexer::new(src),
         path,
+        origin,
         camera: None,
         background: Vec3::ZERO,
         lights: Vec::new(),
@@ -67,6 +80,26 @@ pub fn parse_str(src: &str, path: &Path) -> Result<Scene, LoadError> {
     };
     p.run()?;
     p.finish()
+}
+
+/// The eye (`from`) of the file's first viewpoint, found by a quick scan of the tokens
+/// (`None` when there is none or it does not read: the parse then says why).
+fn eye_of(src: &str) -> Option<DVec3> {
+    let mut lex = Lexer::new(src);
+    while lex.next()?.text != "v" {}
+    if lex.next()?.text != "from" {
+        return None;
+    }
+    let mut xyz = [0.0; 3];
+    for c in &mut xyz {
+        *c = lex
+            .next()?
+            .text
+            .parse::<f64>()
+            .ok()
+            .filter(|v| v.is_finite())?;
+    }
+    Some(DVec3::from(xyz))
 }
 
 /// Stands in until the `v` is read (the scene is built while parsing, and `v` may come
@@ -216,6 +249,8 @@ const RGB: [&str; 3] = ["red", "green", "blue"];
 struct Parser<'a, 'p> {
     lex: Lexer<'a>,
     path: &'p Path,
+    /// The world point that is the scene's zero ([`Scene::origin`]).
+    origin: DVec3,
     camera: Option<Camera>,
     background: Vec3,
     lights: Vec<Light>,
@@ -281,6 +316,47 @@ impl<'a> Parser<'a, '_> {
             )),
             Err(_) => Err(self.err(&t, format!("expected {}, found {}", what(), show(t.text)))),
         }
+    }
+
+    /// The next token as an `f64` that is also finite as an `f32` (so that the file's
+    /// numbers are refused alike whether they are points or not).
+    #[inline]
+    fn num64_with(&mut self, what: &dyn Fn() -> String) -> Result<f64, LoadError> {
+        let t = self.token(what)?;
+        match t.text.parse::<f64>() {
+            Ok(v) if v.is_finite() && (v as f32).is_finite() => Ok(v),
+            Ok(_) => Err(self.err(
+                &t,
+                format!(
+                    "expected {}, found {} (not a finite number)",
+                    what(),
+                    show(t.text)
+                ),
+            )),
+            Err(_) => Err(self.err(&t, format!("expected {}, found {}", what(), show(t.text)))),
+        }
+    }
+
+    /// A point: three numbers read in double precision, checked against the traceable
+    /// range in world coordinates, and returned in the scene's frame, with the first
+    /// number's token.
+    fn point(&mut self, what: &str) -> Result<(Vec3, Tok<'a>), LoadError> {
+        let tok = self.lex.peek();
+        let mut p = [0.0; 3];
+        for (c, name) in p.iter_mut().zip(XYZ) {
+            *c = self.num64_with(&|| format!("{what} {name}"))?;
+        }
+        let world = DVec3::from(p);
+        let tok = tok.expect("a number was read");
+        self.in_range(&tok, range::check_point(what, world.as_vec3()))?;
+        Ok(((world - self.origin).as_vec3(), tok))
+    }
+
+    /// `bounds`, in the scene's frame, in world coordinates (for the range checks).
+    fn world_bounds(&self, bounds: &Aabb) -> Aabb {
+        let o = self.origin;
+        let w = |p: Vec3| (p.as_dvec3() + o).as_vec3();
+        Aabb::from_points(w(bounds.min), w(bounds.max))
     }
 
     #[inline]
@@ -376,11 +452,9 @@ impl<'a> Parser<'a, '_> {
             );
         }
         self.keyword("from")?;
-        let (from, from_tok) = self.vec3("the viewpoint 'from'", XYZ)?;
-        self.in_range(&from_tok, range::check_point("the viewpoint 'from'", from))?;
+        let (from, _) = self.point("the viewpoint 'from'")?;
         self.keyword("at")?;
-        let (at, at_tok) = self.vec3("the viewpoint 'at'", XYZ)?;
-        self.in_range(&at_tok, range::check_point("the viewpoint 'at'", at))?;
+        let (at, at_tok) = self.point("the viewpoint 'at'")?;
         self.keyword("up")?;
         let (up, up_tok) = self.vec3("the viewpoint 'up'", XYZ)?;
         self.keyword("angle")?;
@@ -455,8 +529,7 @@ impl<'a> Parser<'a, '_> {
     }
 
     fn light(&mut self) -> Result<(), LoadError> {
-        let (pos, pos_tok) = self.vec3("the light position", XYZ)?;
-        self.in_range(&pos_tok, range::check_point("the light position", pos))?;
+        let (pos, _) = self.point("the light position")?;
         let has_color = self.lex.peek().is_some_and(|t| looks_numeric(t.text));
         let color = if has_color {
             self.vec3("the light colour", RGB)?.0
@@ -532,22 +605,23 @@ impl<'a> Parser<'a, '_> {
     }
 
     fn sphere(&mut self) -> Result<(), LoadError> {
-        let (center, _) = self.vec3("the sphere centre", XYZ)?;
+        let (center, _) = self.point("the sphere centre")?;
         let (r, r_tok) = self.num("the sphere radius")?;
         if r == 0.0 {
             return Err(self.err(&r_tok, "sphere radius must not be zero".into()));
         }
         let sphere = Sphere::new(center, r);
-        self.in_range(&r_tok, range::check_bounds("the sphere", &sphere.bounds()))?;
+        let bounds = self.world_bounds(&sphere.bounds());
+        self.in_range(&r_tok, range::check_bounds("the sphere", &bounds))?;
         let m = self.material_index();
         self.scene.geometry.push(sphere, m);
         Ok(())
     }
 
     fn cone(&mut self) -> Result<(), LoadError> {
-        let (base, _) = self.vec3("the cone base", XYZ)?;
+        let (base, _) = self.point("the cone base")?;
         let (rb, _) = self.num("the cone base radius")?;
-        let (apex, apex_tok) = self.vec3("the cone apex", XYZ)?;
+        let (apex, apex_tok) = self.point("the cone apex")?;
         let (ra, ra_tok) = self.num("the cone apex radius")?;
         if rb == 0.0 && ra == 0.0 {
             return Err(self.err(&ra_tok, "cone radii must not both be zero".into()));
@@ -566,7 +640,8 @@ impl<'a> Parser<'a, '_> {
             return Err(self.err(&apex_tok, "cone apex equals its base".into()));
         }
         let cone = Cone::new(base, rb, apex, ra);
-        self.in_range(&ra_tok, range::check_bounds("the cone", &cone.bounds()))?;
+        let bounds = self.world_bounds(&cone.bounds());
+        self.in_range(&ra_tok, range::check_bounds("the cone", &bounds))?;
         let m = self.material_index();
         self.scene.geometry.push(cone, m);
         Ok(())
@@ -605,8 +680,7 @@ impl<'a> Parser<'a, '_> {
         self.pts.clear();
         self.nrm.clear();
         for _ in 0..n {
-            let (p, p_tok) = self.vec3("the polygon vertex", XYZ)?;
-            self.in_range(&p_tok, range::check_point("the polygon vertex", p))?;
+            let (p, _) = self.point("the polygon vertex")?;
             self.pts.push(p);
             if with_normals {
                 let (nv, n_tok) = self.vec3("the vertex normal", XYZ)?;
@@ -690,6 +764,7 @@ impl<'a> Parser<'a, '_> {
         scene.lights = self.lights;
         scene.ambient = Vec3::splat(default);
         scene.materials = self.materials;
+        scene.origin = self.origin;
         Ok(scene)
     }
 }

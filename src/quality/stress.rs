@@ -4,7 +4,7 @@
 use crate::accel::Accel;
 use crate::accel::Backend;
 use crate::geometry::reference as r64;
-use crate::load::nff::parse_str;
+use crate::load::nff::{parse_str, parse_str_at};
 use crate::math::{DRay, DVec3, Ray, Rng, Vec3, next_float_down, offset_ray_origin};
 use crate::render::{Film, RayGen, RenderSettings};
 use crate::run::render_scene;
@@ -188,8 +188,13 @@ pub fn tessellated_sphere(n: u32, center: Vec3) -> Watertight {
             targets.push((p, (p - center).normalize(), 0.5));
         }
     }
-    let scene = parse_str(&mesh_source(&tris, center), Path::new("<stress>"))
-        .expect("generated mesh parses");
+    // In the world's frame: the targets are world points.
+    let scene = parse_str_at(
+        &mesh_source(&tris, center),
+        Path::new("<stress>"),
+        DVec3::ZERO,
+    )
+    .expect("generated mesh parses");
     Watertight {
         scene,
         targets,
@@ -231,8 +236,13 @@ pub fn bipyramid(n: u32, center: Vec3) -> Watertight {
             targets.push((bottom + (a - bottom) * f, down, 0.5));
         }
     }
-    let scene = parse_str(&mesh_source(&tris, center), Path::new("<stress>"))
-        .expect("generated mesh parses");
+    // In the world's frame: the targets are world points.
+    let scene = parse_str_at(
+        &mesh_source(&tris, center),
+        Path::new("<stress>"),
+        DVec3::ZERO,
+    )
+    .expect("generated mesh parses");
     Watertight {
         scene,
         targets,

@@ -2,7 +2,7 @@
 //! loaders in [`crate::load`] build it and the backends in [`crate::accel`] read it.
 
 use crate::geometry::{Kind, Param, SurfacePoint};
-use crate::math::{Ray, Vec3, Xform};
+use crate::math::{DVec3, Ray, Vec3, Xform};
 use glam::Vec2;
 
 mod hit;
@@ -209,6 +209,13 @@ pub struct Scene {
     pub textures: Vec<Texture>,
     /// Environment map for rays that leave the scene (replaces `background`).
     pub environment: Option<Environment>,
+    /// Where the scene's zero lies in the world its file describes. The loaders read
+    /// coordinates in double precision and translate the whole scene (geometry, lights,
+    /// camera, instance transforms) by this one origin, the camera's eye, before they
+    /// become single precision: the picture then keeps its detail however far from the
+    /// world's origin the scene is. Everything in the scene is in this frame; add the
+    /// origin back for world coordinates ([`Scene::to_world`]).
+    pub origin: DVec3,
 }
 
 /// Render settings a scene file may carry; `None` leaves the renderer's default.
@@ -257,7 +264,14 @@ impl Scene {
             load_stats: LoadStats::default(),
             textures: Vec::new(),
             environment: None,
+            origin: DVec3::ZERO,
         }
+    }
+
+    /// The world point of `p`, a point of the scene's frame (see [`Scene::origin`]).
+    #[inline]
+    pub fn to_world(&self, p: Vec3) -> DVec3 {
+        p.as_dvec3() + self.origin
     }
 
     /// Number of primitives of `kind` a ray can meet: the top level's and each
@@ -345,7 +359,8 @@ impl Scene {
 
     fn apply_maps(&self, m: &mut Material, prm: &Param, surf: &Surface) -> Vec3 {
         let maps = m.maps;
-        let p = surf.point.p;
+        // Solid textures are of the world point, wherever the frame's origin lies.
+        let p = self.to_world(surf.point.p).as_vec3();
         let [su, sv] = maps.uv_scale;
         let prm = &Param {
             uv: prm.uv * Vec2::new(su, sv),

@@ -169,7 +169,7 @@ pub use framing::{
 };
 
 use super::LoadError;
-use crate::math::{Aabb, Vec3};
+use crate::math::{Aabb, DVec3, Vec3};
 use crate::scene::{Environment, Geometry, LoadStats, Material, Scene, Texture};
 use build::Builder;
 use located::whole_file;
@@ -210,6 +210,18 @@ pub struct ObjData {
     pub warnings: Vec<String>,
     /// Faces read and degenerate faces dropped.
     pub stats: LoadStats,
+    /// The world point the triangles' coordinates are relative to (see [`Origin`]).
+    pub origin: DVec3,
+}
+
+/// Where the frame of a model's triangles lies: their coordinates are the world's
+/// minus this origin, computed in double precision from the file's numbers.
+#[derive(Clone, Copy, Debug, PartialEq)]
+pub enum Origin {
+    /// This world point (the world's own origin for a model placed by a transform).
+    At(DVec3),
+    /// The centre of the model's bounds: a model rendered alone.
+    Centre,
 }
 
 /// Read the OBJ file at `path` (and its material libraries) into a scene: the model,
@@ -219,7 +231,7 @@ pub struct ObjData {
 /// Whatever [`load_geometry`] reports, or `path: …` when the model has no
 /// non-degenerate face to frame.
 pub fn load(path: &Path) -> Result<Scene, LoadError> {
-    let data = load_geometry(path)?;
+    let data = load_geometry_at(path, Origin::Centre)?;
     for w in &data.warnings {
         log::warn!("{w}");
     }
@@ -244,6 +256,7 @@ pub fn load(path: &Path) -> Result<Scene, LoadError> {
     scene.environment = data.environment;
     scene.geometry = data.geometry;
     scene.load_stats = data.stats;
+    scene.origin = data.origin;
     Ok(scene)
 }
 
@@ -255,6 +268,14 @@ pub fn load(path: &Path) -> Result<Scene, LoadError> {
 /// are replaced, which leaves line numbers intact. Problems with material libraries are
 /// warnings, not errors.
 pub fn load_geometry(path: &Path) -> Result<ObjData, LoadError> {
+    load_geometry_at(path, Origin::At(DVec3::ZERO))
+}
+
+/// [`load_geometry`] with the triangles in the frame of `origin`.
+///
+/// # Errors
+/// As [`load_geometry`].
+pub fn load_geometry_at(path: &Path, origin: Origin) -> Result<ObjData, LoadError> {
     let t0 = Instant::now();
     let bytes = std::fs::read(path).map_err(|e| whole_file(path, format!("cannot read: {e}")))?;
     let text = String::from_utf8_lossy(&bytes);
@@ -265,6 +286,11 @@ pub fn load_geometry(path: &Path) -> Result<ObjData, LoadError> {
     let libs = libs::read(path, &obj.mtllibs);
     let t_libs = t0.elapsed();
     runs::check(&mut obj, &libs.names_read_at()).map_err(|e| e.at(path))?;
+    let origin = match origin {
+        Origin::At(p) => p,
+        Origin::Centre => obj.centre(),
+    };
+    obj.recentre(origin);
     let t_checks = t0.elapsed();
     let mut warnings = libs.warnings;
     let mut materials = Materials::new(path, &libs.materials, &mut warnings);
@@ -302,6 +328,7 @@ pub fn load_geometry(path: &Path) -> Result<ObjData, LoadError> {
         bounds: b.bounds,
         warnings,
         stats: b.stats,
+        origin,
     })
 }
 

@@ -46,6 +46,8 @@ impl Element {
 pub(super) struct Numbers {
     /// x y z (a vertex's divided by its weight), u v (and 0), or the normal's x y z.
     pub values: [f32; 3],
+    /// The same in double precision (a vertex's position in the world).
+    pub exact: [f64; 3],
     /// Components of a vertex colour `r g b` read, up to the first that is no number.
     pub colours: usize,
     /// The first problem with the statement's numbers.
@@ -59,6 +61,7 @@ pub(super) struct Numbers {
 pub(super) fn read(kind: Element, ln: usize, line: &str, toks: &[&str], n: usize) -> Numbers {
     let mut out = Numbers {
         values: [0.0; 3],
+        exact: [0.0; 3],
         colours: 0,
         bad: None,
         fatal: false,
@@ -72,9 +75,12 @@ pub(super) fn read(kind: Element, ln: usize, line: &str, toks: &[&str], n: usize
             out.bad.get_or_insert_with(|| err(None, message));
             return out;
         };
-        match tok.parse::<f32>() {
-            Ok(v) => {
+        // Read in double precision; f32 judges what is finite, as the renderer holds it.
+        match tok.parse::<f64>() {
+            Ok(x) => {
+                let v = x as f32;
                 out.values[k] = v;
+                out.exact[k] = x;
                 if out.bad.is_none() {
                     out.bad = check_value(kind, name, v, tok).map(|m| err(Some(tok), m));
                 }
@@ -129,7 +135,7 @@ fn out_of_range(what: impl FnOnce() -> String, v: f32) -> Option<String> {
 
 /// A vertex's weight `w`: the coordinates are divided by it.
 fn weight(out: &mut Numbers, w_tok: &str, err: &impl Fn(Option<&str>, String) -> Located) {
-    let w = match w_tok.parse::<f32>() {
+    let w64 = match w_tok.parse::<f64>() {
         Ok(w) => w,
         Err(_) => {
             out.fatal = true;
@@ -142,6 +148,7 @@ fn weight(out: &mut Numbers, w_tok: &str, err: &impl Fn(Option<&str>, String) ->
             return;
         }
     };
+    let w = w64 as f32;
     if w == 0.0 {
         out.fatal = true;
         out.bad
@@ -153,6 +160,9 @@ fn weight(out: &mut Numbers, w_tok: &str, err: &impl Fn(Option<&str>, String) ->
     }
     for c in &mut out.values {
         *c /= w;
+    }
+    for c in &mut out.exact {
+        *c /= w64;
     }
 }
 

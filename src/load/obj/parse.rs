@@ -11,7 +11,7 @@
 
 use super::located::{Located, article, comment_hint, name_after_space, show};
 use super::numbers::{self, Element};
-use glam::{Vec2, Vec3};
+use glam::{DVec3, Vec2, Vec3};
 
 /// Index of an element a corner does not name.
 pub(super) const NONE: usize = usize::MAX;
@@ -86,8 +86,11 @@ pub(super) struct Cut {
 /// Everything read from an OBJ file.
 #[derive(Debug, Default)]
 pub(super) struct Obj {
-    /// Vertex positions, divided by their weights.
+    /// Vertex positions, divided by their weights, in the frame of [`Obj::recentre`]
+    /// (until then the world's).
     pub positions: Vec<Vec3>,
+    /// Vertex positions in the world, in double precision.
+    pub world: Vec<DVec3>,
     pub texcoords: Vec<Vec2>,
     pub normals: Vec<Vec3>,
     pub corners: Vec<Corner>,
@@ -173,6 +176,30 @@ impl<'a> Words<'a> {
 ///
 /// # Errors
 /// The first problem, at its line and column (see the module documentation).
+impl Obj {
+    /// The centre of the box around the finite vertex positions (the origin 0 when
+    /// there is none): where a model alone is re-centred.
+    pub fn centre(&self) -> DVec3 {
+        let finite = self.world.iter().filter(|p| p.is_finite());
+        let (lo, hi) = finite.fold((DVec3::INFINITY, DVec3::NEG_INFINITY), |(lo, hi), p| {
+            (lo.min(*p), hi.max(*p))
+        });
+        if lo.cmple(hi).all() {
+            (lo + hi) * 0.5
+        } else {
+            DVec3::ZERO
+        }
+    }
+
+    /// Move the positions into the frame whose origin is the world point `origin`:
+    /// each becomes `world − origin`, computed in double precision.
+    pub fn recentre(&mut self, origin: DVec3) {
+        for (p, w) in self.positions.iter_mut().zip(&self.world) {
+            *p = (*w - origin).as_vec3();
+        }
+    }
+}
+
 pub(super) fn parse(text: &str) -> Result<Obj, Located> {
     let mut p = Parser::default();
     for (i, line) in text.lines().enumerate() {
@@ -249,6 +276,7 @@ impl Parser {
         self.note_colour(n == 6, ln, || err(Some(kw), String::new()));
         let read = self.numbers(Element::Vertex, ln, line, w);
         self.obj.positions.push(Vec3::from(read.values));
+        self.obj.world.push(DVec3::from(read.exact));
         self.obj.counts.v += 1;
         self.obj.counts.colours += read.colours;
         Ok(())

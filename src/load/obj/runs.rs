@@ -152,10 +152,10 @@ fn check_corner(c: &Corner, counts: &Counts) -> Result<(), OutOfBounds> {
 /// Whether every position and normal that faces use is in range.
 fn elements_in_range(obj: &Obj, normal0_used: bool) -> bool {
     let usable_position = |i: usize| {
-        obj.positions.get(i).is_some_and(|p| {
+        obj.world.get(i).is_some_and(|p| {
             p.to_array()
                 .iter()
-                .all(|c| c.abs() <= range::MAX_COORDINATE)
+                .all(|c| c.abs() <= range::MAX_COORDINATE as f64)
         })
     };
     let usable_normal = |i: usize| obj.normals.get(i).is_some_and(|n| n.is_finite());

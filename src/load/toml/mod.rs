@@ -66,7 +66,20 @@ pub fn parse_str_with_settings(
 ) -> Result<(Scene, SceneSettings), LoadError> {
     let source = Source::new(path, src);
     let file = parse_file_in(&source)?;
-    build::build(&file, &source)
+    build::build(&file, &source, None)
+}
+
+/// [`parse_str`] in the frame whose origin is the world point `origin` rather than the
+/// camera's eye (see [`Scene::origin`]): with [`glam::DVec3::ZERO`], the scene holds the
+/// file's own coordinates (rounded to single precision), which is what tests of the
+/// format compare with.
+///
+/// # Errors
+/// As [`parse_str`].
+pub fn parse_str_at(src: &str, path: &Path, origin: glam::DVec3) -> Result<Scene, LoadError> {
+    let source = Source::new(path, src);
+    let file = parse_file_in(&source)?;
+    build::build(&file, &source, Some(origin)).map(|(scene, _)| scene)
 }
 
 /// Read TOML text into the format structures only (no names resolved, nothing built):

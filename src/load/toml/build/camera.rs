@@ -23,7 +23,9 @@ struct View {
 }
 
 impl Builder<'_, '_> {
-    pub(super) fn camera(&self) -> R<Camera> {
+    /// The camera in the scene's frame, and the frame's origin: `origin`, or else the
+    /// eye.
+    pub(super) fn camera(&self, origin: Option<DVec3>) -> R<(Camera, DVec3)> {
         let cam = &self.file.camera;
         let c = cam.get_ref();
         let fov = match &c.fov {
@@ -44,15 +46,17 @@ impl Builder<'_, '_> {
         };
         self.check_up(&view)?;
         self.check_view_range(cam, &view)?;
-        Ok(Camera {
-            from: f32v(view.from),
-            at: f32v(view.at),
+        let origin = origin.unwrap_or(view.from);
+        let camera = Camera {
+            from: f32v(view.from - origin),
+            at: f32v(view.at - origin),
             up: f32v(view.up),
             angle_deg: fov as f32,
             hither: hither as f32,
             width,
             height,
-        })
+        };
+        Ok((camera, origin))
     }
 
     fn fov(&self, f: &Spanned<Real>) -> R<f64> {

@@ -6,10 +6,11 @@
 use super::super::format::{ObjectDef, Spanned};
 use super::bake::bake;
 use super::objects::Sink;
+use super::objects::split_translation;
 use super::types::Ty;
 use super::{Builder, R, article};
 use crate::geometry::{Csg, CsgOp, CsgTree, Primitive, Shape};
-use glam::DAffine3;
+use glam::{DAffine3, DMat3};
 use std::sync::Arc;
 
 impl<'a> Builder<'a, '_> {
@@ -24,7 +25,8 @@ impl<'a> Builder<'a, '_> {
         sink: &mut Sink,
     ) -> R<()> {
         let span = node.get_ref().ty.span();
-        let instanced = !sink.in_define() && x != DAffine3::IDENTITY;
+        // A translation (the scene's frame, `translate` steps) goes into the leaves.
+        let instanced = !sink.in_define() && x.matrix3 != DMat3::IDENTITY;
         let rel = if instanced { DAffine3::IDENTITY } else { x };
         let tree = self.csg_operands(node, op, rel, None, 0)?;
         let csg = Csg::new(&tree).map_err(|e| self.err(span.clone(), e.to_string()))?;
@@ -96,8 +98,9 @@ impl<'a> Builder<'a, '_> {
                 t
             }
             Ty::Analytic(t) => {
-                let shape = self.analytic(node, t)?;
-                self.csg_leaf(node, shape, rel, material)
+                let (at, rest) = split_translation(&rel);
+                let shape = self.analytic(node, t, at)?;
+                self.csg_leaf(node, shape, rest, material)
             }
             Ty::Group => Err(self.err(
                 o.ty.span(),

@@ -1,7 +1,10 @@
 //! `include`: an NFF or OBJ file read once (however often it is placed), its
 //! materials, textures and statistics joined to the scene's, and its content placed
 //! under the node's transform: triangles baked with their normals, texture coordinates
-//! and quads, analytic primitives by the placement rules, NFF lights on request. Errors
+//! and quads, analytic primitives by the placement rules, NFF lights on request. The
+//! file is read in double precision into a frame of its own (an NFF file's eye, an OBJ
+//! model's centre), and each placement maps that frame into the scene's in double
+//! precision, so that a model far from its own origin keeps its detail. Errors
 //! and warnings in the included file carry its own position and say where it was
 //! included from.
 
@@ -13,7 +16,7 @@ use crate::geometry::{QuadUv, Triangle};
 use crate::load::{LoadError, nff, obj};
 use crate::math::Vec3;
 use crate::scene::{Geometry, Light, LoadStats, Material, Spot};
-use glam::{DAffine3, DMat3};
+use glam::{DAffine3, DMat3, DVec3};
 use std::path::Path;
 use std::rc::Rc;
 
@@ -26,8 +29,10 @@ enum Format {
 
 /// A parsed included file, its materials already appended to the scene's.
 pub(super) struct Included {
-    /// Its primitives, material indices local to the file.
+    /// Its primitives, material indices local to the file, relative to `origin`.
     geometry: Geometry,
+    /// The point of the file's own coordinates that is the zero of `geometry`.
+    origin: DVec3,
     /// Its lights (NFF).
     lights: Vec<Light>,
     /// Where its materials start in the scene's list.
@@ -38,6 +43,7 @@ pub(super) struct Included {
 /// An included file as read, before it joins the scene.
 struct Read {
     geometry: Geometry,
+    origin: DVec3,
     materials: Vec<Material>,
     lights: Vec<Light>,
     stats: LoadStats,
@@ -57,6 +63,8 @@ impl Builder<'_, '_> {
         let o = node.get_ref();
         let file = self.need(&o.file, "file", node, Ty::Include)?;
         let inc = self.included(file)?;
+        // From the file's frame to its own coordinates, then where the node places them.
+        let x = x * DAffine3::from_translation(inc.origin);
         let mat = |m: u32| material.unwrap_or(inc.material_base + m);
         if let Some(l) = &o.lights {
             if *l.get_ref() {
@@ -139,6 +147,7 @@ impl Builder<'_, '_> {
         self.stats.degenerate_dropped += read.stats.degenerate_dropped;
         let inc = Rc::new(Included {
             geometry: read.geometry,
+            origin: read.origin,
             lights: read.lights,
             material_base,
             format: read.format,
@@ -151,7 +160,8 @@ impl Builder<'_, '_> {
     fn read_obj(&mut self, file: &Spanned<String>, path: &Path) -> R<Read> {
         std::fs::File::open(path).map_err(|e| self.unreadable(file, path, e))?;
         let from = self.included_from(file);
-        let data = obj::load_geometry(path).map_err(|e| located(e, &from))?;
+        let data =
+            obj::load_geometry_at(path, obj::Origin::Centre).map_err(|e| located(e, &from))?;
         for w in &data.warnings {
             log::warn!(target: LOG_TARGET, "{w}{from}");
         }
@@ -171,6 +181,7 @@ impl Builder<'_, '_> {
             .collect();
         Ok(Read {
             geometry: data.geometry,
+            origin: data.origin,
             materials,
             lights: Vec::new(),
             stats: data.stats,
@@ -186,6 +197,7 @@ impl Builder<'_, '_> {
             .map_err(|e| located(e, &from))?;
         Ok(Read {
             geometry: scene.geometry,
+            origin: scene.origin,
             materials: scene.materials,
             lights: scene.lights,
             stats: scene.load_stats,

@@ -45,7 +45,7 @@ impl Builder<'_, '_> {
             None
         };
         Ok(Light {
-            pos: f32v(pos),
+            pos: f32v(pos - self.origin),
             color: color * intensity,
             spot,
             attenuation,

@@ -83,17 +83,26 @@ struct Builder<'a, 's> {
     pts: Vec<Vec3>,
     nrm: Vec<Vec3>,
     tris: Vec<[usize; 3]>,
+    /// The world point that is the scene's zero: the camera's eye (see
+    /// [`Scene::origin`]).
+    origin: DVec3,
 }
 
-/// Build the scene described by `file`, read from `src`.
-pub(super) fn build(file: &SceneFile, src: &Source) -> R<(Scene, SceneSettings)> {
+/// Build the scene described by `file`, read from `src`, in the frame whose origin is
+/// the world point `origin` (by default the camera's eye; see [`Scene::origin`]).
+pub(super) fn build(
+    file: &SceneFile,
+    src: &Source,
+    origin: Option<DVec3>,
+) -> R<(Scene, SceneSettings)> {
     let mut b = Builder::new(file, src);
-    let camera = b.camera()?;
+    let (camera, origin) = b.camera(origin)?;
+    b.origin = origin;
     let (background, ambient, settings) = b.render()?;
     b.named_materials()?;
     b.file_lights()?;
     for obj in &file.objects {
-        b.walk(obj, Ctx::ROOT, &mut Sink::Top)?;
+        b.walk(obj, Ctx::frame(origin), &mut Sink::Top)?;
     }
     b.check_unused_defines()?;
     b.warn_degenerate();
@@ -110,6 +119,7 @@ pub(super) fn build(file: &SceneFile, src: &Source) -> R<(Scene, SceneSettings)>
         load_stats: b.stats,
         textures: b.textures,
         environment: b.environment,
+        origin,
     };
     Ok((scene, settings))
 }
@@ -169,6 +179,7 @@ impl<'a, 's> Builder<'a, 's> {
             pts: Vec::new(),
             nrm: Vec::new(),
             tris: Vec::new(),
+            origin: DVec3::ZERO,
         }
     }
 

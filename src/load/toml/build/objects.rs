@@ -5,12 +5,13 @@
 
 use super::super::format::{ObjectDef, Spanned};
 use super::bake::bake;
+use super::shapes::At;
 use super::types::Ty;
 use super::{Builder, R, article};
 use crate::geometry::{Csg, CsgTree, Primitive, Shape};
-use crate::math::{Aabb, Xform};
+use crate::math::{Aabb, Vec3, Xform};
 use crate::scene::{Geometry, GeometryMark, Instance, range};
-use glam::DAffine3;
+use glam::{DAffine3, DMat3, DVec3};
 use std::ops::Range;
 use std::sync::Arc;
 
@@ -39,11 +40,37 @@ pub(super) struct Ctx {
 }
 
 impl Ctx {
+    /// A define's root: its object's own space.
     pub(super) const ROOT: Ctx = Ctx {
         xform: DAffine3::IDENTITY,
         material: None,
         depth: 0,
     };
+
+    /// The scene's root: world coordinates moved into the frame whose origin is the
+    /// world point `origin` (see [`crate::scene::Scene::origin`]).
+    pub(super) fn frame(origin: DVec3) -> Ctx {
+        Ctx {
+            xform: DAffine3::from_translation(-origin),
+            ..Ctx::ROOT
+        }
+    }
+}
+
+/// `x` as a translation that a primitive can be built in place with (see [`At`]) and
+/// the rest: `(x's translation, identity)` when `x` is a translation, else
+/// `(nothing, x)`.
+pub(super) fn split_translation(x: &DAffine3) -> (At, DAffine3) {
+    if x.matrix3 == DMat3::IDENTITY {
+        (
+            At {
+                offset: x.translation,
+            },
+            DAffine3::IDENTITY,
+        )
+    } else {
+        (At::LOCAL, *x)
+    }
 }
 
 impl<'a> Builder<'a, '_> {
@@ -119,8 +146,9 @@ impl<'a> Builder<'a, '_> {
             }
             Ty::Analytic(t) => {
                 let m = self.material_or_fallback(inner.material, sink);
-                let shape = self.analytic(node, t)?;
-                self.place_shape(shape, &x, m, node.get_ref().ty.span(), sink)
+                let (at, rest) = split_translation(&x);
+                let shape = self.analytic(node, t, at)?;
+                self.place_shape(shape, &rest, m, node.get_ref().ty.span(), sink)
             }
         }
     }
@@ -145,8 +173,16 @@ impl<'a> Builder<'a, '_> {
         span: Range<usize>,
     ) -> R<()> {
         let what = format!("this {}", ty.name());
+        // The range is the world's: the frame's bounds moved back by its origin.
+        let o = self.origin;
         let check = |b: &Aabb| {
-            range::check_bounds(&what, b).map_err(|e| self.err(span.clone(), e.to_string()))
+            let world = |p: Vec3| (p.as_dvec3() + o).as_vec3();
+            let b = if b.is_finite() {
+                Aabb::from_points(world(b.min), world(b.max))
+            } else {
+                *b
+            };
+            range::check_bounds(&what, &b).map_err(|e| self.err(span.clone(), e.to_string()))
         };
         for b in self.geometry.bounds_since(mark) {
             check(&b)?;

@@ -2,8 +2,8 @@
 
 use super::super::super::format::{ObjectDef, Spanned};
 use super::super::types::Ty;
-use super::super::{Builder, R, f32v, v3};
-use super::{AnalyticType, from_constructor};
+use super::super::{Builder, R};
+use super::{AnalyticType, At, from_constructor};
 use crate::geometry::{AaBox, Shape};
 
 pub(super) const TYPE: AnalyticType = AnalyticType {
@@ -12,11 +12,11 @@ pub(super) const TYPE: AnalyticType = AnalyticType {
     build,
 };
 
-fn build(b: &Builder<'_, '_>, node: &Spanned<ObjectDef>, ty: Ty) -> R<Shape> {
+fn build(b: &Builder<'_, '_>, node: &Spanned<ObjectDef>, ty: Ty, at: At) -> R<Shape> {
     let o = node.get_ref();
     let min = b.need(&o.min, "min", node, ty)?;
     let max = b.need(&o.max, "max", node, ty)?;
-    let aabox = AaBox::new(f32v(v3(min.get_ref())), f32v(v3(max.get_ref())))
+    let aabox = AaBox::new(at.point(min.get_ref()), at.point(max.get_ref()))
         .map_err(|e| b.err(max.span(), from_constructor(ty, e)))?;
     Ok(Shape::Box(aabox))
 }

@@ -4,8 +4,8 @@
 
 use super::super::super::format::{ObjectDef, Spanned};
 use super::super::types::Ty;
-use super::super::{Builder, R, f32v, v3};
-use super::{AnalyticType, from_constructor};
+use super::super::{Builder, R, f32v};
+use super::{AnalyticType, At, from_constructor};
 use crate::geometry::{CappedCone, Shape, ShapeError};
 use crate::math::Vec3;
 use std::sync::Arc;
@@ -16,9 +16,9 @@ pub(super) const TYPE: AnalyticType = AnalyticType {
     build,
 };
 
-fn build(b: &Builder<'_, '_>, node: &Spanned<ObjectDef>, ty: Ty) -> R<Shape> {
+fn build(b: &Builder<'_, '_>, node: &Spanned<ObjectDef>, ty: Ty, at: At) -> R<Shape> {
     let o = node.get_ref();
-    let (base, axis, height) = frame(b, node, ty)?;
+    let (base, axis, height) = frame(b, node, ty, at)?;
     let rb = b.need(&o.base_radius, "base_radius", node, ty)?;
     let rt = b.need(&o.top_radius, "top_radius", node, ty)?;
     let (rb_v, rt_v) = (
@@ -36,9 +36,10 @@ pub(super) fn frame(
     b: &Builder<'_, '_>,
     node: &Spanned<ObjectDef>,
     ty: Ty,
+    at: At,
 ) -> R<(Vec3, Vec3, f32)> {
     let o = node.get_ref();
-    let base = f32v(v3(b.need(&o.base, "base", node, ty)?.get_ref()));
+    let base = at.point(b.need(&o.base, "base", node, ty)?.get_ref());
     let axis = f32v(b.direction(b.need(&o.axis, "axis", node, ty)?, "`axis`")?);
     let height = b.positive(b.need(&o.height, "height", node, ty)?, "`height`")? as f32;
     Ok((base, axis, height))

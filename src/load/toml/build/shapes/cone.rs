@@ -3,8 +3,8 @@
 
 use super::super::super::format::{ObjectDef, Spanned};
 use super::super::types::Ty;
-use super::super::{Builder, R, f32v, v3};
-use super::AnalyticType;
+use super::super::{Builder, R};
+use super::{AnalyticType, At};
 use crate::geometry::{Cone, Shape};
 
 pub(super) const TYPE: AnalyticType = AnalyticType {
@@ -13,7 +13,7 @@ pub(super) const TYPE: AnalyticType = AnalyticType {
     build,
 };
 
-fn build(b: &Builder<'_, '_>, node: &Spanned<ObjectDef>, ty: Ty) -> R<Shape> {
+fn build(b: &Builder<'_, '_>, node: &Spanned<ObjectDef>, ty: Ty, at: At) -> R<Shape> {
     let o = node.get_ref();
     let base = b.need(&o.base, "base", node, ty)?;
     let rb = b.need(&o.base_radius, "base_radius", node, ty)?;
@@ -26,14 +26,14 @@ fn build(b: &Builder<'_, '_>, node: &Spanned<ObjectDef>, ty: Ty) -> R<Shape> {
     if rb_v == 0.0 && ra_v == 0.0 {
         return Err(b.err(rb.span(), "cone radii must not both be zero"));
     }
-    let (base, apex_at) = (v3(base.get_ref()), v3(apex.get_ref()));
-    if f32v(base) == f32v(apex_at) {
+    let (base, apex_at) = (at.point(base.get_ref()), at.point(apex.get_ref()));
+    if base == apex_at {
         return Err(b.err(apex.span(), "cone `apex` equals its `base`"));
     }
     Ok(Shape::Cone(Cone::new(
-        f32v(base),
+        base,
         rb_v as f32,
-        f32v(apex_at),
+        apex_at,
         ra_v as f32,
     )))
 }

@@ -4,8 +4,8 @@
 use super::super::super::format::{ObjectDef, Spanned};
 use super::super::types::Ty;
 use super::super::{Builder, R};
-use super::AnalyticType;
 use super::capped_cone::{frame, shape};
+use super::{AnalyticType, At};
 use crate::geometry::{CappedCone, Shape};
 
 pub(super) const TYPE: AnalyticType = AnalyticType {
@@ -14,9 +14,9 @@ pub(super) const TYPE: AnalyticType = AnalyticType {
     build,
 };
 
-fn build(b: &Builder<'_, '_>, node: &Spanned<ObjectDef>, ty: Ty) -> R<Shape> {
+fn build(b: &Builder<'_, '_>, node: &Spanned<ObjectDef>, ty: Ty, at: At) -> R<Shape> {
     let o = node.get_ref();
-    let (base, axis, height) = frame(b, node, ty)?;
+    let (base, axis, height) = frame(b, node, ty, at)?;
     let r = b.need(&o.radius, "radius", node, ty)?;
     let r = b.positive(r, "cylinder `radius`")? as f32;
     shape(b, node, ty, CappedCone::cylinder(base, axis, height, r))

@@ -1,6 +1,7 @@
 //! The analytic primitives' object types, one file each: the type's name, the keys it
 //! takes, and its constructor, which checks those fields and builds the [`Shape`] in
-//! the object's own coordinates (its transform is applied where it is placed).
+//! the object's own coordinates moved by an [`At`] offset (the rest of its transform is
+//! applied where it is placed).
 
 mod aabox;
 mod capped_cone;
@@ -13,11 +14,36 @@ mod quadric;
 mod sphere;
 mod torus;
 
+use super::super::format::V3;
 use super::super::format::{ObjectDef, Spanned};
 use super::types::Ty;
-use super::{Builder, R};
+use super::{Builder, R, f32v, v3};
 use crate::geometry::Shape;
+use crate::math::Vec3;
+use glam::DVec3;
 use std::fmt;
+
+/// Where a primitive's points go: its keys' coordinates plus `offset`, added in double
+/// precision before they become single precision. A primitive placed by a translation
+/// alone (the scene's frame origin, and any `translate` steps) is built in place this
+/// way, so a primitive far from the world's origin keeps its precision.
+#[derive(Clone, Copy, Debug)]
+pub(super) struct At {
+    /// Added to every point.
+    pub(super) offset: DVec3,
+}
+
+impl At {
+    /// In the object's own coordinates.
+    pub(super) const LOCAL: At = At {
+        offset: DVec3::ZERO,
+    };
+
+    /// The point `v`, moved.
+    pub(super) fn point(&self, v: &V3) -> Vec3 {
+        f32v(v3(v) + self.offset)
+    }
+}
 
 /// An analytic primitive's object type.
 pub(super) struct AnalyticType {
@@ -26,7 +52,7 @@ pub(super) struct AnalyticType {
     /// The keys it takes besides `type`, `material` and `transform`.
     pub(super) keys: &'static [&'static str],
     /// Its constructor: the shape of an object table of this type, `ty`.
-    build: fn(&Builder<'_, '_>, &Spanned<ObjectDef>, Ty) -> R<Shape>,
+    build: fn(&Builder<'_, '_>, &Spanned<ObjectDef>, Ty, At) -> R<Shape>,
 }
 
 /// The analytic types, in the order the list of all types shows them.
@@ -59,9 +85,15 @@ impl fmt::Debug for AnalyticType {
 }
 
 impl Builder<'_, '_> {
-    /// An analytic primitive of type `t` in its own coordinates (before its transform).
-    pub(super) fn analytic(&self, node: &Spanned<ObjectDef>, t: &'static AnalyticType) -> R<Shape> {
-        (t.build)(self, node, Ty::Analytic(t))
+    /// An analytic primitive of type `t` in its own coordinates moved by `at` (before
+    /// the rest of its transform).
+    pub(super) fn analytic(
+        &self,
+        node: &Spanned<ObjectDef>,
+        t: &'static AnalyticType,
+        at: At,
+    ) -> R<Shape> {
+        (t.build)(self, node, Ty::Analytic(t), at)
     }
 }
 

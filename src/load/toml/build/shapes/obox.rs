@@ -5,7 +5,7 @@ use super::super::super::format::{ObjectDef, Spanned, TransformList};
 use super::super::transforms::similarity_scale;
 use super::super::types::Ty;
 use super::super::{Builder, R, f32v, v3};
-use super::{AnalyticType, from_constructor};
+use super::{AnalyticType, At, from_constructor};
 use crate::geometry::{OBox, Shape};
 use crate::math::Vec3;
 use glam::{DQuat, DVec3, Quat};
@@ -17,9 +17,9 @@ pub(super) const TYPE: AnalyticType = AnalyticType {
     build,
 };
 
-fn build(b: &Builder<'_, '_>, node: &Spanned<ObjectDef>, ty: Ty) -> R<Shape> {
+fn build(b: &Builder<'_, '_>, node: &Spanned<ObjectDef>, ty: Ty, at: At) -> R<Shape> {
     let o = node.get_ref();
-    let center = f32v(v3(b.need(&o.center, "center", node, ty)?.get_ref()));
+    let center = at.point(b.need(&o.center, "center", node, ty)?.get_ref());
     let half = half_size(b, node)?;
     let obox = match (&o.rotation, &o.axes) {
         (Some(r), None) => OBox::new(center, half, rotation(b, r)?)

@@ -4,8 +4,8 @@
 
 use super::super::super::format::{ObjectDef, Real, Spanned};
 use super::super::types::Ty;
-use super::super::{Builder, R, did_you_mean, f32v, v3};
-use super::{AnalyticType, from_constructor};
+use super::super::{Builder, R, did_you_mean, f32v};
+use super::{AnalyticType, At, from_constructor};
 use crate::geometry::{Polyhedron, Shape};
 use crate::math::Vec3;
 use glam::DVec3;
@@ -18,14 +18,14 @@ pub(super) const TYPE: AnalyticType = AnalyticType {
     build,
 };
 
-fn build(b: &Builder<'_, '_>, node: &Spanned<ObjectDef>, ty: Ty) -> R<Shape> {
+fn build(b: &Builder<'_, '_>, node: &Spanned<ObjectDef>, ty: Ty, at: At) -> R<Shape> {
     let o = node.get_ref();
     let center = o
         .center
         .as_ref()
-        .map_or(Vec3::ZERO, |c| f32v(v3(c.get_ref())));
+        .map_or(at.point(&[Real(0.0); 3]), |c| at.point(c.get_ref()));
     let p = match (&o.planes, &o.preset, &o.sides) {
-        (Some(planes), None, None) => from_planes(b, o, planes, ty)?,
+        (Some(planes), None, None) => from_planes(b, o, planes, ty, at)?,
         (None, Some(name), None) => preset(b, node, name, center, ty)?,
         (None, None, Some(sides)) => prism(b, node, sides, center, ty)?,
         (None, None, None) => {
@@ -64,6 +64,7 @@ fn from_planes(
     o: &ObjectDef,
     planes: &Spanned<Vec<Spanned<[Real; 4]>>>,
     ty: Ty,
+    at: At,
 ) -> R<Polyhedron> {
     if let Some((k, span)) = [
         ("center", o.center.as_ref().map(|v| v.span())),
@@ -85,7 +86,8 @@ fn from_planes(
         if n == DVec3::ZERO {
             return Err(b.err(p.span(), "a plane's normal must not be zero"));
         }
-        list.push((f32v(n), d as f32));
+        // n·(q + offset) ≤ d for the points q of the moved polyhedron.
+        list.push((f32v(n), (d - n.dot(at.offset)) as f32));
     }
     Polyhedron::new(list).map_err(|e| b.err(planes.span(), from_constructor(ty, e)))
 }

@@ -2,8 +2,8 @@
 
 use super::super::super::format::{ObjectDef, Spanned};
 use super::super::types::Ty;
-use super::super::{Builder, R, f32v, v3};
-use super::AnalyticType;
+use super::super::{Builder, R};
+use super::{AnalyticType, At};
 use crate::geometry::{Shape, Sphere};
 
 pub(super) const TYPE: AnalyticType = AnalyticType {
@@ -12,9 +12,9 @@ pub(super) const TYPE: AnalyticType = AnalyticType {
     build,
 };
 
-fn build(b: &Builder<'_, '_>, node: &Spanned<ObjectDef>, ty: Ty) -> R<Shape> {
+fn build(b: &Builder<'_, '_>, node: &Spanned<ObjectDef>, ty: Ty, at: At) -> R<Shape> {
     let o = node.get_ref();
-    let c = v3(b.need(&o.center, "center", node, ty)?.get_ref());
+    let c = at.point(b.need(&o.center, "center", node, ty)?.get_ref());
     let r = b.positive(b.need(&o.radius, "radius", node, ty)?, "sphere `radius`")?;
-    Ok(Shape::Sphere(Sphere::new(f32v(c), r as f32)))
+    Ok(Shape::Sphere(Sphere::new(c, r as f32)))
 }

@@ -3,8 +3,8 @@
 
 use super::super::super::format::{ObjectDef, Spanned};
 use super::super::types::Ty;
-use super::super::{Builder, R, f32v, v3};
-use super::{AnalyticType, from_constructor};
+use super::super::{Builder, R, f32v};
+use super::{AnalyticType, At, from_constructor};
 use crate::geometry::{Shape, Torus};
 use std::sync::Arc;
 
@@ -14,7 +14,7 @@ pub(super) const TYPE: AnalyticType = AnalyticType {
     build,
 };
 
-fn build(b: &Builder<'_, '_>, node: &Spanned<ObjectDef>, ty: Ty) -> R<Shape> {
+fn build(b: &Builder<'_, '_>, node: &Spanned<ObjectDef>, ty: Ty, at: At) -> R<Shape> {
     let o = node.get_ref();
     let c = b.need(&o.center, "center", node, ty)?;
     let axis = b.direction(b.need(&o.axis, "axis", node, ty)?, "torus `axis`")?;
@@ -27,7 +27,7 @@ fn build(b: &Builder<'_, '_>, node: &Spanned<ObjectDef>, ty: Ty) -> R<Shape> {
         "`minor_radius`",
     )?;
     let t = Torus::new(
-        f32v(v3(c.get_ref())),
+        at.point(c.get_ref()),
         f32v(axis),
         major as f32,
         minor as f32,
