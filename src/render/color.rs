@@ -160,7 +160,7 @@ mod tests {
     fn srgb8_is_the_formula() {
         let formula = |c: f32| code_of(srgb_encode(clamp01(c)));
         let steps = srgb8_steps();
-        let mut check = |c: f32| assert_eq!(srgb8(c), formula(c), "{c:e}");
+        let check = |c: f32| assert_eq!(srgb8(c), formula(c), "{c:e}");
         for &t in &steps.at {
             let b = t.to_bits();
             for d in 0..1000u32 {
