@@ -409,9 +409,13 @@ pub struct PeerSample {
     pub rep: usize,
     /// Tachyon's ray-tracing time, ms.
     pub trace_ms: f64,
+    /// emray's render time of the same file (pixel centres), ms.
+    #[serde(default)]
+    pub emray_ms: Option<f64>,
 }
 
-/// NFF files of the suite's scenes for Tachyon, in a private directory removed on drop.
+/// NFF files of the suite's scenes for Tachyon and emray's runs beside it (the angle set
+/// to Tachyon's, see [`peer`]), in a private directory removed on drop.
 struct PeerFiles {
     dir: std::path::PathBuf,
     files: std::collections::BTreeMap<String, (std::path::PathBuf, String)>,
@@ -433,6 +437,7 @@ impl PeerFiles {
                 None => continue,
             };
             let path = dir.join(format!("scene{k}.nff"));
+            let text = peer::with_angle(&text, peer::TACHYON_ANGLE_DEG);
             std::fs::write(&path, &text).map_err(|e| BenchError::io(&path, "write", e))?;
             let scene = load_scene(name)?;
             files.insert(name.clone(), (path, peer::differences(&scene)));
@@ -456,6 +461,8 @@ pub struct Measured {
     pub peers: Vec<PeerSample>,
     /// Scene → how Tachyon's picture differs.
     pub peer_notes: std::collections::BTreeMap<String, String>,
+    /// Scene → share of pixels Tachyon and emray frame alike ([`peer::framing`]).
+    pub peer_framing: std::collections::BTreeMap<String, f64>,
     /// Why there are no Tachyon runs, if there are none.
     pub peer_missing: String,
 }
@@ -522,22 +529,67 @@ pub fn run_suite(
                 };
                 let image = nff.with_extension("ppm");
                 let t = peer::run(nff, &image, cfg.width, cfg.height, threads)?;
+                let emray_ms = run_peer_emray(cfg, exe, nff, threads)?;
                 log(&format!(
-                    "rep {} {scene} tachyon {threads}t: {:.1} ms",
+                    "rep {} {scene} tachyon {threads}t: {:.1} ms (emray on its file {:.1} ms)",
                     rep + 1,
-                    t.trace_ms
+                    t.trace_ms,
+                    emray_ms
                 ));
+                if !m.peer_framing.contains_key(scene) {
+                    let framing = peer_framing(nff, &image, cfg)?;
+                    m.peer_framing.insert(scene.clone(), framing);
+                }
                 m.peer_notes.insert(scene.clone(), note.clone());
                 m.peers.push(PeerSample {
                     scene: scene.clone(),
                     threads,
                     rep,
                     trace_ms: t.trace_ms,
+                    emray_ms: Some(emray_ms),
                 });
             }
         }
     }
     Ok(m)
+}
+
+/// emray's render time of the peer's file `nff`: the renderer's default backend (Embree
+/// when built with it), one ray per pixel centre, as Tachyon casts them.
+fn run_peer_emray(cfg: &Config, exe: &Path, nff: &Path, threads: usize) -> Result<f64, BenchError> {
+    let backend = if cfg.backends.contains(&Backend::Embree) {
+        Backend::Embree
+    } else {
+        Backend::Bvh
+    };
+    let spec = RunSpec {
+        scene: nff.to_string_lossy().into_owned(),
+        backend: backend.name().to_string(),
+        threads,
+        width: cfg.width,
+        height: cfg.height,
+        spd: false,
+        mode: Mode::Render,
+        embree_quality: cfg.embree_quality,
+        packet_width: cfg.packet_width,
+        embree_fast: cfg.embree_fast,
+    };
+    Ok(run_in_child(exe, &spec)?.ms)
+}
+
+/// How alike Tachyon's picture `image` of `nff` and emray's frame the scene.
+fn peer_framing(nff: &Path, image: &Path, cfg: &Config) -> Result<f64, BenchError> {
+    let scene = load_scene(nff)?;
+    let bytes = std::fs::read(image).map_err(|e| BenchError::io(image, "read", e))?;
+    let (w, h, rgb) = peer::read_ppm(&bytes).ok_or_else(|| BenchError::Io {
+        path: image.to_path_buf(),
+        action: "read",
+        message: "not a binary 8-bit PPM".into(),
+    })?;
+    if (w, h) != (cfg.width, cfg.height) {
+        return Ok(0.0);
+    }
+    Ok(peer::framing(&scene, w, h, &rgb))
 }
 
 /// Where the report goes besides standard output.
@@ -575,7 +627,7 @@ pub fn bench(
     machine.load_after = load_average();
     let rows = report::rows(&m.samples);
     let summary = report::summary(&rows);
-    let peers = report::peer_rows(&m, &rows);
+    let peers = report::peer_rows(&m);
     let mut md = report::markdown(&machine, &rows, &summary, &peers, &m.peer_missing);
     if let Some(b) = base {
         md.push_str("\n## Against the baseline\n\n");

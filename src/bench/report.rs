@@ -175,7 +175,7 @@ fn is_default_size(scene: &str) -> bool {
 
 /// Tachyon's samples folded into rows (median), next to emray's Embree render time
 /// for the same scene and threads.
-pub fn peer_rows(m: &super::Measured, rows: &[Row]) -> Vec<PeerRow> {
+pub fn peer_rows(m: &super::Measured) -> Vec<PeerRow> {
     let mut out: Vec<PeerRow> = Vec::new();
     for p in &m.peers {
         if out
@@ -184,20 +184,20 @@ pub fn peer_rows(m: &super::Measured, rows: &[Row]) -> Vec<PeerRow> {
         {
             continue;
         }
-        let times: Vec<f64> = m
+        let same = |q: &&super::PeerSample| q.scene == p.scene && q.threads == p.threads;
+        let times: Vec<f64> = m.peers.iter().filter(same).map(|q| q.trace_ms).collect();
+        let emray: Vec<f64> = m
             .peers
             .iter()
-            .filter(|q| q.scene == p.scene && q.threads == p.threads)
-            .map(|q| q.trace_ms)
+            .filter(same)
+            .filter_map(|q| q.emray_ms)
             .collect();
         out.push(PeerRow {
             scene: p.scene.clone(),
             threads: p.threads,
             tachyon_ms: median(&times),
-            emray_ms: rows
-                .iter()
-                .find(|r| r.backend == "embree" && r.scene == p.scene && r.threads == p.threads)
-                .map(|r| r.render_ms),
+            emray_ms: (!emray.is_empty()).then(|| median(&emray)),
+            framing: m.peer_framing.get(&p.scene).copied(),
             note: m.peer_notes.get(&p.scene).cloned().unwrap_or_default(),
         });
     }
@@ -376,25 +376,35 @@ pub fn markdown(
     } else {
         let _ = writeln!(
             o,
-            "| scene | thr | tachyon ms | emray embree ms | tachyon ÷ emray | note |\n|---|---:|---:|---:|---:|---|"
+            "| scene | thr | tachyon ms | emray ms | emray ÷ tachyon | same view | note |\n|---|---:|---:|---:|---:|---:|---|"
         );
         for p in peers {
             let _ = writeln!(
                 o,
-                "| {} | {} | {:.1} | {} | {} | {} |",
+                "| {} | {} | {:.1} | {} | {} | {} | {} |",
                 p.scene,
                 p.threads,
                 p.tachyon_ms,
                 opt(p.emray_ms, 1),
-                opt(p.emray_ms.filter(|&e| e > 0.0).map(|e| p.tachyon_ms / e), 2),
+                opt(
+                    p.emray_ms
+                        .filter(|_| p.tachyon_ms > 0.0)
+                        .map(|e| e / p.tachyon_ms),
+                    2
+                ),
+                p.framing
+                    .map_or("–".to_string(), |f| format!("{:.1}%", f * 100.0)),
                 p.note
             );
         }
         let _ = writeln!(
             o,
-            "\nTachyon's ray-tracing time (its own report) against emray's render time on Embree. \
-             Tachyon traces one ray per pixel centre; in SPD mode emray traces the (W+1)×(H+1) \
-             pixel corners."
+            "\nThe same view for both: Tachyon ignores the NFF `angle` (its camera spans {:.2}°), \
+             so both render the scene's file with its `angle` set to that, at the same \
+             resolution and threads, one ray per pixel centre, depth 5. Tachyon's time is its \
+             own \"Ray Tracing Time\", emray's its render phase. \"same view\" is the share of \
+             pixels both see as background or both as scene.",
+            super::peer::TACHYON_ANGLE_DEG
         );
     }
     o
