@@ -3,6 +3,7 @@
 //! interleaved (every backend and thread count of a scene side by side in each
 //! repetition), with raw-casting runs for the renderer's overhead and Tachyon as a peer.
 
+pub mod cpu;
 pub mod peer;
 pub mod raw;
 pub mod report;
@@ -201,6 +202,12 @@ pub struct RunResult {
     pub peak_kib: Option<u64>,
     /// The backend's description (Embree version and ISA, BVH nodes).
     pub accel: String,
+    /// CPU time of the process's threads during the render (or the raw casting), ms.
+    #[serde(default)]
+    pub cpu_ms: Option<f64>,
+    /// Time the machine's processors were stolen during it (all processors), ms.
+    #[serde(default)]
+    pub steal_ms: Option<f64>,
 }
 
 fn backend_named(name: &str) -> Result<Backend, BenchError> {
@@ -211,6 +218,39 @@ fn backend_named(name: &str) -> Result<Backend, BenchError> {
     }
 }
 
+/// What a child measured of its render or raw casting.
+struct Measure {
+    build_ms: f64,
+    ms: f64,
+    counts: crate::render::RayCounts,
+    detail: String,
+    cpu_ms: Option<f64>,
+    steal_ms: Option<f64>,
+}
+
+/// The render, its CPU and stolen time measured around the render alone.
+struct RenderWork<'a> {
+    scene: &'a Scene,
+    settings: &'a RenderSettings,
+}
+
+impl WithAccel for RenderWork<'_> {
+    type Output = Measure;
+    fn run<A: crate::accel::Accel>(self, accel: &A, build_ms: f64) -> Measure {
+        let mark = cpu::Mark::now();
+        let (_, stats) = crate::render::render(self.scene, accel, self.settings, None);
+        let (cpu_ms, steal_ms) = mark.elapsed();
+        Measure {
+            build_ms,
+            ms: stats.render_ms,
+            counts: stats.rays,
+            detail: accel.stats().detail,
+            cpu_ms,
+            steal_ms,
+        }
+    }
+}
+
 /// The raw-casting work: record the render's queries, then cast them timed.
 struct RawWork<'a> {
     scene: &'a Scene,
@@ -218,11 +258,20 @@ struct RawWork<'a> {
 }
 
 impl WithAccel for RawWork<'_> {
-    type Output = (f64, raw::RawCast, crate::render::RayCounts, String);
-    fn run<A: crate::accel::Accel>(self, accel: &A, build_ms: f64) -> Self::Output {
+    type Output = Measure;
+    fn run<A: crate::accel::Accel>(self, accel: &A, build_ms: f64) -> Measure {
         let (queries, counts) = raw::record(self.scene, accel, self.settings);
+        let mark = cpu::Mark::now();
         let cast = raw::cast(accel, &queries);
-        (build_ms, cast, counts, accel.stats().detail)
+        let (cpu_ms, steal_ms) = mark.elapsed();
+        Measure {
+            build_ms,
+            ms: cast.ms,
+            counts,
+            detail: accel.stats().detail,
+            cpu_ms,
+            steal_ms,
+        }
     }
 }
 
@@ -263,42 +312,38 @@ pub fn run_child(spec: &RunSpec) -> Result<RunResult, BenchError> {
         embree_robust: !spec.embree_fast,
         packet_width: spec.packet_width,
     };
-    let (build_ms, ms, rays, accel) = pool.install(|| match spec.mode {
+    let (scene_ref, settings_ref) = (&scene, &settings);
+    let m = pool.install(|| match spec.mode {
         Mode::Render => {
-            let (_, rep) =
-                crate::run::render_scene(&spec.scene, &scene, options, &settings, load_ms, None)?;
-            let r = |k: &str| rep.rays.get(k).copied().unwrap_or(0);
-            let rays = Rays {
-                eye: r("eye"),
-                reflection: r("reflection"),
-                refraction: r("refraction"),
-                shadow: r("shadow"),
-                total: r("total"),
+            let work = RenderWork {
+                scene: scene_ref,
+                settings: settings_ref,
             };
-            Ok::<_, AccelError>((rep.time_ms.build, rep.time_ms.render, rays, rep.accel))
+            crate::accel::build(scene_ref, &options, work)
         }
         Mode::Raw => {
             let work = RawWork {
-                scene: &scene,
-                settings: &settings,
+                scene: scene_ref,
+                settings: settings_ref,
             };
-            let (build_ms, cast, counts, detail) = crate::accel::build(&scene, &options, work)?;
-            Ok((build_ms, cast.ms, Rays::from(counts), detail))
+            crate::accel::build(scene_ref, &options, work)
         }
     })?;
     let accel = match (backend, spec.packet_width) {
-        (Backend::Embree, 0) => format!("{accel}, eye rays one by one"),
-        (Backend::Embree, w) => format!("{accel}, eye rays in packets of {w}"),
-        _ => accel,
+        (Backend::Embree, 0) => format!("{}, eye rays one by one", m.detail),
+        (Backend::Embree, w) => format!("{}, eye rays in packets of {w}", m.detail),
+        _ => m.detail,
     };
     Ok(RunResult {
         prims: scene.prim_count_with_instances(),
         load_ms,
-        build_ms,
-        ms,
-        rays,
+        build_ms: m.build_ms,
+        ms: m.ms,
+        rays: Rays::from(m.counts),
         peak_kib: peak_rss_kib(),
         accel,
+        cpu_ms: m.cpu_ms,
+        steal_ms: m.steal_ms,
     })
 }
 

@@ -42,6 +42,12 @@ pub struct Row {
     pub reps: usize,
     /// The backend's description.
     pub accel: String,
+    /// Median CPU time of the process during the render, ms.
+    #[serde(default)]
+    pub cpu_ms: Option<f64>,
+    /// Median time stolen from the machine's processors during the render, ms.
+    #[serde(default)]
+    pub steal_ms: Option<f64>,
 }
 
 impl Row {
@@ -64,6 +70,12 @@ pub fn median(v: &[f64]) -> f64 {
     } else {
         (s[n / 2 - 1] + s[n / 2]) / 2.0
     }
+}
+
+/// The median of the values, `None` when there are none.
+fn median_of(v: impl Iterator<Item = f64>) -> Option<f64> {
+    let v: Vec<f64> = v.collect();
+    (!v.is_empty()).then(|| median(&v))
 }
 
 /// The geometric mean of positive values; `None` when there are none.
@@ -134,6 +146,8 @@ pub fn rows(samples: &[Sample]) -> Vec<Row> {
                 vs_embree: None,
                 reps: render.len(),
                 accel: first.map(|r| r.accel.clone()).unwrap_or_default(),
+                cpu_ms: median_of(render.iter().filter_map(|s| s.result.cpu_ms)),
+                steal_ms: median_of(render.iter().filter_map(|s| s.result.steal_ms)),
             }
         })
         .collect();
@@ -167,6 +181,63 @@ pub struct Summary {
     /// Per `"BACKEND, N thread(s)"`: exponent `k` in render time ∝ primitives^k
     /// between the smallest and largest balls of the suite.
     pub balls_exponent: BTreeMap<String, f64>,
+    /// The most threads against one, per backend and scene.
+    #[serde(default)]
+    pub scaling: Vec<Scaling>,
+}
+
+/// How a render on `threads` threads compares with one thread, in wall time and in
+/// CPU time: `speedup = threads × busy ÷ busy₁ ÷ work` (`busy₁` the one-thread run's,
+/// near 1), so a speed-up below the thread count comes from threads off the processors
+/// (`busy` below 1: emray waiting, or the machine not giving it the processors, which
+/// `steal` shows) or from more work (`work` above 1).
+#[derive(Clone, Debug, PartialEq, Serialize, Deserialize)]
+pub struct Scaling {
+    /// Backend.
+    pub backend: String,
+    /// Scene.
+    pub scene: String,
+    /// Threads compared with one.
+    pub threads: usize,
+    /// Render time on one thread ÷ on `threads`.
+    pub speedup: f64,
+    /// CPU time ÷ (threads × wall time) on `threads`: the share of the processors' time
+    /// the render's threads were running.
+    pub busy: Option<f64>,
+    /// CPU time on `threads` ÷ CPU time on one: how much more work the split made.
+    pub work: Option<f64>,
+    /// Stolen time ÷ (threads × wall time) on `threads`, over the whole machine.
+    pub steal: Option<f64>,
+}
+
+/// [`Scaling`] of every scene that ran on one thread and on `max_t` on `backend`.
+fn scaling(rows: &[Row], backend: &str, max_t: usize) -> Vec<Scaling> {
+    let mut out = Vec::new();
+    for one in rows
+        .iter()
+        .filter(|r| r.backend == backend && r.threads == 1)
+    {
+        let Some(many) = rows
+            .iter()
+            .find(|r| r.backend == backend && r.threads == max_t && r.scene == one.scene)
+        else {
+            continue;
+        };
+        if many.render_ms <= 0.0 {
+            continue;
+        }
+        let slots = max_t as f64 * many.render_ms;
+        out.push(Scaling {
+            backend: backend.to_string(),
+            scene: one.scene.clone(),
+            threads: max_t,
+            speedup: one.render_ms / many.render_ms,
+            busy: many.cpu_ms.map(|c| c / slots),
+            work: many.cpu_ms.zip(one.cpu_ms).map(|(m, o)| m / o.max(1e-9)),
+            steal: many.steal_ms.map(|s| s / slots),
+        });
+    }
+    out
 }
 
 fn is_default_size(scene: &str) -> bool {
@@ -233,6 +304,7 @@ pub fn summary(rows: &[Row]) -> Summary {
             s.overhead.insert(b.to_string(), g);
         }
         if max_t > 1 {
+            s.scaling.extend(scaling(rows, b, max_t));
             let mut worst: Option<(f64, String)> = None;
             for r in rows.iter().filter(of).filter(|r| r.threads == 1) {
                 let Some(m) = rows
@@ -362,6 +434,33 @@ pub fn markdown(
         let _ = writeln!(
             o,
             "- smallest speed-up of all threads over one on {b}: {k:.2}× ({scene}) (target ≥ 1.85)"
+        );
+    }
+    if !sum.scaling.is_empty() {
+        let _ = writeln!(
+            o,
+            "\n| scaling | backend | thr | speed-up | CPU busy | CPU work | steal |\n|---|---|---:|---:|---:|---:|---:|"
+        );
+        let pct = |v: Option<f64>| v.map_or("–".to_string(), |x| format!("{:.0}%", x * 100.0));
+        for k in &sum.scaling {
+            let _ = writeln!(
+                o,
+                "| {} | {} | {} | {:.2}× | {} | {} | {} |",
+                k.scene,
+                k.backend,
+                k.threads,
+                k.speedup,
+                pct(k.busy),
+                opt(k.work, 2),
+                pct(k.steal)
+            );
+        }
+        let _ = writeln!(
+            o,
+            "\nspeed-up ≈ threads × busy ÷ work: CPU busy is the share of the processors' time the \
+             render's threads ran, CPU work the CPU time against one thread's, steal the share \
+             the machine's processors were taken by the host. Busy below 100% with no steal is \
+             waiting emray causes; with steal, the machine's.\n"
         );
     }
     for (b, k) in &sum.balls_exponent {
@@ -542,6 +641,9 @@ mod tests {
                 },
                 peak_kib: Some(2048),
                 accel: backend.into(),
+                // Threads 90% busy, the host taking 5% of one processor.
+                cpu_ms: Some(ms * threads as f64 * 0.9),
+                steal_ms: Some(ms * 0.05),
             },
         }
     }
@@ -581,12 +683,26 @@ mod tests {
         let sum = summary(&r);
         assert_eq!(sum.bvh_vs_embree.get(&1), Some(&2.0));
         assert_eq!(sum.scaling_min["embree"], (2.0, "spd:balls".to_string()));
+        // Both runs 90% busy, the same CPU time: speed-up 2 = 2 threads x 0.9 / 0.9 / 1.
+        let k = &sum.scaling[0];
+        assert_eq!(
+            (k.backend.as_str(), k.scene.as_str(), k.threads),
+            ("embree", "spd:balls", 2)
+        );
+        assert!((k.speedup - 2.0).abs() < 1e-12);
+        assert!((k.busy.unwrap() - 0.9).abs() < 1e-12, "{k:?}");
+        assert!((k.work.unwrap() - 1.0).abs() < 1e-12, "{k:?}");
+        assert!((k.steal.unwrap() - 0.025).abs() < 1e-12, "{k:?}");
         // 10 -> 100 primitives, 1 ms -> 5.5 ms: exponent log10(5.5).
         let k = sum.balls_exponent["embree, 2 thread(s)"];
         assert!((k - 5.5f64.log10()).abs() < 1e-12, "{k}");
         let md = markdown(&Machine::default(), &r, &sum, &[], "tachyon not installed");
         assert!(md.contains("| spd:balls | 100 | bvh | 1 |"));
         assert!(md.contains("tachyon not installed"));
+        assert!(
+            md.contains("| spd:balls | embree | 2 | 2.00× | 90% | 1.00 | 2% |"),
+            "{md}"
+        );
         let c = csv(&r);
         assert_eq!(c.lines().count(), 5);
         assert!(c.lines().nth(2).unwrap().ends_with(",2.0000"));
