@@ -85,7 +85,11 @@ fn teapot_has_no_pinholes_on_either_backend() {
         settings.max_depth = d;
     }
     assert_eq!((settings.width, settings.height), (640, 480));
-    let render = |b| render_scene("teapot", &scene, b, &settings, 0.0, None).unwrap().0;
+    let render = |b| {
+        render_scene("teapot", &scene, b, &settings, 0.0, None)
+            .unwrap()
+            .0
+    };
     let same = invariance_of(&render(Backend::Bvh), &render(Backend::Embree));
     assert_eq!(same.within, 1.0, "largest difference {}", same.max_diff);
 }

@@ -2,6 +2,7 @@
 //! file extension, always written to a temporary file beside the target and renamed,
 //! so a failed or interrupted write never leaves a truncated image.
 
+pub mod colormap;
 pub mod part;
 
 // The PNG writer's encodings, defined with the colour curves in `render`.
