@@ -7,15 +7,21 @@
 pub mod area;
 mod camera;
 pub mod color;
+mod counts;
 mod film;
 pub mod gi;
+mod local;
+pub mod media;
+mod optics;
+pub mod record;
 pub mod reference;
+mod shade;
 mod whitted;
 
 pub use camera::RayGen;
+pub use counts::RayCounts;
 pub use film::Film;
 pub use gi::GlobalIllumination;
-pub use whitted::RayCounts;
 
 use crate::accel::Accel;
 use crate::scene::Scene;
