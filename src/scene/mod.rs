@@ -7,10 +7,12 @@ use glam::Vec2;
 
 mod hit;
 pub mod range;
+mod sources;
 mod store;
 pub mod texture;
 
 pub use hit::{Hit, NO_INSTANCE};
+pub use sources::{Origin, PrimSources, Sources};
 pub use store::{Geometry, GeometryMark, KindVisitor, Prims, ShapeEntry};
 
 pub use texture::{Environment, Maps, NO_TEXTURE, Texture};
@@ -209,6 +211,20 @@ pub struct Scene {
     pub textures: Vec<Texture>,
     /// Environment map for rays that leave the scene (replaces `background`).
     pub environment: Option<Environment>,
+    /// Where the materials, lights and instances were defined (the primitives' origins
+    /// are in each [`Geometry`]'s `sources`).
+    pub sources: SceneSources,
+}
+
+/// Where the items of a scene's lists were defined, as far as the loader recorded it.
+#[derive(Clone, Debug, Default, PartialEq, Eq)]
+pub struct SceneSources {
+    /// Per material index.
+    pub materials: Sources,
+    /// Per point light.
+    pub lights: Sources,
+    /// Per instance.
+    pub instances: Sources,
 }
 
 /// Render settings a scene file may carry; `None` leaves the renderer's default.
@@ -257,6 +273,7 @@ impl Scene {
             load_stats: LoadStats::default(),
             textures: Vec::new(),
             environment: None,
+            sources: SceneSources::default(),
         }
     }
 

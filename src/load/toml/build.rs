@@ -307,6 +307,7 @@ pub(super) fn build(file: &SceneFile, src: &Source) -> R<(Scene, SceneSettings)>
         load_stats: b.stats,
         textures: b.textures,
         environment: b.environment,
+        sources: Default::default(),
     };
     Ok((scene, settings))
 }
