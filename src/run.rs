@@ -3,9 +3,11 @@
 //! ([`RenderRequest::settings`]), check the memory it needs ([`limits`]), build the
 //! backend and render ([`render_scene`], [`render_two_pass`], [`render_reference`]).
 
+mod explain;
 pub mod limits;
 mod request;
 
+pub use explain::{ExplainRunError, explain_pixel};
 pub use request::{
     CropSpecError, DEFAULT_MAX_DEPTH, DEFAULT_SPP, IndexOfError, Part, RenderRequest,
     SPD_MAX_DEPTH, SPD_SIDE, SettingsError, parse_crop, parse_index_of, parse_tile,

@@ -11,6 +11,7 @@ mod compare;
 #[cfg(test)]
 mod docs_commands;
 mod error;
+mod explain;
 mod generate;
 mod interrupt;
 mod merge;
@@ -62,6 +63,9 @@ pub enum Command {
     Study(study::Args),
     /// Solve a scene's diffuse interreflection by radiosity and render a view of it.
     Radiosity(radiosity::Args),
+    /// One pixel's whole ray tree: each ray, what it hit and where that was defined,
+    /// the light at each hit term by term, and what each ray brings back.
+    Explain(explain::Args),
 }
 
 /// Run the command line's command (a bare `emray` renders the default scene).
@@ -77,6 +81,7 @@ pub fn run(cli: Cli) -> Result<(), Error> {
         Some(Command::Stress(a)) => stress::run(a),
         Some(Command::Study(a)) => study::run(a),
         Some(Command::Radiosity(a)) => radiosity::run(a),
+        Some(Command::Explain(a)) => explain::run(a),
     }
 }
 

@@ -8,6 +8,7 @@ pub mod area;
 mod camera;
 pub mod color;
 mod counts;
+pub mod explain;
 mod film;
 pub mod gi;
 mod local;
@@ -279,6 +280,19 @@ where
                 px.push(f(i, j, counts));
             }
         }
+    }
+}
+
+/// The tile of edge `tile` holding position `(i, j)` of a `gw × gh` sample grid, cut
+/// from the grid's top-left corner as [`sample_grid`] cuts a whole image.
+pub(crate) fn tile_of(i: u32, j: u32, gw: u32, gh: u32, tile: u32) -> Region {
+    let ts = tile.max(1);
+    let (x0, y0) = (i / ts * ts, j / ts * ts);
+    Region {
+        x0,
+        y0,
+        x1: (x0 + ts).min(gw),
+        y1: (y0 + ts).min(gh),
     }
 }
 
