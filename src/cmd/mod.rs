@@ -13,6 +13,7 @@ mod docs_commands;
 mod error;
 mod explain;
 mod generate;
+mod insight;
 mod interrupt;
 mod merge;
 mod progress;
