@@ -416,6 +416,31 @@ fn degenerate_polygons_warn_once_per_file() {
     assert!(warnings_about("no-warning.nff").is_empty());
 }
 
+/// Colours above 1 (a 0–255 scale by mistake) are a warning at the colour, for the
+/// fill colour and the background; light colours (intensities) may exceed 1.
+#[test]
+fn colours_above_one_warn() {
+    warnings_about("");
+    let src = format!("b 0 0 300\n{V}l 0 5 0 2 2 2\nf 255 0 0 1 0 0 0 1\ns 0 0 0 1\n");
+    parse_str(&src, Path::new("bytes.nff")).unwrap();
+    let w = warnings_about("bytes.nff");
+    assert_eq!(w.len(), 2, "{w:?}");
+    assert!(
+        w[0].contains("bytes.nff:1:3: the background colour 0 0 300"),
+        "{}",
+        w[0]
+    );
+    assert!(
+        w[1].contains("bytes.nff:10:3: the fill colour 255 0 0"),
+        "{}",
+        w[1]
+    );
+    assert!(w[1].contains("0-255 scale"), "{}", w[1]);
+    let src = format!("b 0 0 1\n{V}l 0 5 0 2 2 2\nf 1 0.5 0 1 0 0 0 1\ns 0 0 0 1\n");
+    parse_str(&src, Path::new("unit.nff")).unwrap();
+    assert!(warnings_about("unit.nff").is_empty());
+}
+
 #[test]
 fn second_viewpoint_warns() {
     warnings_about("");

@@ -494,7 +494,7 @@ const TRI: &str = "v 0 0 0\nv 1 0 0\nv 0 1 0\n";
 
 #[test]
 fn malformed_files_are_errors_at_their_line() {
-    // Bad numbers (found after the structural checks pass, since tobj has no lines).
+    // Bad numbers (reported unless a structural problem comes first).
     fails("v 0 0 0\nv 1 x 0\n", 2, 5, "expected vertex y, found 'x'");
     fails("v 0 0 0\nvn 0 0 1.5.2\n", 2, 8, "expected normal z");
     fails("vt 0.5 abc\n", 1, 8, "expected texture v");
@@ -579,8 +579,10 @@ fn malformed_files_are_errors_at_their_line() {
 
 #[test]
 fn forward_references_within_the_file_are_accepted() {
-    // tobj resolves indices when a group ends, so a face may name a vertex defined
-    // after it; only an index beyond the whole file is an error.
+    // Indices are checked when a run of faces ends (at `g`, `o`, a `usemtl` that
+    // changes the material, or the end of the file), so a face may name a vertex
+    // defined after it in its run. An index beyond the whole file is an error at its
+    // line; one beyond its run, an error for the whole file.
     let (_dir, _path, r) = load_text("f 1 2 3\nv 0 0 0\nv 1 0 0\nv 0 1 0\n", &[]);
     assert_eq!(r.unwrap().geometry.triangles.len(), 1);
     fails(
@@ -588,6 +590,13 @@ fn forward_references_within_the_file_are_accepted() {
         2,
         7,
         "index 9",
+    );
+    let (_dir, path, r) = load_text("f 1 2 3\ng next\nv 0 0 0\nv 1 0 0\nv 0 1 0\n", &[]);
+    let e = r.unwrap_err();
+    assert_eq!((e.path, e.line), (path, 0));
+    assert_eq!(
+        e.message,
+        "malformed OBJ file (face vertex index out of bounds)"
     );
 }
 

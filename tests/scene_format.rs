@@ -3,6 +3,7 @@
 //! points, NFF files are included, and every malformed file is reported at the right
 //! line. Errors are checked against a `# HERE` marker on the line they must name.
 
+mod common;
 use emray::geometry::{Intersect, Kind, Primitive, Shape};
 use emray::load::LoadError;
 use emray::load::toml::{self as scene_toml, SceneSettings, format::SceneFile};
@@ -883,7 +884,7 @@ fn errors_of_the_new_primitives() {
     );
     error_at(
         "[[objects]]\ntype = \"quadric\"\ncoefficients = [1, 1, 1] # HERE\n",
-        &["invalid length 3"],
+        &["expected an array of 10 values, found an array of 3 values"],
     );
     error_at(
         "[[objects]]\ntype = \"plane\"\npoint = [0, 0, 0]\nnormal = [0, 0, 0] # HERE\n",
@@ -1360,7 +1361,7 @@ fn bezier_patches_tessellate_in_final_coordinates() {
     );
     error_at(
         "[[objects]]\ntype = \"bezier\"\npatches = [\n  [[0, 0, 0], [1, 0, 0]], # HERE\n]\n",
-        &["invalid length 2", "16"],
+        &["expected an array of 16 values, found an array of 2 values"],
     );
     error_at(
         "[[objects]]\ntype = \"bezier\"\nbuiltin = \"teapot\"\ntolerance = 0 # HERE\n",
@@ -1703,17 +1704,20 @@ fn error_key_of_another_type() {
 fn error_wrong_type() {
     error_at(
         "[[objects]]\ntype = \"sphere\"\ncenter = [0, 0, 0]\nradius = \"big\" # HERE\n",
-        &["invalid type", "a number"],
+        &["expected a number, found the string \"big\""],
     );
     error_at(
         "[[objects]]\ntype = \"sphere\"\ncenter = [0, 0] # HERE\nradius = 1\n",
-        &["invalid length 2"],
+        &["expected an array of 3 values, found an array of 2 values"],
     );
     error_at(
         "[[objects]]\ntype = \"group\"\nchildren = { type = \"sphere\" } # HERE\n",
-        &["invalid type"],
+        &["expected an array, found a table"],
     );
-    error_at("[render]\nspp = -1 # HERE\n", &["invalid value"]);
+    error_at(
+        "[render]\nspp = -1 # HERE\n",
+        &["expected a whole number, 0 or more, found the whole number -1"],
+    );
     error_at(
         "[[objects]]\ntype = \"sphere\"\ncenter = [0, 0, 0]\nradius = 1\ntransform = [{ scale = \"x\" }] # HERE\n",
         &["a number or an array of 3 numbers"],
@@ -2058,5 +2062,29 @@ color = [0, 0, 1]
     error_at(
         "[[objects]]\ntype = \"group\"\n[[objects.children]]\ntype = \"sphere\"\ncenter = [1, 0, 0]\nradius = 0 # HERE\n",
         &["must be positive"],
+    );
+}
+
+/// A material colour or the background above 1 (a 0–255 scale by mistake) is a
+/// warning at the value; light intensities may exceed 1.
+#[test]
+fn colours_above_one_warn() {
+    let dir = tempfile::tempdir().unwrap();
+    std::fs::write(
+        dir.path().join("s.toml"),
+        "[camera]\nfrom = [0, 0, 5]\nat = [0, 0, 0]\nresolution = [8, 8]\n\
+         [render]\nbackground = [0.1, 0.2, 0.3]\n\
+         [materials.red]\ncolor = [200, 30, 30]\n\
+         [[lights]]\nposition = [0, 5, 5]\nintensity = 3\n\
+         [[objects]]\ntype = \"sphere\"\ncenter = [0, 0, 0]\nradius = 1\nmaterial = \"red\"\n",
+    )
+    .unwrap();
+    let out = common::emray(dir.path(), &["render", "s.toml", "-o", "s.png"]);
+    let err = common::stderr(&out);
+    assert!(out.status.success(), "{err}");
+    assert_eq!(err.matches("above 1").count(), 1, "{err}");
+    assert!(
+        err.contains("s.toml:8:9: `color` [200, 30, 30] has channels above 1"),
+        "{err}"
     );
 }

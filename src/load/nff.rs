@@ -348,7 +348,9 @@ impl<'a> Parser<'a, '_> {
             match t.text {
                 "v" => self.viewpoint(&t)?,
                 "b" => {
-                    self.background = self.vec3("the background", RGB)?.0;
+                    let (c, tok) = self.vec3("the background", RGB)?;
+                    self.warn_above_one(&tok, "background", c);
+                    self.background = c;
                 }
                 "l" => self.light()?,
                 "f" => self.material()?,
@@ -477,8 +479,26 @@ impl<'a> Parser<'a, '_> {
         Ok(())
     }
 
+    /// A warning when a colour has a channel above 1, the sign of a colour written on a
+    /// 0–255 scale (NFF's colours run from 0 to 1).
+    fn warn_above_one(&self, tok: &Tok<'a>, what: &str, c: Vec3) {
+        if c.max_element() > 1.0 {
+            log::warn!(
+                "{}:{}:{}: the {what} colour {} {} {} has channels above 1; NFF colours run \
+                 from 0 to 1 (a colour on a 0-255 scale is divided by 255)",
+                self.path.display(),
+                tok.line,
+                self.lex.col(tok.line_start, tok.start),
+                c.x,
+                c.y,
+                c.z
+            );
+        }
+    }
+
     fn material(&mut self) -> Result<(), LoadError> {
-        let (color, _) = self.vec3("the fill colour", RGB)?;
+        let (color, color_tok) = self.vec3("the fill colour", RGB)?;
+        self.warn_above_one(&color_tok, "fill", color);
         let (kd, _) = self.num("the diffuse weight Kd")?;
         let (ks, _) = self.num("the specular weight Ks")?;
         let (shine, shine_tok) = self.num("the Phong exponent Shine")?;
