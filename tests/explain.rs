@@ -287,7 +287,7 @@ material = "floor"
     .unwrap();
     let scene = load_scene(&path).unwrap();
     let seen = check("textured", &scene, RenderRequest::default(), None);
-    has(&seen, &["Refraction", "Reflection", "Ambient"]);
+    has(&seen, &["Refraction", "Reflection", "Ambient", "source"]);
     let ice =
         load_scene(Path::new(env!("CARGO_MANIFEST_DIR")).join("scenes/ice-cube.toml")).unwrap();
     let seen = check("ice cube", &ice, request((32, 24)), None);

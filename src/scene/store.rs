@@ -173,6 +173,13 @@ for_each_kind!(define_store);
 #[derive(Clone, Copy, Debug, Default, PartialEq, Eq)]
 pub struct GeometryMark([usize; Kind::ALL.len()]);
 
+impl GeometryMark {
+    /// How many primitives of `kind` there were.
+    pub fn count(&self, kind: Kind) -> usize {
+        self.0[kind as usize]
+    }
+}
+
 impl Geometry {
     /// Add an analytic primitive of a statically known kind.
     pub fn push<P: Analytic>(&mut self, prim: P, material: u32) {

@@ -32,6 +32,7 @@ mod mesh;
 mod objects;
 mod settings;
 mod shapes;
+mod sources;
 mod transforms;
 mod types;
 mod values;
@@ -41,7 +42,9 @@ use super::{SceneSettings, Source, suggest};
 use crate::geometry::polygon::Triangulator;
 use crate::load::LoadError;
 use crate::math::Vec3;
-use crate::scene::{Environment, Geometry, Instance, Light, LoadStats, Material, Scene, Texture};
+use crate::scene::{
+    Environment, Geometry, Instance, Light, LoadStats, Material, Scene, SceneSources, Texture,
+};
 use glam::DVec3;
 use include::Included;
 use objects::{Ctx, Sink};
@@ -49,6 +52,7 @@ use std::collections::HashMap;
 use std::ops::Range;
 use std::path::{Path, PathBuf};
 use std::rc::Rc;
+use std::sync::Arc;
 
 type R<T> = Result<T, LoadError>;
 
@@ -83,6 +87,10 @@ struct Builder<'a, 's> {
     pts: Vec<Vec3>,
     nrm: Vec<Vec3>,
     tris: Vec<[usize; 3]>,
+    /// The scene file, as the origins of what it defines name it.
+    origin_file: Arc<str>,
+    /// Where the materials, lights and instances were defined.
+    sources: SceneSources,
 }
 
 /// Build the scene described by `file`, read from `src`.
@@ -110,7 +118,7 @@ pub(super) fn build(file: &SceneFile, src: &Source) -> R<(Scene, SceneSettings)>
         load_stats: b.stats,
         textures: b.textures,
         environment: b.environment,
-        sources: Default::default(),
+        sources: b.sources,
     };
     Ok((scene, settings))
 }
@@ -170,6 +178,8 @@ impl<'a, 's> Builder<'a, 's> {
             pts: Vec::new(),
             nrm: Vec::new(),
             tris: Vec::new(),
+            origin_file: Arc::from(src.path.display().to_string()),
+            sources: SceneSources::default(),
         }
     }
 
