@@ -295,6 +295,8 @@ fn heat_maps_are_deterministic_and_aov_needs_an_exr() {
     let read = |f: &str| std::fs::read(dir.path().join(f)).unwrap();
     assert_eq!(read("rays1.png"), read("rays3.png"));
     assert_eq!(read("depth1.png"), read("depth3.png"));
+    let colour = image::open(dir.path().join("x.png")).unwrap();
+    assert_eq!(colour.width(), 33, "the image is the colour, as a PNG");
     let img = image::open(dir.path().join("rays1.png")).unwrap();
     assert!(
         img.width() >= 33 && img.height() > 33,

@@ -479,7 +479,7 @@ fn trace(
     if insight_wanted(args) {
         let maps = insight::heatmaps(&args.heatmap, 1)?;
         let set = insight::gathered(args.aov.unwrap_or_default(), &maps);
-        let (film, aov, report) = run::render_aov(
+        let (film, mut aov, report) = run::render_aov(
             name,
             scene,
             options,
@@ -489,6 +489,9 @@ fn trace(
             load_ms,
             Some(&progress),
         )?;
+        // The layers written are the ones --aov asks for; the heat maps' are gathered
+        // for them alone.
+        aov.set = args.aov.unwrap_or_default();
         return Ok((film, Some(aov), report));
     }
     let (film, report) = match &radiosity {
