@@ -146,7 +146,7 @@ pub fn run(a: Args) -> Result<(), Error> {
         print(format_args!("{json}\n"))?;
     } else {
         print(format_args!(
-            "{name} on {}\n{}",
+            "scene {name}, backend {}\n{}",
             backend.name(),
             text::format(&explanation)
         ))?;

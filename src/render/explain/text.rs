@@ -265,9 +265,13 @@ fn light(out: &mut String, l: &LightNode, pad: &str) {
         "lit" => {
             let _ = writeln!(
                 out,
-                ", intensity {} (attenuation {}), diffuse {} + specular {} -> adds {}",
+                ", intensity {} (attenuation {})",
                 vec3(l.intensity),
-                num(l.attenuation),
+                num(l.attenuation)
+            );
+            let _ = writeln!(
+                out,
+                "{pad}    diffuse {} + specular {}, adds {}",
                 vec3(l.diffuse),
                 num(l.specular),
                 vec3(l.value)
@@ -320,7 +324,10 @@ fn source(s: &Option<String>) -> String {
 
 /// A number with at most six significant digits.
 fn num(x: f32) -> String {
-    if x == 0.0 || !x.is_finite() {
+    if x == 0.0 {
+        return "0".into();
+    }
+    if !x.is_finite() {
         return format!("{x}");
     }
     let a = x.abs();
@@ -357,6 +364,7 @@ mod tests {
         assert_eq!(num(1234.5678), "1234.57");
         assert_eq!(num(-0.5), "-0.5");
         assert_eq!(num(0.0), "0");
+        assert_eq!(num(-0.0), "0");
         assert_eq!(num(1e-7), "1.00000e-7");
         assert_eq!(num(f32::INFINITY), "inf");
     }
