@@ -408,7 +408,12 @@ fn render_one(args: &Args, scene_path: Option<&Path>, out: &Path) -> Result<()> 
         .settings(&scene)
         .map_err(|e| anyhow!("{name}: {e}"))?;
     let max_memory = args.max_memory.unwrap_or_else(limits::default_max_memory);
-    limits::check(Path::new(&name), &scene, &settings, max_memory)?;
+    let extra = if insight_wanted(args) {
+        limits::aov_bytes(&settings)
+    } else {
+        0
+    };
+    limits::check_with(Path::new(&name), &scene, &settings, extra, max_memory)?;
     let options = backend_options(args);
     let bar = TileBar::new(&name, args.quiet);
     let (film, aov, report) = trace(args, &name, &scene, &settings, options, load_ms, &bar)?;

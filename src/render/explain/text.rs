@@ -157,7 +157,21 @@ fn sum_of(h: &HitNode) -> String {
     s
 }
 
+/// A hit: the surface, the light there term by term, and the branches.
 fn hit(out: &mut String, h: &HitNode, pad: &str, contribution: [f32; 3]) {
+    surface(out, h, pad);
+    light_terms(out, h, pad);
+    let _ = writeln!(
+        out,
+        "{pad}  local light {}, adds {} to the pixel",
+        vec3(h.local),
+        vec3(contribution)
+    );
+    branches(out, h, pad);
+}
+
+/// What was hit: the primitive, its side and normals, the material, the media.
+fn surface(out: &mut String, h: &HitNode, pad: &str) {
     let _ = writeln!(
         out,
         "{pad}  hits {} at t = {}, point {}",
@@ -197,6 +211,10 @@ fn hit(out: &mut String, h: &HitNode, pad: &str, contribution: [f32; 3]) {
         }
     );
     let _ = writeln!(out, "{pad}  in {}", media(&h.media));
+}
+
+/// The local light's terms, area lights and point lights.
+fn light_terms(out: &mut String, h: &HitNode, pad: &str) {
     for t in &h.terms {
         let name = match t.term {
             Term::Ambient => "ambient",
@@ -219,12 +237,10 @@ fn hit(out: &mut String, h: &HitNode, pad: &str, contribution: [f32; 3]) {
     for l in &h.lights {
         light(out, l, pad);
     }
-    let _ = writeln!(
-        out,
-        "{pad}  local light {}, adds {} to the pixel",
-        vec3(h.local),
-        vec3(contribution)
-    );
+}
+
+/// Snell's law at a transmissive surface, and the rays not cast.
+fn branches(out: &mut String, h: &HitNode, pad: &str) {
     if let Some(b) = &h.boundary {
         let _ = writeln!(
             out,
