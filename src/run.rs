@@ -3,9 +3,13 @@
 //! ([`RenderRequest::settings`]), check the memory it needs ([`limits`]), build the
 //! backend and render ([`render_scene`], [`render_two_pass`], [`render_reference`]).
 
+mod aov;
+mod explain;
 pub mod limits;
 mod request;
 
+pub use aov::{AovRunError, render_aov};
+pub use explain::{ExplainRunError, explain_pixel};
 pub use request::{
     CropSpecError, DEFAULT_MAX_DEPTH, DEFAULT_SPP, IndexOfError, Part, RenderRequest,
     SPD_MAX_DEPTH, SPD_SIDE, SettingsError, parse_crop, parse_index_of, parse_tile,
@@ -325,15 +329,7 @@ struct TwoPassWork<'a> {
 impl WithAccel for TwoPassWork<'_> {
     type Output = Result<(Film, Report), RadiosityError>;
     fn run<A: Accel>(self, accel: &A, build_ms: f64) -> Self::Output {
-        let sol = crate::radiosity::solve(self.scene, accel, self.rad)?;
-        log::info!(
-            "radiosity: {} elements, {} shots, residual {:.2e}, form factors {:.0} ms, solve {:.0} ms",
-            sol.mesh.elements.len(),
-            sol.solve.iterations,
-            sol.solve.residuals.last().copied().unwrap_or(0.0),
-            sol.solve.form_factor_ms,
-            sol.solve.total_ms
-        );
+        let sol = solve_logged(self.scene, accel, self.rad)?;
         let (film, stats) =
             render::render_with_gi(self.scene, accel, self.settings, Some(&sol), self.progress);
         let t = Timings {
@@ -352,6 +348,24 @@ impl WithAccel for TwoPassWork<'_> {
         );
         Ok((film, report))
     }
+}
+
+/// Solve the radiosity of `scene` with `accel`'s visibility, and log what it took.
+fn solve_logged<A: Accel>(
+    scene: &Scene,
+    accel: &A,
+    rad: &RadiositySettings,
+) -> Result<crate::radiosity::Solution, RadiosityError> {
+    let sol = crate::radiosity::solve(scene, accel, rad)?;
+    log::info!(
+        "radiosity: {} elements, {} shots, residual {:.2e}, form factors {:.0} ms, solve {:.0} ms",
+        sol.mesh.elements.len(),
+        sol.solve.iterations,
+        sol.solve.residuals.last().copied().unwrap_or(0.0),
+        sol.solve.form_factor_ms,
+        sol.solve.total_ms
+    );
+    Ok(sol)
 }
 
 /// Two-pass rendering: build the backend over `scene`, solve its radiosity with the

@@ -67,7 +67,10 @@ impl Triangle {
     }
 
     /// Watertight intersection: no ray passes between two triangles sharing an edge.
-    #[inline]
+    /// Always inlined: it is the inner loop of the BVH's leaves and of every hit's
+    /// exact recomputation ([`crate::scene::Geometry::exact_hit`]), whose cost should not
+    /// depend on what else the caller inlines.
+    #[inline(always)]
     pub fn intersect_wt(&self, r: &WatertightRay) -> Option<ShapeHit> {
         let [kx, ky, kz] = r.k;
         let a = self.p[0] - r.org;

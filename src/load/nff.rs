@@ -18,11 +18,13 @@
 //! [`LoadStats::degenerate_dropped`](crate::scene::LoadStats).
 
 use super::LoadError;
+use crate::geometry::Kind;
 use crate::geometry::polygon::Triangulator;
 use crate::geometry::{Cone, Sphere, Triangle};
 use crate::math::{Aabb, DVec3, Vec3};
 use crate::scene::{Camera, Light, Material, Scene, default_light_intensity, range};
 use std::path::Path;
+use std::sync::Arc;
 
 /// Largest accepted image side.
 pub const MAX_RESOLUTION_SIDE: u64 = 65_536;
@@ -77,6 +79,8 @@ pub fn parse_str_at(src: &str, path: &Path, origin: DVec3) -> Result<Scene, Load
         tris: Vec::new(),
         triangulator: Triangulator::new(),
         first_degenerate: None,
+        file: Arc::from(path.display().to_string()),
+        entity_line: 0,
     };
     p.run()?;
     p.finish()
@@ -267,6 +271,10 @@ struct Parser<'a, 'p> {
     triangulator: Triangulator,
     /// Position of the first degenerate polygon, for the warning.
     first_degenerate: Option<(usize, usize)>,
+    /// The file, as the primitives' origins name it.
+    file: Arc<str>,
+    /// The line of the entity being read.
+    entity_line: u32,
 }
 
 impl<'a> Parser<'a, '_> {
@@ -412,6 +420,7 @@ impl<'a> Parser<'a, '_> {
 
     fn run(&mut self) -> Result<(), LoadError> {
         while let Some(t) = self.lex.next() {
+            self.entity_line = u32::try_from(t.line).unwrap_or(u32::MAX);
             match t.text {
                 "v" => self.viewpoint(&t)?,
                 "b" => {
@@ -536,6 +545,8 @@ impl<'a> Parser<'a, '_> {
         } else {
             Vec3::ZERO // set in `finish` once the number of lights is known
         };
+        let (index, line) = (self.lights.len(), self.entity_line);
+        self.scene.sources.lights.add(index, 1, &self.file, line);
         self.lights.push(Light::point(pos, color));
         self.light_has_color.push(has_color);
         Ok(())
@@ -574,6 +585,8 @@ impl<'a> Parser<'a, '_> {
         let (t, _) = self.num("the transmittance T")?;
         let (ior, ior_tok) = self.num("the index of refraction")?;
         self.in_range(&ior_tok, range::check_ior(t, ior))?;
+        let (index, line) = (self.materials.len(), self.entity_line);
+        self.scene.sources.materials.add(index, 1, &self.file, line);
         self.materials.push(Material {
             color,
             ka: kd,
@@ -614,6 +627,7 @@ impl<'a> Parser<'a, '_> {
         let bounds = self.world_bounds(&sphere.bounds());
         self.in_range(&r_tok, range::check_bounds("the sphere", &bounds))?;
         let m = self.material_index();
+        self.record(Kind::Sphere, 1);
         self.scene.geometry.push(sphere, m);
         Ok(())
     }
@@ -643,6 +657,7 @@ impl<'a> Parser<'a, '_> {
         let bounds = self.world_bounds(&cone.bounds());
         self.in_range(&ra_tok, range::check_bounds("the cone", &bounds))?;
         let m = self.material_index();
+        self.record(Kind::Cone, 1);
         self.scene.geometry.push(cone, m);
         Ok(())
     }
@@ -699,6 +714,7 @@ impl<'a> Parser<'a, '_> {
         match self.triangulator.triangulate(&self.pts, &mut self.tris) {
             Ok(()) => {
                 let m = self.material_index();
+                self.record(Kind::Triangle, self.tris.len());
                 for &[a, b, c] in &self.tris {
                     self.scene.geometry.triangles.push(
                         Triangle {
@@ -732,6 +748,14 @@ impl<'a> Parser<'a, '_> {
             }
         }
         Ok(())
+    }
+
+    /// The next `count` primitives of `kind` come from the entity being read.
+    fn record(&mut self, kind: Kind, count: usize) {
+        let first = self.scene.geometry.count(kind);
+        let g = &mut self.scene.geometry;
+        g.sources
+            .add(kind, first, count, &self.file, self.entity_line);
     }
 
     fn finish(mut self) -> Result<Scene, LoadError> {
@@ -822,6 +846,32 @@ mod tests {
         let s = show(&long);
         assert!(s.len() < 60, "{s}");
         assert_eq!(show("abc"), "'abc'");
+    }
+
+    /// Each primitive, material and light knows the line of its entity; a polygon's
+    /// triangles share their `p`'s line; the scene's `Debug` form (the render hash of
+    /// `emray merge`) does not depend on the file's name.
+    #[test]
+    fn primitives_materials_and_lights_know_their_line() {
+        let src = "v from 0 0 5 at 0 0 0 up 0 1 0 angle 40 hither 1 resolution 8 8\n\
+                   l 1 1 1\n\
+                   f 1 0 0 1 0 0 0 0\n\
+                   s 0 0 0 1\n\
+                   # a quad: two triangles\n\
+                   p 4 0 0 0 1 0 0 1 1 0 0 1 0\n\
+                   c 0 0 0 1 0 1 0 1\n";
+        let scene = parse_str(src, Path::new("dir/a.nff")).unwrap();
+        let g = &scene.geometry;
+        let at = |o: Option<crate::scene::Origin>| o.unwrap().to_string();
+        assert_eq!(at(g.sources.get(Kind::Sphere, 0)), "dir/a.nff:4");
+        assert_eq!(g.count(Kind::Triangle), 2);
+        assert_eq!(at(g.sources.get(Kind::Triangle, 0)), "dir/a.nff:6");
+        assert_eq!(at(g.sources.get(Kind::Triangle, 1)), "dir/a.nff:6");
+        assert_eq!(at(g.sources.get(Kind::Cone, 0)), "dir/a.nff:7");
+        assert_eq!(at(scene.sources.materials.get(0)), "dir/a.nff:3");
+        assert_eq!(at(scene.sources.lights.get(0)), "dir/a.nff:2");
+        let elsewhere = parse_str(src, Path::new("b.nff")).unwrap();
+        assert_eq!(format!("{scene:?}"), format!("{elsewhere:?}"));
     }
 
     #[test]

@@ -95,17 +95,29 @@ pub fn read_exr(path: &Path) -> Result<(Film, PartInfo), String> {
         .all_attributes()
         .from_file(path)
         .map_err(|e| format!("{}: not a readable RGB EXR: {e}", path.display()))?;
-    let display = image.attributes.display_window;
     let layer = image.layer_data;
-    let pos = layer.attributes.layer_position;
+    let film = layer.channel_data.pixels;
+    let size = (film.width as usize, film.height as usize);
+    let info = part_info(path, &image.attributes, &layer.attributes, size)?;
+    Ok((film, info))
+}
+
+/// Where a layer of `size` pixels lies in its image (display window), and its hash.
+pub(crate) fn part_info(
+    path: &Path,
+    image: &ImageAttributes,
+    layer: &LayerAttributes,
+    size: (usize, usize),
+) -> Result<PartInfo, String> {
+    let display = image.display_window;
+    let pos = layer.layer_position;
     let (dx, dy) = (display.position.x(), display.position.y());
     let (fw, fh) = (display.size.x(), display.size.y());
-    let film = layer.channel_data.pixels;
     let (x0, y0) = (pos.x() - dx, pos.y() - dy);
     let fits = x0 >= 0
         && y0 >= 0
-        && x0 as u64 + film.width as u64 <= fw as u64
-        && y0 as u64 + film.height as u64 <= fh as u64;
+        && x0 as u64 + size.0 as u64 <= fw as u64
+        && y0 as u64 + size.1 as u64 <= fh as u64;
     if !fits || fw > u32::MAX as usize || fh > u32::MAX as usize {
         return Err(format!(
             "{}: the data window lies outside the display window",
@@ -114,20 +126,19 @@ pub fn read_exr(path: &Path) -> Result<(Film, PartInfo), String> {
     }
     let region = Region {
         x0: x0 as u32,
-        x1: x0 as u32 + film.width,
+        x1: x0 as u32 + size.0 as u32,
         y0: y0 as u32,
-        y1: y0 as u32 + film.height,
+        y1: y0 as u32 + size.1 as u32,
     };
-    let hash = match layer.attributes.other.get(&Text::from(HASH_ATTRIBUTE)) {
+    let hash = match layer.other.get(&Text::from(HASH_ATTRIBUTE)) {
         Some(AttributeValue::Text(t)) => Some(t.to_string()),
         _ => None,
     };
-    let info = PartInfo {
+    Ok(PartInfo {
         full: (fw as u32, fh as u32),
         region,
         hash,
-    };
-    Ok((film, info))
+    })
 }
 
 #[cfg(test)]

@@ -11,8 +11,8 @@
 //! and triangles; instances; spot lights; media priorities) are refused, never
 //! rendered differently.
 
+use super::RayCounts;
 use super::film::Film;
-use super::whitted::RayCounts;
 use crate::geometry::Kind;
 use crate::geometry::reference as r64;
 use crate::math::DRay;

@@ -7,10 +7,12 @@ use glam::Vec2;
 
 mod hit;
 pub mod range;
+mod sources;
 mod store;
 pub mod texture;
 
 pub use hit::{Hit, NO_INSTANCE};
+pub use sources::{Origin, PrimSources, Sources};
 pub use store::{Geometry, GeometryMark, KindVisitor, Prims, ShapeEntry};
 
 pub use texture::{Environment, Maps, NO_TEXTURE, Texture};
@@ -216,6 +218,20 @@ pub struct Scene {
     /// world's origin the scene is. Everything in the scene is in this frame; add the
     /// origin back for world coordinates ([`Scene::to_world`]).
     pub origin: DVec3,
+    /// Where the materials, lights and instances were defined (the primitives' origins
+    /// are in each [`Geometry`]'s `sources`).
+    pub sources: SceneSources,
+}
+
+/// Where the items of a scene's lists were defined, as far as the loader recorded it.
+#[derive(Clone, Debug, Default, PartialEq, Eq)]
+pub struct SceneSources {
+    /// Per material index.
+    pub materials: Sources,
+    /// Per point light.
+    pub lights: Sources,
+    /// Per instance.
+    pub instances: Sources,
 }
 
 /// Render settings a scene file may carry; `None` leaves the renderer's default.
@@ -265,6 +281,7 @@ impl Scene {
             textures: Vec::new(),
             environment: None,
             origin: DVec3::ZERO,
+            sources: SceneSources::default(),
         }
     }
 

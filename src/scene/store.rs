@@ -9,7 +9,7 @@
 //! read one list, and [`Geometry::visit`]/[`Geometry::visit_all`] to run code on a
 //! list at its static type (a [`KindVisitor`], as the backends do to build).
 
-use super::{Hit, Surface};
+use super::{Hit, PrimSources, Surface};
 use crate::geometry::{
     AaBox, Analytic, CappedCone, Cone, Csg, Kind, OBox, Param, Plane, Polyhedron, QuadUv, Quadric,
     Shape, ShapeHit, Sphere, Torus, Triangle, for_each_kind,
@@ -110,6 +110,9 @@ macro_rules! define_store {
             /// Textured quad faces (OBJ faces of four vertices with `vt`, planar and
             /// convex).
             pub quads: Vec<QuadUv>,
+            /// Where each primitive was defined (file and line), as far as the loader
+            /// recorded it.
+            pub sources: PrimSources,
             $(#[doc = $doc] $field: Prims<$t>,)*
         }
 
@@ -169,6 +172,13 @@ for_each_kind!(define_store);
 /// The primitive counts of a [`Geometry`] at one moment ([`Geometry::mark`]), per kind.
 #[derive(Clone, Copy, Debug, Default, PartialEq, Eq)]
 pub struct GeometryMark([usize; Kind::ALL.len()]);
+
+impl GeometryMark {
+    /// How many primitives of `kind` there were.
+    pub fn count(&self, kind: Kind) -> usize {
+        self.0[kind as usize]
+    }
+}
 
 impl Geometry {
     /// Add an analytic primitive of a statically known kind.

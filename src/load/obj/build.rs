@@ -7,17 +7,20 @@ use super::material::{DEFAULT_SLOT, Materials};
 use super::parse::{Face, Obj};
 use super::smoothing::{self, GroupKey, unit};
 use crate::geometry::polygon::Triangulator;
-use crate::geometry::{QuadUv, Triangle};
+use crate::geometry::{Kind, QuadUv, Triangle};
 use crate::load::LoadError;
 use crate::math::{Aabb, Vec3};
 use crate::scene::{Geometry, LoadStats};
 use glam::Vec2;
 use std::collections::HashMap;
 use std::path::Path;
+use std::sync::Arc;
 
 /// The triangles of a model, with what was noted on the way.
 pub(super) struct Builder<'a> {
     path: &'a Path,
+    /// The file, as the triangles' origins name it.
+    file: Arc<str>,
     pub geometry: Geometry,
     pub bounds: Aabb,
     pub stats: LoadStats,
@@ -47,6 +50,7 @@ impl<'a> Builder<'a> {
     pub fn new(path: &'a Path) -> Self {
         Builder {
             path,
+            file: Arc::from(path.display().to_string()),
             geometry: Geometry::default(),
             bounds: Aabb::EMPTY,
             stats: LoadStats::default(),
@@ -126,6 +130,11 @@ impl<'a> Builder<'a> {
         for t in 0..self.tris.len() {
             self.triangle(t, smooth, m)?;
         }
+        let count = self.geometry.triangles.len() - first;
+        let line = u32::try_from(face.line).unwrap_or(u32::MAX);
+        let g = &mut self.geometry;
+        g.sources
+            .add(Kind::Triangle, first, count, &self.file, line);
         self.quad_uv(face, first);
         Ok(())
     }

@@ -6,16 +6,18 @@
 //! model's centre), and each placement maps that frame into the scene's in double
 //! precision, so that a model far from its own origin keeps its detail. Errors
 //! and warnings in the included file carry its own position and say where it was
-//! included from.
+//! included from; its primitives, materials and lights keep their own file and line as
+//! their origin.
 
 use super::super::format::{ObjectDef, Spanned};
 use super::objects::Sink;
 use super::types::Ty;
 use super::{Builder, LOG_TARGET, R, f32v};
+use crate::geometry::Kind;
 use crate::geometry::{QuadUv, Triangle};
 use crate::load::{LoadError, nff, obj};
 use crate::math::Vec3;
-use crate::scene::{Geometry, Light, LoadStats, Material, Spot};
+use crate::scene::{Geometry, Light, LoadStats, Material, SceneSources, Spot};
 use glam::{DAffine3, DMat3, DVec3};
 use std::path::Path;
 use std::rc::Rc;
@@ -33,6 +35,8 @@ pub(super) struct Included {
     geometry: Geometry,
     /// The point of the file's own coordinates that is the zero of `geometry`.
     origin: DVec3,
+    /// Where its materials and lights were defined.
+    sources: SceneSources,
     /// Its lights (NFF).
     lights: Vec<Light>,
     /// Where its materials start in the scene's list.
@@ -44,6 +48,7 @@ pub(super) struct Included {
 struct Read {
     geometry: Geometry,
     origin: DVec3,
+    sources: SceneSources,
     materials: Vec<Material>,
     lights: Vec<Light>,
     stats: LoadStats,
@@ -80,7 +85,10 @@ impl Builder<'_, '_> {
         let span = o.ty.span();
         for entry in inc.geometry.shapes() {
             let m = mat(entry.material);
+            let origin = inc.geometry.sources.get(entry.kind, entry.prim);
+            let before = self.placed(sink);
             self.place_shape(entry.shape, &x, m, span.clone(), sink)?;
+            self.record_origin(sink, &before, origin);
         }
         Ok(())
     }
@@ -106,7 +114,11 @@ impl Builder<'_, '_> {
                  object placed by instances; lights are not instanced)",
             ));
         }
-        for light in &inc.lights {
+        for (k, light) in inc.lights.iter().enumerate() {
+            if let Some(o) = inc.sources.lights.get(k as u32) {
+                let index = self.lights.len();
+                self.sources.lights.add(index, 1, &o.file, o.line);
+            }
             self.lights.push(Light {
                 pos: f32v(x.transform_point3(light.pos.as_dvec3())),
                 spot: light.spot.map(|sp| Spot {
@@ -142,12 +154,19 @@ impl Builder<'_, '_> {
             self.read_nff(file, &path)?
         };
         let material_base = self.materials.len() as u32;
+        for k in 0..read.materials.len() {
+            if let Some(o) = read.sources.materials.get(k as u32) {
+                let index = material_base as usize + k;
+                self.sources.materials.add(index, 1, &o.file, o.line);
+            }
+        }
         self.materials.extend_from_slice(&read.materials);
         self.stats.polygons += read.stats.polygons;
         self.stats.degenerate_dropped += read.stats.degenerate_dropped;
         let inc = Rc::new(Included {
             geometry: read.geometry,
             origin: read.origin,
+            sources: read.sources,
             lights: read.lights,
             material_base,
             format: read.format,
@@ -182,6 +201,7 @@ impl Builder<'_, '_> {
         Ok(Read {
             geometry: data.geometry,
             origin: data.origin,
+            sources: SceneSources::default(),
             materials,
             lights: Vec::new(),
             stats: data.stats,
@@ -198,6 +218,7 @@ impl Builder<'_, '_> {
         Ok(Read {
             geometry: scene.geometry,
             origin: scene.origin,
+            sources: scene.sources,
             materials: scene.materials,
             lights: scene.lights,
             stats: scene.load_stats,
@@ -289,6 +310,9 @@ fn place_triangles(g: &mut Geometry, s: &Geometry, x: &DAffine3, mat: impl Fn(u3
             None => g.add_triangle(Triangle { p }, m),
         }
         let placed = g.triangles.len() - 1;
+        if let Some(o) = s.sources.get(Kind::Triangle, i as u32) {
+            g.sources.add(Kind::Triangle, placed, 1, &o.file, o.line);
+        }
         if let Some(&k) = s.triangle_uvs.get(i).filter(|&&k| k != u32::MAX) {
             let t = s.vertex_uvs[k as usize];
             let t = if place.mirror { [t[0], t[2], t[1]] } else { t };

@@ -16,6 +16,9 @@ impl Builder<'_, '_> {
         let file = self.file;
         for l in &file.lights {
             let light = self.light(l)?;
+            let (index, line) = (self.lights.len(), self.line_of(l.span()));
+            let origin = self.origin_file.clone();
+            self.sources.lights.add(index, 1, &origin, line);
             self.lights.push(light);
         }
         Ok(())

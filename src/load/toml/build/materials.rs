@@ -22,8 +22,10 @@ impl<'a> Builder<'a, '_> {
         for (name, def) in materials {
             let mut m = self.material(def)?;
             m.maps = self.maps(def)?;
-            self.material_names
-                .insert(name, self.materials.len() as u32);
+            let index = self.materials.len();
+            let (file, line) = (self.origin_file.clone(), self.line_of(def.span()));
+            self.sources.materials.add(index, 1, &file, line);
+            self.material_names.insert(name, index as u32);
             self.materials.push(m);
         }
         Ok(())

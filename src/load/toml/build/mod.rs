@@ -32,6 +32,7 @@ mod mesh;
 mod objects;
 mod settings;
 mod shapes;
+mod sources;
 mod transforms;
 mod types;
 mod values;
@@ -41,7 +42,9 @@ use super::{SceneSettings, Source, suggest};
 use crate::geometry::polygon::Triangulator;
 use crate::load::LoadError;
 use crate::math::Vec3;
-use crate::scene::{Environment, Geometry, Instance, Light, LoadStats, Material, Scene, Texture};
+use crate::scene::{
+    Environment, Geometry, Instance, Light, LoadStats, Material, Scene, SceneSources, Texture,
+};
 use glam::DVec3;
 use include::Included;
 use objects::{Ctx, Sink};
@@ -49,6 +52,7 @@ use std::collections::HashMap;
 use std::ops::Range;
 use std::path::{Path, PathBuf};
 use std::rc::Rc;
+use std::sync::Arc;
 
 type R<T> = Result<T, LoadError>;
 
@@ -86,6 +90,10 @@ struct Builder<'a, 's> {
     /// The world point that is the scene's zero: the camera's eye (see
     /// [`Scene::origin`]).
     origin: DVec3,
+    /// The scene file, as the origins of what it defines name it.
+    origin_file: Arc<str>,
+    /// Where the materials, lights and instances were defined.
+    sources: SceneSources,
 }
 
 /// Build the scene described by `file`, read from `src`, in the frame whose origin is
@@ -120,6 +128,7 @@ pub(super) fn build(
         textures: b.textures,
         environment: b.environment,
         origin,
+        sources: b.sources,
     };
     Ok((scene, settings))
 }
@@ -180,6 +189,8 @@ impl<'a, 's> Builder<'a, 's> {
             nrm: Vec::new(),
             tris: Vec::new(),
             origin: DVec3::ZERO,
+            origin_file: Arc::from(src.path.display().to_string()),
+            sources: SceneSources::default(),
         }
     }
 

@@ -103,7 +103,9 @@ impl<'a> Builder<'a, '_> {
             depth: ctx.depth + 1,
         };
         let (mark, first_instance) = (self.geometry.mark(), self.instances.len());
+        let before = self.placed(sink);
         self.place(node, ty, explicit, inner, sink)?;
+        self.record_at(sink, &before, node.span());
         // A group's children were checked one by one; inside a define, coordinates are
         // the object's own, checked where an instance places it.
         if ty != Ty::Group && !sink.in_define() {
