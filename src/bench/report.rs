@@ -359,6 +359,16 @@ pub fn markdown(
     peer_note: &str,
 ) -> String {
     let mut o = String::new();
+    md_header(&mut o, machine, rows);
+    md_rows(&mut o, rows);
+    md_rays_by_type(&mut o, rows);
+    md_targets(&mut o, sum);
+    md_peers(&mut o, peers, peer_note);
+    o
+}
+
+/// The machine, the Embree version and how the rows were measured.
+fn md_header(o: &mut String, machine: &Machine, rows: &[Row]) {
     let accel = rows
         .iter()
         .find(|r| r.backend == "embree")
@@ -375,6 +385,10 @@ pub fn markdown(
         o,
         "- {reps} repetitions per row, interleaved; times are medians, spread = (max − min) / median\n"
     );
+}
+
+/// One line per row.
+fn md_rows(o: &mut String, rows: &[Row]) {
     let _ = writeln!(
         o,
         "| scene | prims | backend | thr | load ms | build ms | render ms | spread | raw ms | render/raw | rays | Mrays/s | peak MiB | ÷ embree |"
@@ -403,6 +417,10 @@ pub fn markdown(
             opt(r.vs_embree, 2),
         );
     }
+}
+
+/// The rays of each scene by kind.
+fn md_rays_by_type(o: &mut String, rows: &[Row]) {
     let _ = writeln!(
         o,
         "\nRays by type (eye / reflection / refraction / shadow):\n"
@@ -417,6 +435,10 @@ pub fn markdown(
             );
         }
     }
+}
+
+/// The summary against the targets, with the scaling table.
+fn md_targets(o: &mut String, sum: &Summary) {
     let _ = writeln!(o, "\n## Targets\n");
     for (t, g) in &sum.bvh_vs_embree {
         let _ = writeln!(
@@ -436,13 +458,24 @@ pub fn markdown(
             "- smallest speed-up of all threads over one on {b}: {k:.2}× ({scene}) (target ≥ 1.85)"
         );
     }
-    if !sum.scaling.is_empty() {
+    md_scaling(o, &sum.scaling);
+    for (b, k) in &sum.balls_exponent {
+        let _ = writeln!(
+            o,
+            "- balls render time ∝ primitives^{k:.2} ({b}) (target < 1)"
+        );
+    }
+}
+
+/// The speed-up of all threads over one, explained by CPU time and steal.
+fn md_scaling(o: &mut String, scaling: &[Scaling]) {
+    if !scaling.is_empty() {
         let _ = writeln!(
             o,
             "\n| scaling | backend | thr | speed-up | CPU busy | CPU work | steal |\n|---|---|---:|---:|---:|---:|---:|"
         );
         let pct = |v: Option<f64>| v.map_or("–".to_string(), |x| format!("{:.0}%", x * 100.0));
-        for k in &sum.scaling {
+        for k in scaling {
             let _ = writeln!(
                 o,
                 "| {} | {} | {} | {:.2}× | {} | {} | {} |",
@@ -463,12 +496,10 @@ pub fn markdown(
              waiting emray causes; with steal, the machine's.\n"
         );
     }
-    for (b, k) in &sum.balls_exponent {
-        let _ = writeln!(
-            o,
-            "- balls render time ∝ primitives^{k:.2} ({b}) (target < 1)"
-        );
-    }
+}
+
+/// Tachyon's times beside emray's, or why there are none.
+fn md_peers(o: &mut String, peers: &[PeerRow], peer_note: &str) {
     let _ = writeln!(o, "\n## Peer: Tachyon\n");
     if peers.is_empty() {
         let _ = writeln!(o, "{peer_note}");
@@ -506,7 +537,6 @@ pub fn markdown(
             super::peer::TACHYON_ANGLE_DEG
         );
     }
-    o
 }
 
 /// The rows as CSV, one line per row.
