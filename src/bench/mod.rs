@@ -150,6 +150,13 @@ pub struct RunSpec {
     /// Embree without `RTC_SCENE_FLAG_ROBUST` (the renderer's default sets it).
     #[serde(default)]
     pub embree_fast: bool,
+    /// Eye rays only: one ray per pixel centre (never SPD mode), the scene's lights
+    /// removed and the ray tree cut at depth 1, so that a render casts its camera rays
+    /// and nothing else, and render ÷ raw is the cost of
+    /// emray's eye-ray pipeline (camera, packets, surfaces, shading, film) over casting
+    /// the same rays.
+    #[serde(default)]
+    pub eye_only: bool,
 }
 
 /// What runs recorded before `packet_width` existed are read with: the renderer's
@@ -282,8 +289,9 @@ fn run_settings(spec: &RunSpec, scene: &Scene) -> RenderSettings {
     let request = RenderRequest {
         res: Some((spec.width, spec.height)),
         spp: Some(1),
-        max_depth: Some(5),
-        spd: spec.spd,
+        max_depth: Some(if spec.eye_only { 1 } else { 5 }),
+        // SPD mode's corner rays and fixed depth are not eye rays alone.
+        spd: spec.spd && !spec.eye_only,
         bailout: Some(0.0),
         ..RenderRequest::default()
     };
@@ -303,7 +311,10 @@ pub fn run_child(spec: &RunSpec) -> Result<RunResult, BenchError> {
             message: e.to_string(),
         })?;
     let t0 = Instant::now();
-    let scene = load_scene(&spec.scene)?;
+    let mut scene = load_scene(&spec.scene)?;
+    if spec.eye_only {
+        scene.lights.clear();
+    }
     let load_ms = t0.elapsed().as_secs_f64() * 1e3;
     let settings = run_settings(spec, &scene);
     let options = BackendOptions {
@@ -412,6 +423,8 @@ pub struct Config {
     pub packet_width: u32,
     /// Embree without `RTC_SCENE_FLAG_ROBUST`.
     pub embree_fast: bool,
+    /// Eye rays only (see [`RunSpec::eye_only`]).
+    pub eye_only: bool,
 }
 
 /// The default suite: the eight SPD scenes at their default sizes, then balls and jacks
@@ -558,6 +571,7 @@ pub fn run_suite(
                             embree_quality: cfg.embree_quality,
                             packet_width: cfg.packet_width,
                             embree_fast: cfg.embree_fast,
+                            eye_only: cfg.eye_only,
                         };
                         let result = run_in_child(exe, &spec)?;
                         log(&format!(
@@ -618,6 +632,7 @@ fn run_peer_emray(cfg: &Config, exe: &Path, nff: &Path, threads: usize) -> Resul
         embree_quality: cfg.embree_quality,
         packet_width: cfg.packet_width,
         embree_fast: cfg.embree_fast,
+        eye_only: false,
     };
     Ok(run_in_child(exe, &spec)?.ms)
 }
@@ -774,6 +789,7 @@ mod tests {
             embree_quality: Default::default(),
             packet_width: 8,
             embree_fast: false,
+            eye_only: false,
         };
         let r = run_child(&spec).unwrap();
         assert_eq!(r.rays.eye, 17 * 17);
@@ -794,6 +810,20 @@ mod tests {
         })
         .unwrap();
         assert_eq!(raw.rays, r.rays, "the raw run casts the render's rays");
+        // Eye rays only: the same eye rays, nothing else, and raw casting casts them.
+        let eye = RunSpec {
+            eye_only: true,
+            ..spec.clone()
+        };
+        let e = run_child(&eye).unwrap();
+        assert_eq!(e.rays.eye, 16 * 16, "pixel centres");
+        assert_eq!(e.rays.total, e.rays.eye, "{:?}", e.rays);
+        let raw = run_child(&RunSpec {
+            mode: Mode::Raw,
+            ..eye
+        })
+        .unwrap();
+        assert_eq!(raw.rays, e.rays);
         assert!(
             run_child(&RunSpec {
                 backend: "nope".into(),

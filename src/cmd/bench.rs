@@ -41,6 +41,10 @@ pub struct Args {
     /// Embree's fast traversal, without RTC_SCENE_FLAG_ROBUST (as `render --embree-fast`).
     #[arg(long)]
     pub embree_fast: bool,
+    /// Eye rays only: one per pixel centre, lights removed, depth 1, so that render ÷ raw is the cost of the
+    /// eye-ray pipeline over casting the same rays.
+    #[arg(long)]
+    pub eye_only: bool,
     /// Skip the raw-casting runs.
     #[arg(long)]
     pub no_raw: bool,
@@ -126,5 +130,6 @@ fn config(b: &Args) -> bench::Config {
         embree_quality: b.embree_quality.into(),
         packet_width: b.packet_width,
         embree_fast: b.embree_fast,
+        eye_only: b.eye_only,
     }
 }
