@@ -2,16 +2,15 @@
 //! written with every channel in one layer, in the name order EXR requires, and read
 //! back whole, so that `emray merge` can stitch every channel of the parts.
 
-use super::part::{HASH_ATTRIBUTE, PartInfo};
-use super::{OutputError, write_atomic};
+use super::OutputError;
+use super::part::{PartInfo, encoding, layer_attributes, placement, write_image};
 use crate::render::Film;
 use exr::prelude::{
-    AnyChannel, AnyChannels, AttributeValue, FlatSamples, Image, ImageAttributes, IntegerBounds,
-    Layer, LayerAttributes, ReadChannels, ReadLayers, Text, Vec2, WritableImage, read,
+    AnyChannel, AnyChannels, FlatSamples, Image, ImageAttributes, IntegerBounds, Layer,
+    ReadChannels, ReadLayers, read,
 };
 use glam::Vec3;
 use smallvec::SmallVec;
-use std::io::BufWriter;
 use std::path::Path;
 
 /// The samples of one channel, row-major over the data window.
@@ -90,14 +89,7 @@ pub fn write_exr_channels(
     extra: &[Channel],
     part: Option<&PartInfo>,
 ) -> Result<(), OutputError> {
-    let (w, h) = (film.width as usize, film.height as usize);
-    let (full, origin) = match part {
-        Some(p) => (
-            (p.full.0 as usize, p.full.1 as usize),
-            (p.region.x0 as i32, p.region.y0 as i32),
-        ),
-        None => ((w, h), (0, 0)),
-    };
+    let (full, origin) = placement(film, part);
     let rgb = |f: fn(&Vec3) -> f32| FlatSamples::F32(film.pixels.iter().map(f).collect());
     let mut list: SmallVec<[AnyChannel<FlatSamples>; 4]> = SmallVec::new();
     list.push(AnyChannel::new("R", rgb(|v| v.x)));
@@ -110,42 +102,19 @@ pub fn write_exr_channels(
         };
         list.push(AnyChannel::new(c.name.as_str(), samples));
     }
-    let mut attributes = LayerAttributes {
-        layer_position: Vec2(origin.0, origin.1),
-        ..LayerAttributes::default()
-    };
-    if let Some(hash) = part.and_then(|p| p.hash.as_deref()) {
-        let text = Text::new_or_none(hash).ok_or_else(|| OutputError::Write {
-            path: path.to_path_buf(),
-            message: "the part hash is not plain text".into(),
-        })?;
-        attributes
-            .other
-            .insert(Text::from(HASH_ATTRIBUTE), AttributeValue::Text(text));
-    }
     let layer = Layer::new(
-        (w, h),
-        attributes,
-        // Blocks in increasing order: the same image always gives the same bytes.
-        exr::image::Encoding {
-            line_order: exr::meta::attribute::LineOrder::Increasing,
-            ..exr::image::Encoding::FAST_LOSSLESS
-        },
+        (film.width as usize, film.height as usize),
+        layer_attributes(path, origin, part)?,
+        encoding(),
         AnyChannels::sort(list),
     );
-    let image = Image::new(
-        ImageAttributes::new(IntegerBounds::new((0, 0), full)),
-        layer,
-    );
-    write_atomic(path, |file| {
-        let mut bw = BufWriter::new(file);
-        image
-            .write()
-            .to_buffered(&mut bw)
-            .map_err(|e| e.to_string())?;
-        let file = bw.into_inner().map_err(|e| e.into_error().to_string())?;
-        file.sync_all().map_err(|e| e.to_string())
-    })
+    write_image(
+        path,
+        &Image::new(
+            ImageAttributes::new(IntegerBounds::new((0, 0), full)),
+            layer,
+        ),
+    )
 }
 
 /// Read an EXR's first layer whole: its colour, its other channels (in name order) and

@@ -30,20 +30,46 @@ pub struct PartInfo {
 /// Write `film` as a linear f32 RGB EXR. With `part`, `film` is `part.region` of a
 /// `part.full` image: the data window says so and the hash is stored.
 pub fn write_exr(path: &Path, film: &Film, part: Option<&PartInfo>) -> Result<(), OutputError> {
-    let (w, h) = (film.width as usize, film.height as usize);
-    let (full, origin) = match part {
-        Some(p) => (
-            (p.full.0 as usize, p.full.1 as usize),
-            (p.region.x0 as i32, p.region.y0 as i32),
-        ),
-        None => ((w, h), (0, 0)),
-    };
+    let w = film.width as usize;
+    let (full, origin) = placement(film, part);
     let px = &film.pixels;
     let channels = SpecificChannels::rgb(|p: Vec2<usize>| {
         let v = px[p.y() * w + p.x()];
         (v.x, v.y, v.z)
     });
-    let mut layer_attributes = LayerAttributes {
+    let layer = Layer::new(
+        (w, film.height as usize),
+        layer_attributes(path, origin, part)?,
+        encoding(),
+        channels,
+    );
+    write_image(
+        path,
+        &Image::new(
+            ImageAttributes::new(IntegerBounds::new((0, 0), full)),
+            layer,
+        ),
+    )
+}
+
+/// The whole image's size and where `film` lies in it: the part's, or the film's own.
+pub(super) fn placement(film: &Film, part: Option<&PartInfo>) -> ((usize, usize), (i32, i32)) {
+    match part {
+        Some(p) => (
+            (p.full.0 as usize, p.full.1 as usize),
+            (p.region.x0 as i32, p.region.y0 as i32),
+        ),
+        None => ((film.width as usize, film.height as usize), (0, 0)),
+    }
+}
+
+/// A layer's attributes: its position in the whole image and the part's hash.
+pub(super) fn layer_attributes(
+    path: &Path,
+    origin: (i32, i32),
+    part: Option<&PartInfo>,
+) -> Result<LayerAttributes, OutputError> {
+    let mut attributes = LayerAttributes {
         layer_position: Vec2(origin.0, origin.1),
         ..LayerAttributes::default()
     };
@@ -52,23 +78,27 @@ pub fn write_exr(path: &Path, film: &Film, part: Option<&PartInfo>) -> Result<()
             path: path.to_path_buf(),
             message: "the part hash is not plain text".into(),
         })?;
-        layer_attributes
+        attributes
             .other
             .insert(Text::from(HASH_ATTRIBUTE), AttributeValue::Text(text));
     }
-    let layer = Layer::new(
-        (w, h),
-        layer_attributes,
-        // Blocks in increasing order: compressed in parallel, they are still written in
-        // one order, so the same image always gives the same bytes.
-        exr::image::Encoding {
-            line_order: exr::meta::attribute::LineOrder::Increasing,
-            ..exr::image::Encoding::FAST_LOSSLESS
-        },
-        channels,
-    );
-    let attributes = ImageAttributes::new(IntegerBounds::new((0, 0), full));
-    let image = Image::new(attributes, layer);
+    Ok(attributes)
+}
+
+/// Lossless compression with blocks in increasing order: compressed in parallel, they
+/// are still written in one order, so the same image always gives the same bytes.
+pub(super) fn encoding() -> exr::image::Encoding {
+    exr::image::Encoding {
+        line_order: exr::meta::attribute::LineOrder::Increasing,
+        ..exr::image::Encoding::FAST_LOSSLESS
+    }
+}
+
+/// Write `image` to `path` atomically (a temporary file, then a rename).
+pub(super) fn write_image<'i, L>(path: &Path, image: &'i Image<L>) -> Result<(), OutputError>
+where
+    L: exr::image::write::layers::WritableLayers<'i>,
+{
     write_atomic(path, |file| {
         let mut bw = BufWriter::new(file);
         image
