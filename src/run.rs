@@ -101,6 +101,10 @@ pub struct Report {
     pub mrays_per_s: f64,
     /// Backend details.
     pub accel: String,
+    /// Bytes of the backend's structure ([`AccelStats::bytes`], 0 when unknown).
+    pub accel_bytes: usize,
+    /// Primitives in the backend's structure ([`AccelStats::prims`]).
+    pub accel_prims: usize,
     /// The primitive kinds the backend holds and dispatches to
     /// ([`AccelStats::kinds`]), e.g. `triangles, spheres`.
     pub kinds: String,
@@ -194,6 +198,17 @@ impl Report {
                 format!("{}: {}", accel.backend, accel.detail)
             },
             kinds: crate::accel::kinds_summary(&accel.kinds),
+            accel_bytes: accel.bytes,
+            accel_prims: accel.prims,
+        }
+    }
+
+    /// The backend's memory for `--stats`: bytes, and bytes per primitive.
+    fn memory(&self) -> String {
+        match (self.accel_bytes, self.accel_prims) {
+            (0, _) => "unknown".to_string(),
+            (b, 0) => format!("{b} bytes"),
+            (b, n) => format!("{b} bytes, {:.1} per primitive", b as f64 / n as f64),
         }
     }
 
@@ -213,6 +228,7 @@ impl Report {
              image      {}x{}, {} spp, depth {}{}\n\
              prims      {} ({} lights{})\n\
              kinds      {} (only these are dispatched to)\n\
+             memory     {}\n\
              time       load {:.1} ms, build {:.1} ms, render {:.1} ms\n\
              rays       eye {} (hit {}), reflection {}, refraction {}, shadow {}, total {}\n\
              tir        {}\n\
@@ -238,6 +254,7 @@ impl Report {
                 String::new()
             },
             self.kinds,
+            self.memory(),
             t.load,
             t.build,
             t.render,

@@ -24,7 +24,10 @@ pub struct AccelStats {
     pub prims: usize,
     /// Nodes (BVH only; 0 when the backend does not say).
     pub nodes: usize,
-    /// Bytes used by the structure (approximate for Embree: 0 when unknown).
+    /// Bytes of the structure: its nodes and leaves with the primitive data they hold
+    /// (the BVH's own count; for Embree what its memory monitor counted once the scene
+    /// was committed, plus the primitive lists its user geometries read). 0 when
+    /// unknown.
     pub bytes: usize,
     /// Free-form details (Embree version, ISA, ...).
     pub detail: String,
@@ -33,6 +36,13 @@ pub struct AccelStats {
     /// to: Embree holds one geometry per kind present, the BVH's leaves only the
     /// primitives present.
     pub kinds: Vec<(Kind, usize)>,
+}
+
+impl AccelStats {
+    /// [`AccelStats::bytes`] per primitive, `None` when either is 0.
+    pub fn bytes_per_prim(&self) -> Option<f64> {
+        (self.bytes > 0 && self.prims > 0).then(|| self.bytes as f64 / self.prims as f64)
+    }
 }
 
 /// Add `n` primitives of `kind` to a [`AccelStats::kinds`] list (nothing when `n` is 0).

@@ -36,6 +36,11 @@ pub struct Unbounded {
 }
 
 impl Unbounded {
+    /// Bytes of the list.
+    pub fn memory_bytes(&self) -> usize {
+        self.entries.len() * std::mem::size_of::<Entry>()
+    }
+
     /// The unbounded primitives of `scene`: the top level's, then each instance's.
     pub fn new(scene: &Scene) -> Unbounded {
         let mut entries = Vec::new();

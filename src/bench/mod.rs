@@ -215,6 +215,10 @@ pub struct RunResult {
     /// Time the machine's processors were stolen during it (all processors), ms.
     #[serde(default)]
     pub steal_ms: Option<f64>,
+    /// Bytes of the backend's structure ([`AccelStats::bytes`](crate::accel::AccelStats::bytes);
+    /// 0 when unknown).
+    #[serde(default)]
+    pub accel_bytes: usize,
 }
 
 fn backend_named(name: &str) -> Result<Backend, BenchError> {
@@ -230,7 +234,7 @@ struct Measure {
     build_ms: f64,
     ms: f64,
     counts: crate::render::RayCounts,
-    detail: String,
+    stats: crate::accel::AccelStats,
     cpu_ms: Option<f64>,
     steal_ms: Option<f64>,
 }
@@ -251,7 +255,7 @@ impl WithAccel for RenderWork<'_> {
             build_ms,
             ms: stats.render_ms,
             counts: stats.rays,
-            detail: accel.stats().detail,
+            stats: accel.stats(),
             cpu_ms,
             steal_ms,
         }
@@ -275,7 +279,7 @@ impl WithAccel for RawWork<'_> {
             build_ms,
             ms: cast.ms,
             counts,
-            detail: accel.stats().detail,
+            stats: accel.stats(),
             cpu_ms,
             steal_ms,
         }
@@ -341,9 +345,9 @@ pub fn run_child(spec: &RunSpec) -> Result<RunResult, BenchError> {
         }
     })?;
     let accel = match (backend, spec.packet_width) {
-        (Backend::Embree, 0) => format!("{}, eye rays one by one", m.detail),
-        (Backend::Embree, w) => format!("{}, eye rays in packets of {w}", m.detail),
-        _ => m.detail,
+        (Backend::Embree, 0) => format!("{}, eye rays one by one", m.stats.detail),
+        (Backend::Embree, w) => format!("{}, eye rays in packets of {w}", m.stats.detail),
+        _ => m.stats.detail.clone(),
     };
     Ok(RunResult {
         prims: scene.prim_count_with_instances(),
@@ -355,6 +359,7 @@ pub fn run_child(spec: &RunSpec) -> Result<RunResult, BenchError> {
         accel,
         cpu_ms: m.cpu_ms,
         steal_ms: m.steal_ms,
+        accel_bytes: m.stats.bytes,
     })
 }
 
@@ -810,6 +815,7 @@ mod tests {
         })
         .unwrap();
         assert_eq!(raw.rays, r.rays, "the raw run casts the render's rays");
+        assert!(r.accel_bytes > 30 * r.prims, "{} bytes", r.accel_bytes);
         // Eye rays only: the same eye rays, nothing else, and raw casting casts them.
         let eye = RunSpec {
             eye_only: true,

@@ -51,6 +51,11 @@ pub struct Row {
     /// Eye rays only (see [`RunSpec::eye_only`](super::RunSpec::eye_only)).
     #[serde(default)]
     pub eye_only: bool,
+    /// Bytes of the backend's structure per primitive of the scene (nodes and leaves
+    /// with their primitive data; see [`AccelStats::bytes`](crate::accel::AccelStats::bytes)),
+    /// when the backend says.
+    #[serde(default)]
+    pub bytes_per_prim: Option<f64>,
 }
 
 impl Row {
@@ -152,6 +157,9 @@ pub fn rows(samples: &[Sample]) -> Vec<Row> {
                 cpu_ms: median_of(render.iter().filter_map(|s| s.result.cpu_ms)),
                 steal_ms: median_of(render.iter().filter_map(|s| s.result.steal_ms)),
                 eye_only: g[0].spec.eye_only,
+                bytes_per_prim: first
+                    .filter(|r| r.accel_bytes > 0 && r.prims > 0)
+                    .map(|r| r.accel_bytes as f64 / r.prims as f64),
             }
         })
         .collect();
@@ -409,16 +417,16 @@ fn md_header(o: &mut String, machine: &Machine, rows: &[Row]) {
 fn md_rows(o: &mut String, rows: &[Row]) {
     let _ = writeln!(
         o,
-        "| scene | prims | backend | thr | load ms | build ms | render ms | spread | raw ms | render/raw | rays | Mrays/s | peak MiB | ÷ embree |"
+        "| scene | prims | backend | thr | load ms | build ms | render ms | spread | raw ms | render/raw | rays | Mrays/s | peak MiB | bytes/prim | ÷ embree |"
     );
     let _ = writeln!(
         o,
-        "|---|---:|---|---:|---:|---:|---:|---:|---:|---:|---:|---:|---:|---:|"
+        "|---|---:|---|---:|---:|---:|---:|---:|---:|---:|---:|---:|---:|---:|---:|"
     );
     for r in rows {
         let _ = writeln!(
             o,
-            "| {} | {} | {} | {} | {:.1} | {:.1} | {:.1} | {:.0}% | {} | {} | {} | {:.2} | {} | {} |",
+            "| {} | {} | {} | {} | {:.1} | {:.1} | {:.1} | {:.0}% | {} | {} | {} | {:.2} | {} | {} | {} |",
             r.scene,
             r.prims,
             r.backend,
@@ -432,6 +440,7 @@ fn md_rows(o: &mut String, rows: &[Row]) {
             r.rays.total,
             r.mrays_per_s,
             opt(r.peak_mib, 0),
+            opt(r.bytes_per_prim, 0),
             opt(r.vs_embree, 2),
         );
     }
@@ -565,13 +574,13 @@ fn md_peers(o: &mut String, peers: &[PeerRow], peer_note: &str) {
 /// The rows as CSV, one line per row.
 pub fn csv(rows: &[Row]) -> String {
     let mut o = String::from(
-        "scene,prims,backend,threads,reps,load_ms,build_ms,render_ms,spread_pct,raw_ms,render_over_raw,eye,reflection,refraction,shadow,total_rays,mrays_per_s,peak_mib,vs_embree\n",
+        "scene,prims,backend,threads,reps,load_ms,build_ms,render_ms,spread_pct,raw_ms,render_over_raw,eye,reflection,refraction,shadow,total_rays,mrays_per_s,peak_mib,bytes_per_prim,vs_embree\n",
     );
     let f = |v: Option<f64>| v.map_or(String::new(), |x| format!("{x:.4}"));
     for r in rows {
         let _ = writeln!(
             o,
-            "{},{},{},{},{},{:.3},{:.3},{:.3},{:.2},{},{},{},{},{},{},{},{:.4},{},{}",
+            "{},{},{},{},{},{:.3},{:.3},{:.3},{:.2},{},{},{},{},{},{},{},{:.4},{},{},{}",
             r.scene,
             r.prims,
             r.backend,
@@ -590,6 +599,7 @@ pub fn csv(rows: &[Row]) -> String {
             r.rays.total,
             r.mrays_per_s,
             f(r.peak_mib),
+            f(r.bytes_per_prim),
             f(r.vs_embree),
         );
     }
@@ -695,6 +705,7 @@ mod tests {
                 },
                 peak_kib: Some(2048),
                 accel: backend.into(),
+                accel_bytes: 50 * prims,
                 // Threads 90% busy, the host taking 5% of one processor.
                 cpu_ms: Some(ms * threads as f64 * 0.9),
                 steal_ms: Some(ms * 0.05),
@@ -734,6 +745,7 @@ mod tests {
         assert_eq!(r[0].overhead(), Some(11.0 / 8.0));
         assert_eq!(r[1].vs_embree, Some(22.0 / 11.0));
         assert_eq!(r[0].peak_mib, Some(2.0));
+        assert_eq!(r[0].bytes_per_prim, Some(50.0));
         let sum = summary(&r);
         assert_eq!(sum.bvh_vs_embree.get(&1), Some(&2.0));
         assert_eq!(sum.scaling_min["embree"], (2.0, "spd:balls".to_string()));

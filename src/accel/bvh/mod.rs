@@ -131,6 +131,25 @@ impl Bvh {
 
     /// The hierarchy over the bounded primitives of `geometry` and `instances` (an
     /// instance whose object's tree is empty is left out).
+    /// Bytes of the hierarchy: nodes, leaves, the primitives it holds with their ids,
+    /// the unbounded list, the placed instances, and each instanced object's hierarchy
+    /// once however often it is placed.
+    pub fn memory_bytes(&self) -> usize {
+        let own = self.nodes.len() * std::mem::size_of::<Node4>()
+            + self.leaves.len() * std::mem::size_of::<(u32, u32)>()
+            + self.prims.len() * (std::mem::size_of::<Prim>() + std::mem::size_of::<(u32, u32)>())
+            + self.unbounded.memory_bytes()
+            + self.instances.len() * std::mem::size_of::<PlacedObject>();
+        let mut seen = std::collections::HashSet::new();
+        let objects: usize = self
+            .instances
+            .iter()
+            .filter(|i| seen.insert(Arc::as_ptr(&i.object)))
+            .map(|i| i.object.memory_bytes())
+            .sum();
+        own + objects
+    }
+
     fn build_level(geometry: &Geometry, instances: Vec<PlacedObject>) -> Bvh {
         let n = geometry.prim_count() + instances.len();
         let mut prims = Vec::with_capacity(n);
@@ -313,10 +332,7 @@ impl Accel for Bvh {
             backend: "bvh",
             prims: self.prims.len() + self.unbounded.len(),
             nodes: self.nodes.len(),
-            bytes: self.nodes.len() * std::mem::size_of::<Node4>()
-                + self.leaves.len() * std::mem::size_of::<(u32, u32)>()
-                + (self.prims.len() + self.unbounded.len())
-                    * (std::mem::size_of::<Prim>() + std::mem::size_of::<(u32, u32)>()),
+            bytes: self.memory_bytes(),
             detail: format!(
                 "binned SAH, {} bins, max leaf {}, 4-wide nodes",
                 build::BINS,
@@ -486,6 +502,32 @@ mod agreement {
         assert!(max_depth < STACK, "depth {max_depth}");
         // A SAH tree over 5000 scattered primitives is far shallower than a list.
         assert!(max_depth < 40, "depth {max_depth}");
+    }
+
+    #[test]
+    fn memory_counts_an_instanced_object_once() {
+        use crate::scene::Instance;
+        let mut rng = Rng::new(5);
+        let mut scene = random_scene(200, &mut rng);
+        let flat = Bvh::build(&scene);
+        let own = flat.memory_bytes();
+        // The primitives alone take more than 30 bytes each.
+        assert!(own > 200 * 30, "{own}");
+        assert_eq!(flat.stats().bytes, own);
+        scene.objects.push(random_scene(300, &mut rng).geometry);
+        let place = |x: f32| Instance {
+            object: 0,
+            xform: Xform::new(glam::Affine3A::from_translation(Vec3::X * x)).unwrap(),
+            material: 0,
+        };
+        scene.instances.push(place(20.0));
+        let once = Bvh::build(&scene).memory_bytes();
+        scene.instances.push(place(40.0));
+        let twice = Bvh::build(&scene).memory_bytes();
+        let object = Bvh::build_level(&scene.objects[0], Vec::new()).memory_bytes();
+        assert!(once > own + object, "{once} vs {own} + {object}");
+        // A second instance adds its place in the top level, not the object again.
+        assert!(twice - once < object / 4, "{twice} − {once} vs {object}");
     }
 
     #[test]

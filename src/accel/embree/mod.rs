@@ -83,7 +83,10 @@ impl EmbreeAccel {
             quality.name(),
         );
         Ok(EmbreeAccel {
-            bytes: device.allocated_bytes(),
+            // Embree's own allocations (hierarchy, triangle buffers), read after the
+            // commit has freed the build's temporaries, and the primitive data emray
+            // keeps for the callbacks.
+            bytes: device.allocated_bytes() + committed.rust_bytes(),
             scene: committed,
             device,
             prims: scene.prim_count_with_instances(),

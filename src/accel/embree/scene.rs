@@ -98,7 +98,7 @@ pub(super) struct CommittedScene {
     // Fields drop in declaration order: the top level first, so the instance
     // geometries let go of the objects' scenes before those are released.
     top: Level,
-    _objects: Vec<Level>,
+    objects: Vec<Level>,
     /// What Embree cannot hold (infinite bounds), intersected in Rust before each query.
     unbounded: Unbounded,
     /// The kinds attached, with counts (see [`crate::accel::AccelStats::kinds`]).
@@ -214,6 +214,15 @@ impl KindVisitor for AttachUser<'_> {
 }
 
 impl CommittedScene {
+    /// Bytes of what the scene keeps on emray's side for Embree: the user geometries'
+    /// primitive lists and the unbounded primitives.
+    pub(super) fn rust_bytes(&self) -> usize {
+        let user = |level: &Level| level.user.kinds.iter().map(|k| k.bytes()).sum::<usize>();
+        user(&self.top)
+            + self.objects.iter().map(user).sum::<usize>()
+            + self.unbounded.memory_bytes()
+    }
+
     /// Build and commit the scene of `scene`'s primitives at build quality `quality`,
     /// every level with `RTC_SCENE_FLAG_ROBUST` if `robust`.
     pub(super) fn build(
@@ -248,7 +257,7 @@ impl CommittedScene {
         top.commit(device, quality)?;
         Ok(CommittedScene {
             top,
-            _objects: objects,
+            objects,
             unbounded: Unbounded::new(scene),
             kinds,
         })

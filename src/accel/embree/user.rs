@@ -79,9 +79,16 @@ pub(super) trait UserGeometry: Send + Sync + std::fmt::Debug {
     /// The message of a panic caught in the bounds callback during the last commit
     /// (naming the callback and the kind), if there was one.
     fn bounds_panic(&self) -> Option<String>;
+    /// Bytes of the primitives and ids the callbacks read (emray's memory, which
+    /// Embree's memory monitor does not see).
+    fn bytes(&self) -> usize;
 }
 
 impl<T: Analytic> UserGeometry for UserPrims<T> {
+    fn bytes(&self) -> usize {
+        self.items.len() * std::mem::size_of::<T>() + self.ids.len() * std::mem::size_of::<u32>()
+    }
+
     fn bounds_panic(&self) -> Option<String> {
         self.bounds_panic
             .get()
