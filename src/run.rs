@@ -3,16 +3,20 @@
 //! ([`RenderRequest::settings`]), check the memory it needs ([`limits`]), build the
 //! backend and render ([`render_scene`], [`render_two_pass`], [`render_reference`]).
 
+mod aov;
+mod explain;
 pub mod limits;
 mod request;
 
+pub use aov::{AovRunError, render_aov};
+pub use explain::{ExplainRunError, explain_pixel};
 pub use request::{
     CropSpecError, DEFAULT_MAX_DEPTH, DEFAULT_SPP, IndexOfError, Part, RenderRequest,
     SPD_MAX_DEPTH, SPD_SIDE, SettingsError, parse_crop, parse_index_of, parse_tile,
 };
 
 use crate::accel::{self, Accel, AccelError, AccelStats, BackendOptions, WithAccel};
-use crate::geometry::Kind;
+use crate::geometry::{Kind, Shape};
 use crate::load::{self, LoadError};
 use crate::radiosity::{RadiosityError, RadiositySettings};
 use crate::render::{self, Film, Progress, RenderSettings, RenderStats};
@@ -79,7 +83,9 @@ pub struct Report {
     pub aa: String,
     /// `--bailout` weight (0 = full ray tree).
     pub bailout: f32,
-    /// Primitives by kind (`triangles`, `spheres`, `cones`).
+    /// Primitives a ray can meet (instanced objects counted once per instance), by
+    /// kind, with cylinders named apart (`triangles`, `spheres`, `cones`,
+    /// `open_cylinders`, `cylinders`, ...).
     pub prims: BTreeMap<&'static str, usize>,
     /// Lights.
     pub lights: usize,
@@ -100,8 +106,44 @@ pub struct Report {
     /// Primitives in the backend's structure ([`AccelStats::prims`]).
     pub accel_prims: usize,
     /// The primitive kinds the backend holds and dispatches to
-    /// ([`AccelStats::kinds`]), e.g. `spheres×8, triangles×1`.
+    /// ([`AccelStats::kinds`]), e.g. `triangles, spheres`.
     pub kinds: String,
+}
+
+/// The primitives a ray can meet (each instance's copy of its object counted), by the
+/// name a user knows them by: a kind's plural name, except that cones and capped cones
+/// with equal radii are (open) cylinders.
+fn prim_counts(scene: &Scene) -> BTreeMap<&'static str, usize> {
+    let mut counts = BTreeMap::new();
+    let mut add = |geometry: &crate::scene::Geometry, times: usize| {
+        let tris = geometry.count(Kind::Triangle) * times;
+        if tris > 0 {
+            *counts.entry(Kind::Triangle.name()).or_insert(0) += tris;
+        }
+        for entry in geometry.shapes() {
+            *counts.entry(prim_name(&entry.shape)).or_insert(0) += times;
+        }
+    };
+    add(&scene.geometry, 1);
+    let mut placed = vec![0usize; scene.objects.len()];
+    for inst in &scene.instances {
+        placed[inst.object as usize] += 1;
+    }
+    for (object, times) in scene.objects.iter().zip(placed) {
+        if times > 0 {
+            add(object, times);
+        }
+    }
+    counts
+}
+
+/// What `--stats` calls `shape`.
+fn prim_name(shape: &Shape) -> &'static str {
+    match shape {
+        Shape::Cone(c) if c.is_cylinder() => "open_cylinders",
+        Shape::CappedCone(c) if c.is_cylinder() => "cylinders",
+        other => other.kind().name(),
+    }
 }
 
 impl Report {
@@ -131,10 +173,7 @@ impl Report {
                 }
             },
             bailout: settings.bailout,
-            prims: Kind::ALL
-                .iter()
-                .map(|&k| (k.name(), scene.count_with_instances(k)))
-                .collect(),
+            prims: prim_counts(scene),
             lights: scene.lights.len(),
             transmitters: scene.materials.iter().any(|m| m.t > 0.0),
             degenerate_dropped: scene.load_stats.degenerate_dropped,
@@ -307,15 +346,7 @@ struct TwoPassWork<'a> {
 impl WithAccel for TwoPassWork<'_> {
     type Output = Result<(Film, Report), RadiosityError>;
     fn run<A: Accel>(self, accel: &A, build_ms: f64) -> Self::Output {
-        let sol = crate::radiosity::solve(self.scene, accel, self.rad)?;
-        log::info!(
-            "radiosity: {} elements, {} shots, residual {:.2e}, form factors {:.0} ms, solve {:.0} ms",
-            sol.mesh.elements.len(),
-            sol.solve.iterations,
-            sol.solve.residuals.last().copied().unwrap_or(0.0),
-            sol.solve.form_factor_ms,
-            sol.solve.total_ms
-        );
+        let sol = solve_logged(self.scene, accel, self.rad)?;
         let (film, stats) =
             render::render_with_gi(self.scene, accel, self.settings, Some(&sol), self.progress);
         let t = Timings {
@@ -334,6 +365,24 @@ impl WithAccel for TwoPassWork<'_> {
         );
         Ok((film, report))
     }
+}
+
+/// Solve the radiosity of `scene` with `accel`'s visibility, and log what it took.
+fn solve_logged<A: Accel>(
+    scene: &Scene,
+    accel: &A,
+    rad: &RadiositySettings,
+) -> Result<crate::radiosity::Solution, RadiosityError> {
+    let sol = crate::radiosity::solve(scene, accel, rad)?;
+    log::info!(
+        "radiosity: {} elements, {} shots, residual {:.2e}, form factors {:.0} ms, solve {:.0} ms",
+        sol.mesh.elements.len(),
+        sol.solve.iterations,
+        sol.solve.residuals.last().copied().unwrap_or(0.0),
+        sol.solve.form_factor_ms,
+        sol.solve.total_ms
+    );
+    Ok(sol)
 }
 
 /// Two-pass rendering: build the backend over `scene`, solve its radiosity with the
@@ -360,6 +409,37 @@ pub fn render_two_pass(
     accel::build(scene, &backend.into(), work)?
 }
 
+/// Runs of the reference longer than this are announced with their estimated time.
+const LONG_REFERENCE_MS: f64 = 60_000.0;
+
+/// Say how long the reference render will take when that is more than a minute, so
+/// that a user can stop it (or lower `--res` or `--spp`) before waiting.
+fn warn_if_long(scene: &Scene, settings: &RenderSettings, strata: u32) {
+    let (w, h) = (settings.width, settings.height);
+    let threads = rayon::current_num_threads();
+    let ms = render::reference::estimate_ms(scene, w, h, strata, settings.max_depth, threads);
+    if ms > LONG_REFERENCE_MS {
+        log::warn!(
+            "the f64 reference renders every primitive for every ray: this {w}x{h} render \
+             with {} samples per pixel will take about {} on {threads} threads",
+            strata * strata,
+            format_duration(ms)
+        );
+    }
+}
+
+/// A duration for people: seconds, minutes or hours.
+fn format_duration(ms: f64) -> String {
+    let s = ms / 1e3;
+    if s < 120.0 {
+        format!("{s:.0} s")
+    } else if s < 7200.0 {
+        format!("{:.0} min", s / 60.0)
+    } else {
+        format!("{:.1} h", s / 3600.0)
+    }
+}
+
 /// Render `scene` with the f64 reference renderer ([`render::reference`]) using
 /// `strata × strata` samples per pixel; `Err` names what the reference does not model.
 pub fn render_reference(
@@ -372,6 +452,7 @@ pub fn render_reference(
     if let Some(why) = render::reference::unsupported(scene) {
         return Err(why);
     }
+    warn_if_long(scene, settings, strata);
     let t0 = Instant::now();
     let (film, rays) = render::reference::render(
         scene,
@@ -407,4 +488,40 @@ pub fn render_reference(
         render: stats.render_ms,
     };
     Ok((film, Report::new(name, scene, &st, &accel, t, &stats)))
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+
+    #[test]
+    fn durations_read_as_seconds_minutes_or_hours() {
+        assert_eq!(format_duration(61_000.0), "61 s");
+        assert_eq!(format_duration(600_000.0), "10 min");
+        assert_eq!(format_duration(9_000_000.0), "2.5 h");
+    }
+
+    /// The estimate traces real pixels: a scene with 50× more spheres for every ray is
+    /// estimated as much slower (timing noise cannot bridge a factor of 50).
+    #[test]
+    fn the_reference_estimate_grows_with_the_work() {
+        let scene = |n: usize| {
+            let mut src = String::from(
+                "v\nfrom 0 -8 0\nat 0 0 0\nup 0 0 1\nangle 40\nhither 0\nresolution 16 16\n\
+                 f 0.8 0.8 0.8 1 0 0 0 1\n",
+            );
+            for k in 0..n {
+                src += &format!(
+                    "s {} 0 {} 0.1\n",
+                    (k % 20) as f32 * 0.2 - 2.0,
+                    (k / 20) as f32 * 0.2 - 2.0
+                );
+            }
+            load::nff::parse_str(&src, Path::new("<estimate>")).unwrap()
+        };
+        let (few, many) = (scene(8), scene(400));
+        let est = |s: &Scene| render::reference::estimate_ms(s, 256, 256, 2, 1, 1);
+        let (a, b) = (est(&few), est(&many));
+        assert!(a.is_finite() && a > 0.0 && b > 10.0 * a, "{a} {b}");
+    }
 }

@@ -151,6 +151,8 @@ fn child_runs_report_the_same_rays_on_both_modes() {
         mode: Mode::Raw,
         embree_quality: Default::default(),
         packet_width: 8,
+        embree_fast: false,
+        eye_only: false,
     };
     let raw = bench::run_child(&spec).unwrap();
     let render = bench::run_child(&RunSpec {

@@ -11,8 +11,10 @@ use std::path::Path;
 /// A viewpoint block, as the SPD programs write it.
 const V: &str = "v\nfrom 0 0 -10\nat 0 0 0\nup 0 1 0\nangle 45\nhither 1\nresolution 64 48\n";
 
+/// Parse in the world's frame (origin 0), so that the scene holds the file's own
+/// coordinates; `frame_is_the_eye` checks the default frame.
 fn parse(src: &str) -> Result<Scene, LoadError> {
-    parse_str(src, Path::new("test.nff"))
+    emray::load::nff::parse_str_at(src, Path::new("test.nff"), glam::DVec3::ZERO)
 }
 
 fn ok(src: &str) -> Scene {
@@ -414,6 +416,31 @@ fn degenerate_polygons_warn_once_per_file() {
     // A clean file warns about nothing.
     parse_str(V, Path::new("no-warning.nff")).unwrap();
     assert!(warnings_about("no-warning.nff").is_empty());
+}
+
+/// Colours above 1 (a 0–255 scale by mistake) are a warning at the colour, for the
+/// fill colour and the background; light colours (intensities) may exceed 1.
+#[test]
+fn colours_above_one_warn() {
+    warnings_about("");
+    let src = format!("b 0 0 300\n{V}l 0 5 0 2 2 2\nf 255 0 0 1 0 0 0 1\ns 0 0 0 1\n");
+    parse_str(&src, Path::new("bytes.nff")).unwrap();
+    let w = warnings_about("bytes.nff");
+    assert_eq!(w.len(), 2, "{w:?}");
+    assert!(
+        w[0].contains("bytes.nff:1:3: the background colour 0 0 300"),
+        "{}",
+        w[0]
+    );
+    assert!(
+        w[1].contains("bytes.nff:10:3: the fill colour 255 0 0"),
+        "{}",
+        w[1]
+    );
+    assert!(w[1].contains("0-255 scale"), "{}", w[1]);
+    let src = format!("b 0 0 1\n{V}l 0 5 0 2 2 2\nf 1 0.5 0 1 0 0 0 1\ns 0 0 0 1\n");
+    parse_str(&src, Path::new("unit.nff")).unwrap();
+    assert!(warnings_about("unit.nff").is_empty());
 }
 
 #[test]
@@ -999,4 +1026,48 @@ fn spd_files_load_with_the_published_counts() {
             assert!(rel < 1e-5, "{name}: area off by {rel:e}");
         }
     }
+}
+
+/// Two vectors equal to within a relative 2⁻²² (an ulp or two of single precision).
+fn same_f32(a: Vec3, b: Vec3) -> bool {
+    (a - b).abs().max_element() <= 2.4e-7 * a.abs().max_element().max(b.abs().max_element())
+}
+
+/// The scene's frame has its origin at the eye, and points are read in double
+/// precision: the same scene a million units away reads into the same numbers, where
+/// single precision alone would have kept about a tenth of a unit.
+#[test]
+fn the_frame_is_the_eye_and_far_scenes_keep_their_detail() {
+    let near = "v\nfrom 0.1 -5.3 1.7\nat 0 0 0.5\nup 0 0 1\nangle 40\nhither 0\n\
+        resolution 8 8\nl 3 -2 5\ns 0.3 0.2 0.1 0.7\nc 0 0 0 0.2 0 0 1 0.1\n\
+        p 3 0 0 0 1 0 0 0 1 0.3\n";
+    let shift = glam::DVec3::new(1e6, -1e6, 1e6);
+    let far = emray::quality::moved::move_nff(near, 1.0, shift).unwrap();
+    let a = parse_str(near, Path::new("near.nff")).unwrap();
+    let b = parse_str(&far, Path::new("far.nff")).unwrap();
+    assert_eq!(a.origin, glam::DVec3::new(0.1, -5.3, 1.7));
+    assert!((b.origin - (a.origin + shift)).abs().max_element() < 1e-9);
+    assert_eq!((a.camera.from, b.camera.from), (Vec3::ZERO, Vec3::ZERO));
+    assert!(same_f32(a.camera.at, b.camera.at));
+    assert!(same_f32(a.camera.at, Vec3::new(-0.1, 5.3, -1.2)));
+    assert!(same_f32(a.lights[0].pos, b.lights[0].pos));
+    let (sa, sb) = (a.geometry.spheres().items[0], b.geometry.spheres().items[0]);
+    assert!(
+        same_f32(sa.center, sb.center),
+        "{} {}",
+        sa.center,
+        sb.center
+    );
+    assert!(same_f32(sa.center, Vec3::new(0.2, 5.5, -1.6)));
+    let (ca, cb) = (a.geometry.cones().items[0], b.geometry.cones().items[0]);
+    assert!(same_f32(ca.base, cb.base) && same_f32(ca.apex, cb.apex));
+    for k in 0..3 {
+        let (pa, pb) = (
+            a.geometry.triangles.items[0].p[k],
+            b.geometry.triangles.items[0].p[k],
+        );
+        assert!(same_f32(pa, pb), "{pa} {pb}");
+    }
+    // World points come back through the origin.
+    assert!((a.to_world(sa.center) - glam::DVec3::new(0.3, 0.2, 0.1)).length() < 1e-6);
 }

@@ -494,7 +494,7 @@ const TRI: &str = "v 0 0 0\nv 1 0 0\nv 0 1 0\n";
 
 #[test]
 fn malformed_files_are_errors_at_their_line() {
-    // Bad numbers (found after the structural checks pass, since tobj has no lines).
+    // Bad numbers (reported unless a structural problem comes first).
     fails("v 0 0 0\nv 1 x 0\n", 2, 5, "expected vertex y, found 'x'");
     fails("v 0 0 0\nvn 0 0 1.5.2\n", 2, 8, "expected normal z");
     fails("vt 0.5 abc\n", 1, 8, "expected texture v");
@@ -579,8 +579,10 @@ fn malformed_files_are_errors_at_their_line() {
 
 #[test]
 fn forward_references_within_the_file_are_accepted() {
-    // tobj resolves indices when a group ends, so a face may name a vertex defined
-    // after it; only an index beyond the whole file is an error.
+    // Indices are checked when a run of faces ends (at `g`, `o`, a `usemtl` that
+    // changes the material, or the end of the file), so a face may name a vertex
+    // defined after it in its run. An index beyond the whole file is an error at its
+    // line; one beyond its run, an error for the whole file.
     let (_dir, _path, r) = load_text("f 1 2 3\nv 0 0 0\nv 1 0 0\nv 0 1 0\n", &[]);
     assert_eq!(r.unwrap().geometry.triangles.len(), 1);
     fails(
@@ -588,6 +590,13 @@ fn forward_references_within_the_file_are_accepted() {
         2,
         7,
         "index 9",
+    );
+    let (_dir, path, r) = load_text("f 1 2 3\ng next\nv 0 0 0\nv 1 0 0\nv 0 1 0\n", &[]);
+    let e = r.unwrap_err();
+    assert_eq!((e.path, e.line), (path, 0));
+    assert_eq!(
+        e.message,
+        "malformed OBJ file (face vertex index out of bounds)"
     );
 }
 
@@ -649,9 +658,14 @@ fn automatic_camera_sees_the_whole_model() {
     let c = scene.camera;
     assert_eq!(c.angle_deg, AUTO_FOV_DEG);
     assert_eq!((c.width, c.height), (512, 512));
-    assert!(c.from.z > hi.z, "camera on the +z side");
+    assert!(
+        scene.to_world(c.from).z > hi.z as f64,
+        "camera on the +z side"
+    );
     assert!(c.from.y > c.at.y, "camera above the centre");
-    assert!(close(c.at, (lo + hi) * 0.5));
+    // The model alone is re-centred: its centre is the frame's origin.
+    assert!((scene.origin - ((lo + hi) * 0.5).as_dvec3()).length() < 1e-6);
+    assert!(close(c.at, Vec3::ZERO));
 
     // The camera's basis, as the eye rays are built.
     let forward = (c.at - c.from).normalize();
@@ -665,7 +679,7 @@ fn automatic_camera_sees_the_whole_model() {
             if i & 2 == 0 { lo.y } else { hi.y },
             if i & 4 == 0 { lo.z } else { hi.z },
         );
-        let v = p - c.from;
+        let v = (p.as_dvec3() - scene.origin).as_vec3() - c.from;
         let z = v.dot(forward);
         assert!(z > 0.0, "corner {p} behind the camera");
         let (x, y) = (v.dot(right) / z, v.dot(up) / z);
@@ -765,4 +779,42 @@ fn crlf_line_endings_and_latin1_comments() {
     let data = ok(&dir.path().join("cube.obj"));
     assert_eq!(data.geometry.triangles.len(), 12);
     assert!(data.warnings.is_empty(), "{:?}", data.warnings);
+}
+
+/// Positions are read in double precision and a model rendered alone is re-centred on
+/// the centre of its bounds: the same model a million units away loads into the same
+/// single-precision triangles, where single precision alone would have kept about a
+/// tenth of a unit.
+#[test]
+fn far_models_keep_their_detail() {
+    let model = |s: f64| {
+        let mut obj = String::new();
+        for (x, y, z) in [
+            (0.1, 0.2, 0.3),
+            (1.3, 0.2, 0.3),
+            (0.7, 1.1, 0.35),
+            (0.7, 0.5, 1.2),
+        ] {
+            obj += &format!("v {:?} {:?} {:?}\n", x + s, y - s, z + s);
+        }
+        obj + "f 1 3 2\nf 1 2 4\nf 2 3 4\nf 3 1 4\n"
+    };
+    let dir = dir_with(&[("near.obj", &model(0.0)), ("far.obj", &model(1e6))]);
+    let a = load(&dir.path().join("near.obj")).unwrap();
+    let b = load(&dir.path().join("far.obj")).unwrap();
+    assert!((b.origin - a.origin - glam::DVec3::new(1e6, -1e6, 1e6)).length() < 1e-6);
+    assert_eq!(a.camera, b.camera);
+    assert_eq!(a.lights, b.lights);
+    for (ta, tb) in a
+        .geometry
+        .triangles
+        .items
+        .iter()
+        .zip(&b.geometry.triangles.items)
+    {
+        for k in 0..3 {
+            let d = (ta.p[k] - tb.p[k]).abs().max_element();
+            assert!(d < 1e-6, "{} {}", ta.p[k], tb.p[k]);
+        }
+    }
 }

@@ -445,7 +445,7 @@ fn the_view_shows_the_interpolated_solution() {
         .fold(0.0f32, f32::max);
     assert!(film.pixels.iter().all(|p| p.max_element() <= hi * 1.0001));
     // The PLY lists every vertex and element.
-    let ply = sol.to_ply(1.0);
+    let ply = sol.to_ply(1.0, glam::DVec3::ZERO);
     assert!(ply.contains(&format!("element vertex {}", sol.mesh.vertices.len())));
     assert_eq!(
         ply.lines().count(),
@@ -853,9 +853,11 @@ fn classroom_ceiling_and_desk_undersides_are_lit_only_indirectly_but_lit() {
         assert!(a > 0.0);
         b / a
     };
-    let ceiling = mean(&|e| e.n.y < -0.9 && e.centroid().y > 2.995);
-    let undersides = mean(&|e| e.n.y < -0.9 && (e.centroid().y - 0.7).abs() < 1e-3);
-    let floor = mean(&|e| e.n.y > 0.9 && e.centroid().y < 1e-3);
+    // Heights in the world (the scene is in the frame of its eye).
+    let y = |e: &radiosity::mesh::Element| scene.to_world(e.centroid()).y;
+    let ceiling = mean(&|e| e.n.y < -0.9 && y(e) > 2.995);
+    let undersides = mean(&|e| e.n.y < -0.9 && (y(e) - 0.7).abs() < 1e-3);
+    let floor = mean(&|e| e.n.y > 0.9 && y(e) < 1e-3);
     // The panels face down from just under the ceiling and the desk tops hide them
     // from their undersides: these receive only interreflected light, and get some.
     assert!(

@@ -3,6 +3,7 @@
 //! points, NFF files are included, and every malformed file is reported at the right
 //! line. Errors are checked against a `# HERE` marker on the line they must name.
 
+mod common;
 use emray::geometry::{Intersect, Kind, Primitive, Shape};
 use emray::load::LoadError;
 use emray::load::toml::{self as scene_toml, SceneSettings, format::SceneFile};
@@ -12,8 +13,10 @@ use std::path::{Path, PathBuf};
 
 const CAMERA: &str = "[camera]\nfrom = [0, 0, 10]\nat = [0, 0, 0]\n";
 
+/// Parse in the world's frame (origin 0), so that the scene holds the file's own
+/// coordinates; `the_frame_is_the_eye` checks the default frame.
 fn parse(src: &str) -> Result<Scene, LoadError> {
-    scene_toml::parse_str(src, Path::new("test.toml"))
+    scene_toml::parse_str_at(src, Path::new("test.toml"), glam::DVec3::ZERO)
 }
 
 /// A scene made of `CAMERA` followed by `body`.
@@ -439,9 +442,11 @@ exponent = 4
 "#;
     let (s, settings) = scene_toml::parse_str_with_settings(src, Path::new("c.toml")).unwrap();
     let c = s.camera;
+    // The scene's frame has its origin at the eye: every point is relative to it.
+    assert_eq!(s.origin, glam::DVec3::new(0.0, 2.0, 8.0));
     assert_eq!(
         (c.from, c.at, c.up),
-        (Vec3::new(0.0, 2.0, 8.0), Vec3::new(0.0, 0.5, 0.0), Vec3::Z)
+        (Vec3::ZERO, Vec3::new(0.0, -1.5, -8.0), Vec3::Z)
     );
     assert_eq!(
         (c.angle_deg, c.hither, c.width, c.height),
@@ -463,7 +468,7 @@ exponent = 4
     assert_eq!(
         (p.pos, p.color, p.attenuation),
         (
-            Vec3::new(5.0, 8.0, 5.0),
+            Vec3::new(5.0, 6.0, -3.0),
             Vec3::new(0.5, 0.25, 0.125),
             Vec3::new(1.0, 0.0, 0.01)
         )
@@ -883,7 +888,7 @@ fn errors_of_the_new_primitives() {
     );
     error_at(
         "[[objects]]\ntype = \"quadric\"\ncoefficients = [1, 1, 1] # HERE\n",
-        &["invalid length 3"],
+        &["expected an array of 10 values, found an array of 3 values"],
     );
     error_at(
         "[[objects]]\ntype = \"plane\"\npoint = [0, 0, 0]\nnormal = [0, 0, 0] # HERE\n",
@@ -1224,15 +1229,13 @@ children = [{ type = "difference", material = "outer", children = [
 ] }]
 "#,
     );
-    // Transformed at the top level: an object of its own, placed by an instance.
+    // Translated at the top level: the translation goes into the leaves, no instance.
     assert_eq!(s.count_with_instances(Kind::Csg), 1);
-    assert_eq!((s.objects.len(), s.instances.len()), (1, 1));
-    let inst = &s.instances[0];
-    let shape = &shape_at(&s.objects[0], 0);
+    assert_eq!((s.objects.len(), s.instances.len()), (0, 0));
+    let shape = &shape_at(&s.geometry, 0);
     let Shape::Csg(csg) = shape else { panic!() };
     assert_eq!(csg.leaf_count(), 5);
-    assert_eq!(inst.material, 0); // outer
-    assert_eq!(s.objects[0].shapes().next().unwrap().material, 0);
+    assert_eq!(s.geometry.shapes().next().unwrap().material, 0); // outer
     assert_eq!(csg.leaf_material(0), Some(2)); // inner, from the union
     assert_eq!(csg.leaf_material(2), Some(1)); // cut, its own
     assert_eq!(csg.leaf_material(3), None); // the root's (outer)
@@ -1250,7 +1253,7 @@ children = [{ type = "difference", material = "outer", children = [
         Vec3::new(-1.1, 0.0, 0.0),    // outside the union
         Vec3::new(0.0, 0.0, 0.0) - o, // the untranslated origin
     ];
-    let world_contains = |p: Vec3| shape.contains(inst.xform.to_object.transform_point3(p));
+    let world_contains = |p: Vec3| shape.contains(p);
     for p in inside {
         assert!(world_contains(o + p), "{p} should be inside");
     }
@@ -1360,7 +1363,7 @@ fn bezier_patches_tessellate_in_final_coordinates() {
     );
     error_at(
         "[[objects]]\ntype = \"bezier\"\npatches = [\n  [[0, 0, 0], [1, 0, 0]], # HERE\n]\n",
-        &["invalid length 2", "16"],
+        &["expected an array of 16 values, found an array of 2 values"],
     );
     error_at(
         "[[objects]]\ntype = \"bezier\"\nbuiltin = \"teapot\"\ntolerance = 0 # HERE\n",
@@ -1426,7 +1429,7 @@ children = [
 ]
 "#;
     let a = emray::load::nff::parse_str(nff, Path::new("a.nff")).unwrap();
-    let b = parse(toml).unwrap();
+    let b = scene_toml::parse_str(toml, Path::new("b.toml")).unwrap();
     assert_eq!(a.camera, b.camera);
     assert_eq!(a.background, b.background);
     assert_eq!(a.ambient, b.ambient);
@@ -1485,7 +1488,8 @@ material = "mine"
 "#
         ),
     );
-    let s = scene_toml::load(&main).unwrap();
+    let text = std::fs::read_to_string(&main).unwrap();
+    let s = scene_toml::parse_str_at(&text, &main, glam::DVec3::ZERO).unwrap();
     // Our material, then the NFF's two (read once).
     assert_eq!(s.materials.len(), 3);
     assert_eq!(s.materials[1].color, Vec3::X);
@@ -1703,17 +1707,20 @@ fn error_key_of_another_type() {
 fn error_wrong_type() {
     error_at(
         "[[objects]]\ntype = \"sphere\"\ncenter = [0, 0, 0]\nradius = \"big\" # HERE\n",
-        &["invalid type", "a number"],
+        &["expected a number, found the string \"big\""],
     );
     error_at(
         "[[objects]]\ntype = \"sphere\"\ncenter = [0, 0] # HERE\nradius = 1\n",
-        &["invalid length 2"],
+        &["expected an array of 3 values, found an array of 2 values"],
     );
     error_at(
         "[[objects]]\ntype = \"group\"\nchildren = { type = \"sphere\" } # HERE\n",
-        &["invalid type"],
+        &["expected an array, found a table"],
     );
-    error_at("[render]\nspp = -1 # HERE\n", &["invalid value"]);
+    error_at(
+        "[render]\nspp = -1 # HERE\n",
+        &["expected a whole number, 0 or more, found the whole number -1"],
+    );
     error_at(
         "[[objects]]\ntype = \"sphere\"\ncenter = [0, 0, 0]\nradius = 1\ntransform = [{ scale = \"x\" }] # HERE\n",
         &["a number or an array of 3 numbers"],
@@ -2059,4 +2066,94 @@ color = [0, 0, 1]
         "[[objects]]\ntype = \"group\"\n[[objects.children]]\ntype = \"sphere\"\ncenter = [1, 0, 0]\nradius = 0 # HERE\n",
         &["must be positive"],
     );
+}
+
+/// A material colour or the background above 1 (a 0–255 scale by mistake) is a
+/// warning at the value; light intensities may exceed 1.
+#[test]
+fn colours_above_one_warn() {
+    let dir = tempfile::tempdir().unwrap();
+    std::fs::write(
+        dir.path().join("s.toml"),
+        "[camera]\nfrom = [0, 0, 5]\nat = [0, 0, 0]\nresolution = [8, 8]\n\
+         [render]\nbackground = [0.1, 0.2, 0.3]\n\
+         [materials.red]\ncolor = [200, 30, 30]\n\
+         [[lights]]\nposition = [0, 5, 5]\nintensity = 3\n\
+         [[objects]]\ntype = \"sphere\"\ncenter = [0, 0, 0]\nradius = 1\nmaterial = \"red\"\n",
+    )
+    .unwrap();
+    let out = common::emray(dir.path(), &["render", "s.toml", "-o", "s.png"]);
+    let err = common::stderr(&out);
+    assert!(out.status.success(), "{err}");
+    assert_eq!(err.matches("above 1").count(), 1, "{err}");
+    assert!(
+        err.contains("s.toml:8:9: `color` [200, 30, 30] has channels above 1"),
+        "{err}"
+    );
+}
+
+/// A TOML scene's frame has its origin at the eye, and its points are read in double
+/// precision: the same scene a million units away (its coordinates shifted, not a
+/// transform) builds into the same single-precision numbers, primitives placed in
+/// place, by a rotation (an instance) or inside a CSG alike.
+#[test]
+fn the_frame_is_the_eye_and_far_scenes_keep_their_detail() {
+    let scene = |s: f64| {
+        let p = |x: f64, y: f64, z: f64| format!("[{:?}, {:?}, {:?}]", x + s, y - s, z + s);
+        format!(
+            "[camera]\nfrom = {}\nat = {}\n\
+             [[lights]]\nposition = {}\n\
+             [[objects]]\ntype = \"sphere\"\ncenter = {}\nradius = 0.7\n\
+             [[objects]]\ntype = \"quadric\"\ncoefficients = [1, 1, 1, 0, 0, 0, 0, 0, 0, -0.25]\n\
+             transform = [{{ translate = {} }}]\n\
+             [[objects]]\ntype = \"mesh\"\nvertices = [{}, {}, {}]\nfaces = [[0, 1, 2]]\n\
+             [[objects]]\ntype = \"union\"\nchildren = [\n\
+               {{ type = \"sphere\", center = {}, radius = 0.3 }},\n\
+               {{ type = \"box\", min = {}, max = {} }},\n]\n",
+            p(0.1, -5.3, 1.7),
+            p(0.0, 0.0, 0.5),
+            p(3.0, -2.0, 5.0),
+            p(0.3, 0.2, 0.1),
+            p(-1.0, 0.5, 0.25),
+            p(0.0, 0.0, 0.0),
+            p(1.0, 0.0, 0.0),
+            p(0.0, 1.0, 0.3),
+            p(2.0, 0.0, 0.0),
+            p(2.1, -0.1, -0.1),
+            p(2.4, 0.2, 0.2),
+        )
+    };
+    let a = scene_toml::parse_str(&scene(0.0), Path::new("near.toml")).unwrap();
+    let b = scene_toml::parse_str(&scene(1e6), Path::new("far.toml")).unwrap();
+    assert_eq!(a.camera.from, Vec3::ZERO);
+    assert_eq!(a.camera, b.camera);
+    assert_eq!(a.lights, b.lights);
+    assert_eq!(a.count_with_instances(Kind::Csg), 1);
+    assert!(a.instances.is_empty(), "translations stay in place");
+    // Every primitive in the same place, and hit by the same ray at the same distance.
+    let ray = emray::math::Ray::new(Vec3::ZERO, a.camera.at);
+    for (sa, sb) in a.geometry.shapes().zip(b.geometry.shapes()) {
+        let (ba, bb) = (sa.shape.bounds(), sb.shape.bounds());
+        let d = (ba.min - bb.min)
+            .abs()
+            .max(ba.max - bb.max)
+            .abs()
+            .max_element();
+        assert!(d < 1e-6, "{:?}: {ba:?} {bb:?}", sa.kind);
+        let (ha, hb) = (sa.shape.intersect(&ray), sb.shape.intersect(&ray));
+        let (ta, tb) = (ha.map(|h| h.t), hb.map(|h| h.t));
+        match (ta, tb) {
+            (Some(x), Some(y)) => assert!((x - y).abs() <= 1e-6 * x, "{:?}: {x} {y}", sa.kind),
+            _ => assert_eq!(ta, tb, "{:?}", sa.kind),
+        }
+    }
+    let (ta, tb) = (a.geometry.triangles.items[0], b.geometry.triangles.items[0]);
+    for k in 0..3 {
+        assert!(
+            (ta.p[k] - tb.p[k]).abs().max_element() < 1e-6,
+            "{} {}",
+            ta.p[k],
+            tb.p[k]
+        );
+    }
 }

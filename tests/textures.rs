@@ -614,7 +614,11 @@ fn quad_faces_take_the_inverse_bilinear_uv() {
     for (scene, quad) in [(&obj, KITE), (&toml, placed)] {
         let rays: Vec<Ray> = samples
             .iter()
-            .map(|&(s, t)| Ray::new(bilinear_point(quad, s, t) + Vec3::Z * 5.0, -Vec3::Z))
+            .map(|&(s, t)| {
+                // Aimed in the world, cast in the scene's frame.
+                let org = (bilinear_point(quad, s, t) + Vec3::Z * 5.0).as_dvec3() - scene.origin;
+                Ray::new(org.as_vec3(), -Vec3::Z)
+            })
             .collect();
         for backend in backends() {
             let work = UvAtHits { scene, rays: &rays };

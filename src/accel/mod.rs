@@ -56,16 +56,15 @@ pub(crate) fn add_kind(kinds: &mut Vec<(Kind, usize)>, kind: Kind, n: usize) {
     }
 }
 
-/// `sphere×12, cone×3` for [`AccelStats::kinds`] (`none` when empty).
+/// The names of the kinds of [`AccelStats::kinds`], `spheres, cones` (`none` when
+/// empty). The counts are left out: the backend holds each instanced object once, so
+/// they are not the number of primitives a ray can meet, which `--stats` gives.
 pub fn kinds_summary(kinds: &[(Kind, usize)]) -> String {
     if kinds.is_empty() {
         return "none".into();
     }
-    let parts: Vec<String> = kinds
-        .iter()
-        .map(|(k, n)| format!("{}×{n}", k.name()))
-        .collect();
-    parts.join(", ")
+    let names: Vec<&str> = kinds.iter().map(|(k, _)| k.name()).collect();
+    names.join(", ")
 }
 
 /// A ray-query structure built over a [`Scene`].
@@ -123,8 +122,8 @@ pub struct BackendOptions {
     pub backend: Backend,
     /// Embree's build quality.
     pub embree_quality: EmbreeQuality,
-    /// Embree's `RTC_SCENE_FLAG_ROBUST` on every scene it commits (the BVH is
-    /// watertight anyway).
+    /// Embree's `RTC_SCENE_FLAG_ROBUST` on every scene it commits (on by default: no
+    /// pinholes between triangles sharing an edge; the BVH is watertight anyway).
     pub embree_robust: bool,
     /// Coherent rays (a tile's eye rays with one sample per pixel) are cast in packets
     /// of this many (4, 8 or 16: Embree's `rtcIntersect4/8/16`); 0 casts them one by
@@ -137,13 +136,13 @@ pub struct BackendOptions {
 pub const DEFAULT_PACKET_WIDTH: u32 = 8;
 
 impl BackendOptions {
-    /// `backend` with the default options: medium build quality, fast traversal,
-    /// packets of [`DEFAULT_PACKET_WIDTH`].
+    /// `backend` with the default options: medium build quality, robust (watertight)
+    /// traversal, packets of [`DEFAULT_PACKET_WIDTH`].
     pub fn new(backend: Backend) -> Self {
         BackendOptions {
             backend,
             embree_quality: EmbreeQuality::default(),
-            embree_robust: false,
+            embree_robust: true,
             packet_width: DEFAULT_PACKET_WIDTH,
         }
     }

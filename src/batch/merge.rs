@@ -4,7 +4,10 @@
 //! from one render and cover the image exactly once.
 
 use crate::accel::Backend;
-use crate::output::part::{HASH_ATTRIBUTE, PartInfo, read_exr};
+use crate::output::aov::read_ids;
+use crate::output::channels::{Channel, read_exr_channels};
+use crate::output::part::{HASH_ATTRIBUTE, PartInfo};
+use crate::render::aov::ids::IdEntry;
 use crate::render::{Film, RenderSettings};
 use crate::scene::Scene;
 use std::fmt::Write as _;
@@ -87,6 +90,21 @@ pub enum MergeError {
         /// The first part's.
         first_hash: String,
     },
+    /// A part with other channels (output variables) than the first part.
+    #[error(
+        "{}: has the channels {}, but {} has {} (render the parts with the same --aov)",
+        part.display(), channels, first.display(), first_channels
+    )]
+    OtherChannels {
+        /// The part.
+        part: PathBuf,
+        /// Its channels besides the colour.
+        channels: String,
+        /// The first part.
+        first: PathBuf,
+        /// The first part's.
+        first_channels: String,
+    },
     /// Two parts hold one pixel.
     #[error(
         "{}: pixel ({x}, {y}) is also in {}: the parts overlap",
@@ -114,57 +132,141 @@ pub enum MergeError {
     },
 }
 
-/// Read `parts` and stitch them into the whole image, refusing parts of different
-/// images or renders, overlapping parts and uncovered pixels.
-pub fn merge(parts: &[PathBuf]) -> Result<Film, MergeError> {
-    let mut read: Vec<(&Path, Film, PartInfo)> = Vec::with_capacity(parts.len());
+/// The whole image stitched from its parts: the colour, the other channels (the
+/// output variables the parts were rendered with, in name order), and what the ids
+/// of an `id` channel stand for (from the parts' `.ids.json` files, ascending).
+#[derive(Clone, Debug, PartialEq)]
+pub struct Merged {
+    /// The colour.
+    pub film: Film,
+    /// The other channels.
+    pub channels: Vec<Channel>,
+    /// The ids, when there is an `id` channel.
+    pub ids: Option<Vec<IdEntry>>,
+}
+
+/// A part as read.
+struct ReadPart<'a> {
+    path: &'a Path,
+    film: Film,
+    channels: Vec<Channel>,
+    info: PartInfo,
+}
+
+/// The names and types of channels, for messages and comparisons.
+fn describe(channels: &[Channel]) -> String {
+    if channels.is_empty() {
+        return "no channel besides R, G, B".into();
+    }
+    let names: Vec<String> = channels
+        .iter()
+        .map(|c| format!("{} ({})", c.name, c.samples.type_name()))
+        .collect();
+    names.join(", ")
+}
+
+/// Read `parts` and stitch them into the whole image, every channel of it, refusing
+/// parts of different images or renders, with other channels, overlapping parts and
+/// uncovered pixels.
+pub fn merge(parts: &[PathBuf]) -> Result<Merged, MergeError> {
+    let mut read: Vec<ReadPart> = Vec::with_capacity(parts.len());
     for p in parts {
-        let (film, info) = read_exr(p).map_err(MergeError::Read)?;
+        let (film, channels, info) = read_exr_channels(p).map_err(MergeError::Read)?;
         if info.hash.is_none() {
             return Err(MergeError::NotAPart { path: p.clone() });
         }
-        read.push((p, film, info));
+        read.push(ReadPart {
+            path: p,
+            film,
+            channels,
+            info,
+        });
     }
-    let Some((first, _, info0)) = read.first() else {
+    let Some(first) = read.first() else {
         return Err(MergeError::NoParts);
     };
-    for (p, _, info) in &read[1..] {
-        if info.full != info0.full {
-            return Err(MergeError::OtherImage {
-                part: p.to_path_buf(),
-                full: info.full,
-                first: first.to_path_buf(),
-                first_full: info0.full,
-            });
-        }
-        if info.hash != info0.hash {
-            let hash = |i: &PartInfo| i.hash.clone().unwrap_or_else(|| "-".into());
-            return Err(MergeError::OtherRender {
-                part: p.to_path_buf(),
-                first: first.to_path_buf(),
-                hash: hash(info),
-                first_hash: hash(info0),
-            });
-        }
+    for part in &read[1..] {
+        check_same_render(part, first)?;
     }
-    let (w, h) = info0.full;
-    let mut owner: Vec<u32> = vec![u32::MAX; w as usize * h as usize];
+    let (film, channels) = stitch(&read)?;
+    let ids = if channels.iter().any(|c| c.name == "id") {
+        Some(merge_ids(&read)?)
+    } else {
+        None
+    };
+    Ok(Merged {
+        film,
+        channels,
+        ids,
+    })
+}
+
+/// Refuse `part` unless it is of the same image, render and channels as `first`.
+fn check_same_render(part: &ReadPart, first: &ReadPart) -> Result<(), MergeError> {
+    let (info, info0) = (&part.info, &first.info);
+    if info.full != info0.full {
+        return Err(MergeError::OtherImage {
+            part: part.path.to_path_buf(),
+            full: info.full,
+            first: first.path.to_path_buf(),
+            first_full: info0.full,
+        });
+    }
+    if info.hash != info0.hash {
+        let hash = |i: &PartInfo| i.hash.clone().unwrap_or_else(|| "-".into());
+        return Err(MergeError::OtherRender {
+            part: part.path.to_path_buf(),
+            first: first.path.to_path_buf(),
+            hash: hash(info),
+            first_hash: hash(info0),
+        });
+    }
+    let (mine, theirs) = (describe(&part.channels), describe(&first.channels));
+    if mine != theirs {
+        return Err(MergeError::OtherChannels {
+            part: part.path.to_path_buf(),
+            channels: mine,
+            first: first.path.to_path_buf(),
+            first_channels: theirs,
+        });
+    }
+    Ok(())
+}
+
+/// Every channel of the whole image from the parts, which must cover it exactly once.
+fn stitch(read: &[ReadPart]) -> Result<(Film, Vec<Channel>), MergeError> {
+    let (w, h) = read[0].info.full;
+    let n = w as usize * h as usize;
+    let mut owner: Vec<u32> = vec![u32::MAX; n];
     let mut out = Film::new(w, h);
-    for (k, (p, film, info)) in read.iter().enumerate() {
-        let r = info.region;
+    let mut channels: Vec<Channel> = read[0]
+        .channels
+        .iter()
+        .map(|c| Channel {
+            name: c.name.clone(),
+            samples: c.samples.like(n),
+        })
+        .collect();
+    for (k, part) in read.iter().enumerate() {
+        let r = part.info.region;
         for j in r.y0..r.y1 {
             for i in r.x0..r.x1 {
-                let o = &mut owner[(j * w + i) as usize];
+                let at = (j * w + i) as usize;
+                let o = &mut owner[at];
                 if *o != u32::MAX {
                     return Err(MergeError::Overlap {
-                        part: p.to_path_buf(),
+                        part: part.path.to_path_buf(),
                         x: i,
                         y: j,
-                        other: read[*o as usize].0.to_path_buf(),
+                        other: read[*o as usize].path.to_path_buf(),
                     });
                 }
                 *o = k as u32;
-                out.set(i, j, film.get(i - r.x0, j - r.y0));
+                out.set(i, j, part.film.get(i - r.x0, j - r.y0));
+                let from = ((j - r.y0) * r.width() + (i - r.x0)) as usize;
+                for (dst, src) in channels.iter_mut().zip(&part.channels) {
+                    dst.samples.copy_from(at, &src.samples, from);
+                }
             }
         }
     }
@@ -175,5 +277,16 @@ pub fn merge(parts: &[PathBuf]) -> Result<Film, MergeError> {
             y: idx as u32 / w,
         });
     }
-    Ok(out)
+    Ok((out, channels))
+}
+
+/// The ids of every part's `.ids.json`, each once, ascending.
+fn merge_ids(read: &[ReadPart]) -> Result<Vec<IdEntry>, MergeError> {
+    let mut all: Vec<IdEntry> = Vec::new();
+    for part in read {
+        all.extend(read_ids(part.path).map_err(MergeError::Read)?);
+    }
+    all.sort_by_key(|e| e.id);
+    all.dedup_by_key(|e| e.id);
+    Ok(all)
 }

@@ -3,6 +3,7 @@
 //! interleaved (every backend and thread count of a scene side by side in each
 //! repetition), with raw-casting runs for the renderer's overhead and Tachyon as a peer.
 
+pub mod cpu;
 pub mod peer;
 pub mod raw;
 pub mod report;
@@ -146,6 +147,16 @@ pub struct RunSpec {
     /// Eye rays per packet (see [`RenderSettings::packet_width`]).
     #[serde(default = "default_packet_width")]
     pub packet_width: u32,
+    /// Embree without `RTC_SCENE_FLAG_ROBUST` (the renderer's default sets it).
+    #[serde(default)]
+    pub embree_fast: bool,
+    /// Eye rays only: one ray per pixel centre (never SPD mode), the scene's lights
+    /// removed and the ray tree cut at depth 1, so that a render casts its camera rays
+    /// and nothing else, and render ÷ raw is the cost of
+    /// emray's eye-ray pipeline (camera, packets, surfaces, shading, film) over casting
+    /// the same rays.
+    #[serde(default)]
+    pub eye_only: bool,
 }
 
 /// What runs recorded before `packet_width` existed are read with: the renderer's
@@ -198,6 +209,12 @@ pub struct RunResult {
     pub peak_kib: Option<u64>,
     /// The backend's description (Embree version and ISA, BVH nodes).
     pub accel: String,
+    /// CPU time of the process's threads during the render (or the raw casting), ms.
+    #[serde(default)]
+    pub cpu_ms: Option<f64>,
+    /// Time the machine's processors were stolen during it (all processors), ms.
+    #[serde(default)]
+    pub steal_ms: Option<f64>,
     /// Bytes of the backend's structure ([`AccelStats::bytes`](crate::accel::AccelStats::bytes);
     /// 0 when unknown).
     #[serde(default)]
@@ -212,6 +229,39 @@ fn backend_named(name: &str) -> Result<Backend, BenchError> {
     }
 }
 
+/// What a child measured of its render or raw casting.
+struct Measure {
+    build_ms: f64,
+    ms: f64,
+    counts: crate::render::RayCounts,
+    stats: crate::accel::AccelStats,
+    cpu_ms: Option<f64>,
+    steal_ms: Option<f64>,
+}
+
+/// The render, its CPU and stolen time measured around the render alone.
+struct RenderWork<'a> {
+    scene: &'a Scene,
+    settings: &'a RenderSettings,
+}
+
+impl WithAccel for RenderWork<'_> {
+    type Output = Measure;
+    fn run<A: crate::accel::Accel>(self, accel: &A, build_ms: f64) -> Measure {
+        let mark = cpu::Mark::now();
+        let (_, stats) = crate::render::render(self.scene, accel, self.settings, None);
+        let (cpu_ms, steal_ms) = mark.elapsed();
+        Measure {
+            build_ms,
+            ms: stats.render_ms,
+            counts: stats.rays,
+            stats: accel.stats(),
+            cpu_ms,
+            steal_ms,
+        }
+    }
+}
+
 /// The raw-casting work: record the render's queries, then cast them timed.
 struct RawWork<'a> {
     scene: &'a Scene,
@@ -219,16 +269,20 @@ struct RawWork<'a> {
 }
 
 impl WithAccel for RawWork<'_> {
-    type Output = (
-        f64,
-        raw::RawCast,
-        crate::render::RayCounts,
-        crate::accel::AccelStats,
-    );
-    fn run<A: crate::accel::Accel>(self, accel: &A, build_ms: f64) -> Self::Output {
+    type Output = Measure;
+    fn run<A: crate::accel::Accel>(self, accel: &A, build_ms: f64) -> Measure {
         let (queries, counts) = raw::record(self.scene, accel, self.settings);
+        let mark = cpu::Mark::now();
         let cast = raw::cast(accel, &queries);
-        (build_ms, cast, counts, accel.stats())
+        let (cpu_ms, steal_ms) = mark.elapsed();
+        Measure {
+            build_ms,
+            ms: cast.ms,
+            counts,
+            stats: accel.stats(),
+            cpu_ms,
+            steal_ms,
+        }
     }
 }
 
@@ -239,8 +293,9 @@ fn run_settings(spec: &RunSpec, scene: &Scene) -> RenderSettings {
     let request = RenderRequest {
         res: Some((spec.width, spec.height)),
         spp: Some(1),
-        max_depth: Some(5),
-        spd: spec.spd,
+        max_depth: Some(if spec.eye_only { 1 } else { 5 }),
+        // SPD mode's corner rays and fixed depth are not eye rays alone.
+        spd: spec.spd && !spec.eye_only,
         bailout: Some(0.0),
         ..RenderRequest::default()
     };
@@ -260,62 +315,51 @@ pub fn run_child(spec: &RunSpec) -> Result<RunResult, BenchError> {
             message: e.to_string(),
         })?;
     let t0 = Instant::now();
-    let scene = load_scene(&spec.scene)?;
+    let mut scene = load_scene(&spec.scene)?;
+    if spec.eye_only {
+        scene.lights.clear();
+    }
     let load_ms = t0.elapsed().as_secs_f64() * 1e3;
     let settings = run_settings(spec, &scene);
     let options = BackendOptions {
         backend,
         embree_quality: spec.embree_quality,
-        embree_robust: false,
+        embree_robust: !spec.embree_fast,
         packet_width: spec.packet_width,
     };
-    let (build_ms, ms, rays, (accel, accel_bytes)) = pool.install(|| match spec.mode {
+    let (scene_ref, settings_ref) = (&scene, &settings);
+    let m = pool.install(|| match spec.mode {
         Mode::Render => {
-            let (_, rep) =
-                crate::run::render_scene(&spec.scene, &scene, options, &settings, load_ms, None)?;
-            let r = |k: &str| rep.rays.get(k).copied().unwrap_or(0);
-            let rays = Rays {
-                eye: r("eye"),
-                reflection: r("reflection"),
-                refraction: r("refraction"),
-                shadow: r("shadow"),
-                total: r("total"),
+            let work = RenderWork {
+                scene: scene_ref,
+                settings: settings_ref,
             };
-            Ok::<_, AccelError>((
-                rep.time_ms.build,
-                rep.time_ms.render,
-                rays,
-                (rep.accel, rep.accel_bytes),
-            ))
+            crate::accel::build(scene_ref, &options, work)
         }
         Mode::Raw => {
             let work = RawWork {
-                scene: &scene,
-                settings: &settings,
+                scene: scene_ref,
+                settings: settings_ref,
             };
-            let (build_ms, cast, counts, stats) = crate::accel::build(&scene, &options, work)?;
-            Ok((
-                build_ms,
-                cast.ms,
-                Rays::from(counts),
-                (stats.detail, stats.bytes),
-            ))
+            crate::accel::build(scene_ref, &options, work)
         }
     })?;
     let accel = match (backend, spec.packet_width) {
-        (Backend::Embree, 0) => format!("{accel}, eye rays one by one"),
-        (Backend::Embree, w) => format!("{accel}, eye rays in packets of {w}"),
-        _ => accel,
+        (Backend::Embree, 0) => format!("{}, eye rays one by one", m.stats.detail),
+        (Backend::Embree, w) => format!("{}, eye rays in packets of {w}", m.stats.detail),
+        _ => m.stats.detail.clone(),
     };
     Ok(RunResult {
         prims: scene.prim_count_with_instances(),
         load_ms,
-        build_ms,
-        ms,
-        rays,
+        build_ms: m.build_ms,
+        ms: m.ms,
+        rays: Rays::from(m.counts),
         peak_kib: peak_rss_kib(),
         accel,
-        accel_bytes,
+        cpu_ms: m.cpu_ms,
+        steal_ms: m.steal_ms,
+        accel_bytes: m.stats.bytes,
     })
 }
 
@@ -382,6 +426,10 @@ pub struct Config {
     pub embree_quality: crate::accel::EmbreeQuality,
     /// Eye rays per packet (see [`RenderSettings::packet_width`]).
     pub packet_width: u32,
+    /// Embree without `RTC_SCENE_FLAG_ROBUST`.
+    pub embree_fast: bool,
+    /// Eye rays only (see [`RunSpec::eye_only`]).
+    pub eye_only: bool,
 }
 
 /// The default suite: the eight SPD scenes at their default sizes, then balls and jacks
@@ -424,9 +472,13 @@ pub struct PeerSample {
     pub rep: usize,
     /// Tachyon's ray-tracing time, ms.
     pub trace_ms: f64,
+    /// emray's render time of the same file (pixel centres), ms.
+    #[serde(default)]
+    pub emray_ms: Option<f64>,
 }
 
-/// NFF files of the suite's scenes for Tachyon, in a private directory removed on drop.
+/// NFF files of the suite's scenes for Tachyon and emray's runs beside it (the angle set
+/// to Tachyon's, see [`peer`]), in a private directory removed on drop.
 struct PeerFiles {
     dir: std::path::PathBuf,
     files: std::collections::BTreeMap<String, (std::path::PathBuf, String)>,
@@ -448,6 +500,7 @@ impl PeerFiles {
                 None => continue,
             };
             let path = dir.join(format!("scene{k}.nff"));
+            let text = peer::with_angle(&text, peer::TACHYON_ANGLE_DEG);
             std::fs::write(&path, &text).map_err(|e| BenchError::io(&path, "write", e))?;
             let scene = load_scene(name)?;
             files.insert(name.clone(), (path, peer::differences(&scene)));
@@ -471,6 +524,8 @@ pub struct Measured {
     pub peers: Vec<PeerSample>,
     /// Scene → how Tachyon's picture differs.
     pub peer_notes: std::collections::BTreeMap<String, String>,
+    /// Scene → share of pixels Tachyon and emray frame alike ([`peer::framing`]).
+    pub peer_framing: std::collections::BTreeMap<String, f64>,
     /// Why there are no Tachyon runs, if there are none.
     pub peer_missing: String,
 }
@@ -520,6 +575,8 @@ pub fn run_suite(
                             mode,
                             embree_quality: cfg.embree_quality,
                             packet_width: cfg.packet_width,
+                            embree_fast: cfg.embree_fast,
+                            eye_only: cfg.eye_only,
                         };
                         let result = run_in_child(exe, &spec)?;
                         log(&format!(
@@ -536,22 +593,68 @@ pub fn run_suite(
                 };
                 let image = nff.with_extension("ppm");
                 let t = peer::run(nff, &image, cfg.width, cfg.height, threads)?;
+                let emray_ms = run_peer_emray(cfg, exe, nff, threads)?;
                 log(&format!(
-                    "rep {} {scene} tachyon {threads}t: {:.1} ms",
+                    "rep {} {scene} tachyon {threads}t: {:.1} ms (emray on its file {:.1} ms)",
                     rep + 1,
-                    t.trace_ms
+                    t.trace_ms,
+                    emray_ms
                 ));
+                if !m.peer_framing.contains_key(scene) {
+                    let framing = peer_framing(nff, &image, cfg)?;
+                    m.peer_framing.insert(scene.clone(), framing);
+                }
                 m.peer_notes.insert(scene.clone(), note.clone());
                 m.peers.push(PeerSample {
                     scene: scene.clone(),
                     threads,
                     rep,
                     trace_ms: t.trace_ms,
+                    emray_ms: Some(emray_ms),
                 });
             }
         }
     }
     Ok(m)
+}
+
+/// emray's render time of the peer's file `nff`: the renderer's default backend (Embree
+/// when built with it), one ray per pixel centre, as Tachyon casts them.
+fn run_peer_emray(cfg: &Config, exe: &Path, nff: &Path, threads: usize) -> Result<f64, BenchError> {
+    let backend = if cfg.backends.contains(&Backend::Embree) {
+        Backend::Embree
+    } else {
+        Backend::Bvh
+    };
+    let spec = RunSpec {
+        scene: nff.to_string_lossy().into_owned(),
+        backend: backend.name().to_string(),
+        threads,
+        width: cfg.width,
+        height: cfg.height,
+        spd: false,
+        mode: Mode::Render,
+        embree_quality: cfg.embree_quality,
+        packet_width: cfg.packet_width,
+        embree_fast: cfg.embree_fast,
+        eye_only: false,
+    };
+    Ok(run_in_child(exe, &spec)?.ms)
+}
+
+/// How alike Tachyon's picture `image` of `nff` and emray's frame the scene.
+fn peer_framing(nff: &Path, image: &Path, cfg: &Config) -> Result<f64, BenchError> {
+    let scene = load_scene(nff)?;
+    let bytes = std::fs::read(image).map_err(|e| BenchError::io(image, "read", e))?;
+    let (w, h, rgb) = peer::read_ppm(&bytes).ok_or_else(|| BenchError::Io {
+        path: image.to_path_buf(),
+        action: "read",
+        message: "not a binary 8-bit PPM".into(),
+    })?;
+    if (w, h) != (cfg.width, cfg.height) {
+        return Ok(0.0);
+    }
+    Ok(peer::framing(&scene, w, h, &rgb))
 }
 
 /// Where the report goes besides standard output.
@@ -589,7 +692,7 @@ pub fn bench(
     machine.load_after = load_average();
     let rows = report::rows(&m.samples);
     let summary = report::summary(&rows);
-    let peers = report::peer_rows(&m, &rows);
+    let peers = report::peer_rows(&m);
     let mut md = report::markdown(&machine, &rows, &summary, &peers, &m.peer_missing);
     if let Some(b) = base {
         md.push_str("\n## Against the baseline\n\n");
@@ -690,6 +793,8 @@ mod tests {
             mode: Mode::Render,
             embree_quality: Default::default(),
             packet_width: 8,
+            embree_fast: false,
+            eye_only: false,
         };
         let r = run_child(&spec).unwrap();
         assert_eq!(r.rays.eye, 17 * 17);
@@ -710,6 +815,21 @@ mod tests {
         })
         .unwrap();
         assert_eq!(raw.rays, r.rays, "the raw run casts the render's rays");
+        assert!(r.accel_bytes > 30 * r.prims, "{} bytes", r.accel_bytes);
+        // Eye rays only: the same eye rays, nothing else, and raw casting casts them.
+        let eye = RunSpec {
+            eye_only: true,
+            ..spec.clone()
+        };
+        let e = run_child(&eye).unwrap();
+        assert_eq!(e.rays.eye, 16 * 16, "pixel centres");
+        assert_eq!(e.rays.total, e.rays.eye, "{:?}", e.rays);
+        let raw = run_child(&RunSpec {
+            mode: Mode::Raw,
+            ..eye
+        })
+        .unwrap();
+        assert_eq!(raw.rays, e.rays);
         assert!(
             run_child(&RunSpec {
                 backend: "nope".into(),

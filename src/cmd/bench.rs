@@ -38,6 +38,13 @@ pub struct Args {
     /// Eye rays per Embree packet (0, 4, 8 or 16; 0 casts them one by one).
     #[arg(long, value_name = "N", default_value_t = 8, value_parser = packet_width)]
     pub packet_width: u32,
+    /// Embree's fast traversal, without RTC_SCENE_FLAG_ROBUST (as `render --embree-fast`).
+    #[arg(long)]
+    pub embree_fast: bool,
+    /// Eye rays only: one per pixel centre, lights removed, depth 1, so that render ÷ raw is the cost of the
+    /// eye-ray pipeline over casting the same rays.
+    #[arg(long)]
+    pub eye_only: bool,
     /// Skip the raw-casting runs.
     #[arg(long)]
     pub no_raw: bool,
@@ -122,5 +129,7 @@ fn config(b: &Args) -> bench::Config {
         peer: !b.no_peer,
         embree_quality: b.embree_quality.into(),
         packet_width: b.packet_width,
+        embree_fast: b.embree_fast,
+        eye_only: b.eye_only,
     }
 }

@@ -1,8 +1,10 @@
 //! `emray merge`: stitch the parts rendered with `render --tile` or `--crop` into the
-//! whole image.
+//! whole image, with the output variables they were rendered with (`--aov`).
 
 use super::Error;
 use super::args::EncodingArg;
+use emray::output::aov::write_ids;
+use emray::output::channels::write_exr_channels;
 use emray::output::{self, Format};
 use std::path::PathBuf;
 
@@ -20,10 +22,25 @@ pub struct Args {
     pub encoding: EncodingArg,
 }
 
-/// Check that the parts make one image, and write it.
+/// Check that the parts make one image, and write it: every channel of the parts to
+/// an EXR (with the `.ids.json` of an `id` channel), the colour alone to a PNG.
 pub fn run(m: Args) -> Result<(), Error> {
-    Format::from_path(&m.output)?;
-    let film = emray::batch::merge::merge(&m.parts)?;
-    output::write_image(&m.output, &film, m.encoding.into())?;
+    super::init_log(false, 0);
+    let format = Format::from_path(&m.output)?;
+    let merged = emray::batch::merge::merge(&m.parts)?;
+    if merged.channels.is_empty() || format == Format::Png {
+        if !merged.channels.is_empty() {
+            log::warn!(
+                "{}: a PNG holds the colour alone; the parts' other channels are left out",
+                m.output.display()
+            );
+        }
+        output::write_image(&m.output, &merged.film, m.encoding.into())?;
+        return Ok(());
+    }
+    write_exr_channels(&m.output, &merged.film, &merged.channels, None)?;
+    if let Some(ids) = &merged.ids {
+        write_ids(&m.output, ids)?;
+    }
     Ok(())
 }

@@ -11,7 +11,9 @@ mod compare;
 #[cfg(test)]
 mod docs_commands;
 mod error;
+mod explain;
 mod generate;
+mod insight;
 mod interrupt;
 mod merge;
 mod progress;
@@ -62,6 +64,9 @@ pub enum Command {
     Study(study::Args),
     /// Solve a scene's diffuse interreflection by radiosity and render a view of it.
     Radiosity(radiosity::Args),
+    /// One pixel's whole ray tree: each ray, what it hit and where that was defined,
+    /// the light at each hit term by term, and what each ray brings back.
+    Explain(explain::Args),
 }
 
 /// Run the command line's command (a bare `emray` renders the default scene).
@@ -77,6 +82,7 @@ pub fn run(cli: Cli) -> Result<(), Error> {
         Some(Command::Stress(a)) => stress::run(a),
         Some(Command::Study(a)) => study::run(a),
         Some(Command::Radiosity(a)) => radiosity::run(a),
+        Some(Command::Explain(a)) => explain::run(a),
     }
 }
 

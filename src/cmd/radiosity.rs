@@ -73,7 +73,7 @@ fn solve_and_write(a: &Args) -> Result<()> {
         .with_context(|| a.scene.display().to_string())?;
     output::write_image(&a.output, &film, Encoding::Srgb)?;
     if let Some(p) = &a.ply {
-        output::write_text(p, &sol.to_ply(1.0))?;
+        output::write_text(p, &sol.to_ply(1.0, scene.origin))?;
     }
     if a.stats {
         print(format_args!(

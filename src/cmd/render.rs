@@ -5,6 +5,7 @@ use super::args::{
     BackendArg, EncodingArg, QualityArg, RadiositySolveArgs, packet_width, parse_res,
 };
 use super::error::{error_line, is_closed_pipe, print};
+use super::insight::{self, HeatmapArg};
 use super::progress::TileBar;
 use super::{Error, append_json_line, init_log, thread_pool};
 use anyhow::{Result, anyhow, bail};
@@ -13,6 +14,7 @@ use emray::Scene;
 use emray::accel::{Backend, BackendOptions};
 use emray::load;
 use emray::output::{self, Format, part};
+use emray::render::aov::{AovFilm, AovSet};
 use emray::render::{Aa, Film, RenderSettings};
 use emray::run::{self, Part, RenderRequest, Report, limits};
 use emray::scene::Environment;
@@ -66,10 +68,11 @@ pub struct Args {
     /// Embree build quality (RTC_BUILD_QUALITY_*).
     #[arg(long, value_enum, default_value_t = QualityArg::Medium)]
     pub embree_quality: QualityArg,
-    /// Embree robust traversal (RTC_SCENE_FLAG_ROBUST) on every scene: no ray slips
-    /// between triangles sharing an edge, at some cost in speed.
+    /// Embree's fast traversal: without RTC_SCENE_FLAG_ROBUST, which emray sets on every
+    /// scene by default so that no ray slips between triangles sharing an edge. Faster
+    /// on triangle scenes, at the risk of pinholes in meshes.
     #[arg(long)]
-    pub embree_robust: bool,
+    pub embree_fast: bool,
     /// Cast each tile's primary rays together, as Embree packets of this many rays
     /// (`rtcIntersect4/8/16`); 0 casts them one by one. Used with one sample per pixel
     /// (SPD mode included). Analytic shapes give the same hits either way; Embree's
@@ -143,6 +146,15 @@ pub struct Args {
     /// strata.
     #[arg(long, default_value_t = 16, value_parser = clap::value_parser!(u32).range(1..=4096))]
     pub area_samples: u32,
+    /// Output variables to write as EXR layers beside the colour, comma-separated:
+    /// depth (Z), normal (N.X N.Y N.Z), albedo (albedo.R/G/B), position (P.X P.Y P.Z),
+    /// id (with OUT.ids.json), rays, time; or all (docs/aov.md).
+    #[arg(long, value_name = "LIST", value_parser = insight::parse_aov)]
+    pub aov: Option<AovSet>,
+    /// A heat map of a per-pixel cost: rays (cast), time (spent) or depth (of the
+    /// deepest ray), to a PNG with a colour bar; may be repeated.
+    #[arg(long, num_args = 2, value_names = ["WHAT", "FILE.png"], action = clap::ArgAction::Append)]
+    pub heatmap: Vec<String>,
 }
 
 /// Global-illumination methods.
@@ -165,7 +177,7 @@ impl Args {
             threads: None,
             spd: false,
             embree_quality: QualityArg::Medium,
-            embree_robust: false,
+            embree_fast: false,
             packet_width: 8,
             aa: AaArg::Uniform,
             aa_threshold: emray::render::DEFAULT_AA_THRESHOLD,
@@ -185,6 +197,8 @@ impl Args {
             gi: None,
             radiosity: RadiositySolveArgs::default(),
             area_samples: 16,
+            aov: None,
+            heatmap: Vec::new(),
         }
     }
 }
@@ -198,8 +212,10 @@ pub fn run(args: Args) -> Result<(), Error> {
     let jobs = plan(&args).map_err(Error::Usage)?;
     // An output that cannot be written is found before any render (a missing folder
     // is created, as `batch` does).
-    for (_, out) in &jobs {
+    for (scene, out) in &jobs {
         emray::output::prepare(out).map_err(Error::failed)?;
+        insight::prepare_heatmaps(&heatmap_files(&args, scene.as_deref()))
+            .map_err(Error::Failed)?;
     }
     let pool = thread_pool(args.threads).map_err(Error::Failed)?;
     let mut failed = 0usize;
@@ -255,8 +271,10 @@ fn plan(args: &Args) -> Result<Vec<Job>> {
     if args.tile.is_some() || args.crop.is_some() {
         check_part(args, &jobs)?;
     }
+    insight::heatmaps(&args.heatmap, jobs.len())?;
     for (scene, out) in &jobs {
         Format::from_path(out)?;
+        insight::check_aov_output(&args.aov.unwrap_or_default(), out)?;
         if let Some(s) = scene {
             Database::parse_spec(&s.to_string_lossy()).map_err(anyhow::Error::msg)?;
         }
@@ -289,6 +307,12 @@ fn check_options(args: &Args) -> Result<()> {
             "--reference samples N×N stratified: it cannot be combined with --spd or --aa adaptive"
         );
     }
+    if insight_wanted(args) && (args.reference || (args.aa != AaArg::Uniform && !args.spd)) {
+        bail!(
+            "--aov and --heatmap look inside the Whitted renderer's uniform samples: not with \
+             --reference or --aa adaptive"
+        );
+    }
     for (name, v) in [
         ("--bailout", args.bailout.unwrap_or(0.0)),
         ("--aa-threshold", args.aa_threshold),
@@ -298,6 +322,11 @@ fn check_options(args: &Args) -> Result<()> {
         }
     }
     Ok(())
+}
+
+/// Whether the render gathers output variables (`--aov` or `--heatmap`).
+fn insight_wanted(args: &Args) -> bool {
+    args.aov.is_some_and(|s| s.any()) || !args.heatmap.is_empty()
 }
 
 /// `--tile` and `--crop` render one scene, whole-image modes aside, to an EXR part.
@@ -350,7 +379,7 @@ fn backend_options(args: &Args) -> BackendOptions {
             .map(Backend::from)
             .unwrap_or_else(Backend::default_available),
         embree_quality: args.embree_quality.into(),
-        embree_robust: args.embree_robust,
+        embree_robust: !args.embree_fast,
         packet_width: args.packet_width,
     }
 }
@@ -379,25 +408,34 @@ fn render_one(args: &Args, scene_path: Option<&Path>, out: &Path) -> Result<()> 
         .settings(&scene)
         .map_err(|e| anyhow!("{name}: {e}"))?;
     let max_memory = args.max_memory.unwrap_or_else(limits::default_max_memory);
-    limits::check(Path::new(&name), &scene, &settings, max_memory)?;
+    let extra = if insight_wanted(args) {
+        limits::aov_bytes(&settings)
+    } else {
+        0
+    };
+    limits::check_with(Path::new(&name), &scene, &settings, extra, max_memory)?;
     let options = backend_options(args);
     let bar = TileBar::new(&name, args.quiet);
-    let (film, report) = trace(args, &name, &scene, &settings, options, load_ms, &bar)?;
+    let (film, aov, report) = trace(args, &name, &scene, &settings, options, load_ms, &bar)?;
     bar.finish();
-    match settings.region {
-        Some(region) => {
-            let info = part::PartInfo {
-                full: (settings.width, settings.height),
-                region,
-                hash: Some(emray::batch::merge::render_hash(
-                    &scene,
-                    &settings,
-                    options.backend,
-                )),
-            };
-            part::write_exr(out, &film, Some(&info))?
+    let part = settings.region.map(|region| part::PartInfo {
+        full: (settings.width, settings.height),
+        region,
+        hash: Some(emray::batch::merge::render_hash(
+            &scene,
+            &settings,
+            options.backend,
+        )),
+    });
+    match (&aov, &part) {
+        (Some(aov), _) if aov.set.any() => {
+            emray::output::aov::write_exr_aov(out, &film, aov, part.as_ref())?
         }
-        None => output::write_image(out, &film, args.encoding.into())?,
+        (_, Some(info)) => part::write_exr(out, &film, Some(info))?,
+        (_, None) => output::write_image(out, &film, args.encoding.into())?,
+    }
+    if let Some(aov) = &aov {
+        insight::write_heatmaps(aov, &heatmap_files(args, scene_path))?;
     }
     if args.stats {
         print(format_args!(
@@ -414,7 +452,18 @@ fn render_one(args: &Args, scene_path: Option<&Path>, out: &Path) -> Result<()> 
     Ok(())
 }
 
-/// Build the backend and render: the f64 reference, two-pass, or Whitted alone.
+/// The heat map files of the scene `scene` (`None`: the default scene).
+fn heatmap_files(
+    args: &Args,
+    scene: Option<&Path>,
+) -> Vec<(emray::output::heatmap::Quantity, PathBuf)> {
+    let maps: Vec<HeatmapArg> = insight::heatmaps(&args.heatmap, 1).unwrap_or_default();
+    let stem = emray::batch::scene_stem(scene.unwrap_or(Path::new("emray")));
+    insight::heatmap_files(&maps, &stem)
+}
+
+/// Build the backend and render: the f64 reference, two-pass, or Whitted alone; with
+/// the output variables when `--aov` or `--heatmap` asks for them.
 fn trace(
     args: &Args,
     name: &str,
@@ -423,23 +472,44 @@ fn trace(
     options: BackendOptions,
     load_ms: f64,
     bar: &TileBar,
-) -> Result<(Film, Report)> {
+) -> Result<(Film, Option<AovFilm>, Report)> {
     let progress = |done: usize, total: usize| bar.set(done, total);
     if args.reference {
         let strata = (args.spp.unwrap_or(256) as f64).sqrt().floor() as u32;
-        return run::render_reference(name, scene, settings, strata, load_ms)
-            .map_err(|why| anyhow!("{name}: {why}"));
+        let (film, report) = run::render_reference(name, scene, settings, strata, load_ms)
+            .map_err(|why| anyhow!("{name}: {why}"))?;
+        return Ok((film, None, report));
     }
-    Ok(match args.gi {
-        Some(GiArg::Radiosity) => run::render_two_pass(
+    let radiosity = args.gi.map(|GiArg::Radiosity| args.radiosity.settings());
+    if insight_wanted(args) {
+        let maps = insight::heatmaps(&args.heatmap, 1)?;
+        let set = insight::gathered(args.aov.unwrap_or_default(), &maps);
+        let (film, mut aov, report) = run::render_aov(
             name,
             scene,
             options,
             settings,
-            &args.radiosity.settings(),
+            radiosity.as_ref(),
+            set,
+            load_ms,
+            Some(&progress),
+        )?;
+        // The layers written are the ones --aov asks for; the heat maps' are gathered
+        // for them alone.
+        aov.set = args.aov.unwrap_or_default();
+        return Ok((film, Some(aov), report));
+    }
+    let (film, report) = match &radiosity {
+        Some(rad) => run::render_two_pass(
+            name,
+            scene,
+            options,
+            settings,
+            rad,
             load_ms,
             Some(&progress),
         )?,
         None => run::render_scene(name, scene, options, settings, load_ms, Some(&progress))?,
-    })
+    };
+    Ok((film, None, report))
 }

@@ -654,6 +654,11 @@ impl Solid for CappedCone {
 }
 
 impl CappedCone {
+    /// Whether both ends have the same radius: a (closed) cylinder.
+    pub fn is_cylinder(&self) -> bool {
+        self.base_radius == self.top_radius
+    }
+
     /// The cylindrical parameterisation on the side, a disk onto `[0, 1]²` on the caps
     /// (`ng` the unit outward normal tells them apart).
     pub fn param(&self, p: Vec3, ng: Vec3) -> Param {

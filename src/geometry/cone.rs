@@ -227,6 +227,11 @@ impl Intersect for Cone {
 }
 
 impl Cone {
+    /// Whether both ends have the same radius: an open cylinder.
+    pub fn is_cylinder(&self) -> bool {
+        self.base_radius == self.apex_radius
+    }
+
     /// The cylindrical parameterisation at `p`.
     pub fn param(&self, p: Vec3) -> Param {
         let slope = (self.apex_radius - self.base_radius) / self.height();

@@ -82,7 +82,10 @@ impl Triangle {
     }
 
     /// Watertight intersection: no ray passes between two triangles sharing an edge.
-    #[inline]
+    /// Always inlined: it is the inner loop of the BVH's leaves and of every hit's
+    /// exact recomputation ([`crate::scene::Geometry::exact_hit`]), whose cost should not
+    /// depend on what else the caller inlines.
+    #[inline(always)]
     pub fn intersect_wt(&self, r: &WatertightRay) -> Option<ShapeHit> {
         let [kx, ky, kz] = r.k;
         let a = (self.p[0] - r.org).to_array();
@@ -124,13 +127,19 @@ impl Triangle {
             return None;
         }
         // Reject t within its own rounding error of zero (pbrt §6.8.7), so that a ray
-        // leaving the surface from a robustly offset origin cannot re-hit it.
+        // leaving the surface from a robustly offset origin cannot re-hit it. The sheared
+        // x and y are lengths, with an error relative to |x| + |z| before z is divided
+        // by the direction's z (|Sx·z| ≤ |z| as |d[kx]| ≤ |d[kz]|); pbrt adds the divided
+        // z there, which makes the bound depend on the direction's length: a shadow ray
+        // towards a light (an unnormalised direction) in a scene 10⁻⁴ units across then
+        // found its blocker "within rounding of 0" and passed through it.
         let max_zt = az.abs().max(bz.abs()).max(cz.abs());
+        let max_z = a[kz].abs().max(b[kz].abs()).max(c[kz].abs());
         let max_xt = ax.abs().max(bx.abs()).max(cx.abs());
         let max_yt = ay.abs().max(by.abs()).max(cy.abs());
         let delta_z = gamma(3) * max_zt;
-        let delta_x = gamma(5) * (max_xt + max_zt);
-        let delta_y = gamma(5) * (max_yt + max_zt);
+        let delta_x = gamma(5) * (max_xt + max_z);
+        let delta_y = gamma(5) * (max_yt + max_z);
         let delta_e = 2.0 * (gamma(2) * max_xt * max_yt + delta_y * max_xt + delta_x * max_yt);
         let max_e = u.abs().max(v.abs()).max(w.abs());
         let delta_t =

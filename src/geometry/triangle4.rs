@@ -197,13 +197,15 @@ impl Triangle4 {
             return Hits4::NONE;
         }
         // Reject t within its own rounding error of zero (see `Triangle::intersect_wt`).
+        // The x and y errors are relative to the unscaled z, as in the scalar test.
         let max_zt = az.abs().max(bz.abs()).max(cz.abs());
+        let max_z = a_z.abs().max(b_z.abs()).max(c_z.abs());
         let max_xt = ax.abs().max(bx.abs()).max(cx.abs());
         let max_yt = ay.abs().max(by.abs()).max(cy.abs());
         let g = |n: u32| Vec4::splat(gamma(n));
         let delta_z = g(3) * max_zt;
-        let delta_x = g(5) * (max_xt + max_zt);
-        let delta_y = g(5) * (max_yt + max_zt);
+        let delta_x = g(5) * (max_xt + max_z);
+        let delta_y = g(5) * (max_yt + max_z);
         let delta_e =
             Vec4::splat(2.0) * (g(2) * max_xt * max_yt + delta_y * max_xt + delta_x * max_yt);
         let max_e = u.abs().max(v.abs()).max(w.abs());

@@ -9,17 +9,22 @@
 //! Entities: `v` (viewpoint: `from`, `at`, `up`, `angle`, `hither`, `resolution` in
 //! that order), `b` (background), `l x y z [r g b]` (point light), `f` (material),
 //! `c` (open cone/cylinder), `s` (sphere), `p` (polygon), `pp` (polygon with vertex
-//! normals). Everything is validated here, so the renderer can trust the scene: every
+//! normals). Points (`from`, `at`, light positions, sphere centres, cone ends, polygon
+//! vertices) are read in double precision and moved into the scene's frame, whose
+//! origin is the eye (see [`Scene::origin`]), before they become single precision.
+//! Everything is validated here, so the renderer can trust the scene: every
 //! number is finite, sizes are positive where they must be, the resolution is sane, and
 //! degenerate polygons are dropped with one warning per file and counted in
 //! [`LoadStats::degenerate_dropped`](crate::scene::LoadStats).
 
 use super::LoadError;
+use crate::geometry::Kind;
 use crate::geometry::polygon::Triangulator;
 use crate::geometry::{Cone, Sphere, Triangle};
-use crate::math::Vec3;
+use crate::math::{Aabb, DVec3, Vec3};
 use crate::scene::{Camera, Light, Material, Scene, default_light_intensity, range};
 use std::path::Path;
+use std::sync::Arc;
 
 /// Largest accepted image side.
 pub const MAX_RESOLUTION_SIDE: u64 = 65_536;
@@ -49,9 +54,19 @@ pub fn load(path: &Path) -> Result<Scene, LoadError> {
 /// offending token (1-based; a column counts characters), or `path: no viewpoint ('v')
 /// in file` when there is no `v`.
 pub fn parse_str(src: &str, path: &Path) -> Result<Scene, LoadError> {
+    parse_str_at(src, path, eye_of(src).unwrap_or(DVec3::ZERO))
+}
+
+/// [`parse_str`] in the frame whose origin is the world point `origin`: every point of
+/// the file, `p`, becomes `p − origin` (computed in double precision) in the scene.
+///
+/// # Errors
+/// As [`parse_str`].
+pub fn parse_str_at(src: &str, path: &Path, origin: DVec3) -> Result<Scene, LoadError> {
     let mut p = Parser {
         lex: Lexer::new(src),
         path,
+        origin,
         camera: None,
         background: Vec3::ZERO,
         lights: Vec::new(),
@@ -64,9 +79,31 @@ pub fn parse_str(src: &str, path: &Path) -> Result<Scene, LoadError> {
         tris: Vec::new(),
         triangulator: Triangulator::new(),
         first_degenerate: None,
+        file: Arc::from(path.display().to_string()),
+        entity_line: 0,
     };
     p.run()?;
     p.finish()
+}
+
+/// The eye (`from`) of the file's first viewpoint, found by a quick scan of the tokens
+/// (`None` when there is none or it does not read: the parse then says why).
+fn eye_of(src: &str) -> Option<DVec3> {
+    let mut lex = Lexer::new(src);
+    while lex.next()?.text != "v" {}
+    if lex.next()?.text != "from" {
+        return None;
+    }
+    let mut xyz = [0.0; 3];
+    for c in &mut xyz {
+        *c = lex
+            .next()?
+            .text
+            .parse::<f64>()
+            .ok()
+            .filter(|v| v.is_finite())?;
+    }
+    Some(DVec3::from(xyz))
 }
 
 /// Stands in until the `v` is read (the scene is built while parsing, and `v` may come
@@ -216,6 +253,8 @@ const RGB: [&str; 3] = ["red", "green", "blue"];
 struct Parser<'a, 'p> {
     lex: Lexer<'a>,
     path: &'p Path,
+    /// The world point that is the scene's zero ([`Scene::origin`]).
+    origin: DVec3,
     camera: Option<Camera>,
     background: Vec3,
     lights: Vec<Light>,
@@ -232,6 +271,10 @@ struct Parser<'a, 'p> {
     triangulator: Triangulator,
     /// Position of the first degenerate polygon, for the warning.
     first_degenerate: Option<(usize, usize)>,
+    /// The file, as the primitives' origins name it.
+    file: Arc<str>,
+    /// The line of the entity being read.
+    entity_line: u32,
 }
 
 impl<'a> Parser<'a, '_> {
@@ -281,6 +324,47 @@ impl<'a> Parser<'a, '_> {
             )),
             Err(_) => Err(self.err(&t, format!("expected {}, found {}", what(), show(t.text)))),
         }
+    }
+
+    /// The next token as an `f64` that is also finite as an `f32` (so that the file's
+    /// numbers are refused alike whether they are points or not).
+    #[inline]
+    fn num64_with(&mut self, what: &dyn Fn() -> String) -> Result<f64, LoadError> {
+        let t = self.token(what)?;
+        match t.text.parse::<f64>() {
+            Ok(v) if v.is_finite() && (v as f32).is_finite() => Ok(v),
+            Ok(_) => Err(self.err(
+                &t,
+                format!(
+                    "expected {}, found {} (not a finite number)",
+                    what(),
+                    show(t.text)
+                ),
+            )),
+            Err(_) => Err(self.err(&t, format!("expected {}, found {}", what(), show(t.text)))),
+        }
+    }
+
+    /// A point: three numbers read in double precision, checked against the traceable
+    /// range in world coordinates, and returned in the scene's frame, with the first
+    /// number's token.
+    fn point(&mut self, what: &str) -> Result<(Vec3, Tok<'a>), LoadError> {
+        let tok = self.lex.peek();
+        let mut p = [0.0; 3];
+        for (c, name) in p.iter_mut().zip(XYZ) {
+            *c = self.num64_with(&|| format!("{what} {name}"))?;
+        }
+        let world = DVec3::from(p);
+        let tok = tok.expect("a number was read");
+        self.in_range(&tok, range::check_point(what, world.as_vec3()))?;
+        Ok(((world - self.origin).as_vec3(), tok))
+    }
+
+    /// `bounds`, in the scene's frame, in world coordinates (for the range checks).
+    fn world_bounds(&self, bounds: &Aabb) -> Aabb {
+        let o = self.origin;
+        let w = |p: Vec3| (p.as_dvec3() + o).as_vec3();
+        Aabb::from_points(w(bounds.min), w(bounds.max))
     }
 
     #[inline]
@@ -336,10 +420,13 @@ impl<'a> Parser<'a, '_> {
 
     fn run(&mut self) -> Result<(), LoadError> {
         while let Some(t) = self.lex.next() {
+            self.entity_line = u32::try_from(t.line).unwrap_or(u32::MAX);
             match t.text {
                 "v" => self.viewpoint(&t)?,
                 "b" => {
-                    self.background = self.vec3("the background", RGB)?.0;
+                    let (c, tok) = self.vec3("the background", RGB)?;
+                    self.warn_above_one(&tok, "background", c);
+                    self.background = c;
                 }
                 "l" => self.light()?,
                 "f" => self.material()?,
@@ -374,11 +461,9 @@ impl<'a> Parser<'a, '_> {
             );
         }
         self.keyword("from")?;
-        let (from, from_tok) = self.vec3("the viewpoint 'from'", XYZ)?;
-        self.in_range(&from_tok, range::check_point("the viewpoint 'from'", from))?;
+        let (from, _) = self.point("the viewpoint 'from'")?;
         self.keyword("at")?;
-        let (at, at_tok) = self.vec3("the viewpoint 'at'", XYZ)?;
-        self.in_range(&at_tok, range::check_point("the viewpoint 'at'", at))?;
+        let (at, at_tok) = self.point("the viewpoint 'at'")?;
         self.keyword("up")?;
         let (up, up_tok) = self.vec3("the viewpoint 'up'", XYZ)?;
         self.keyword("angle")?;
@@ -453,21 +538,40 @@ impl<'a> Parser<'a, '_> {
     }
 
     fn light(&mut self) -> Result<(), LoadError> {
-        let (pos, pos_tok) = self.vec3("the light position", XYZ)?;
-        self.in_range(&pos_tok, range::check_point("the light position", pos))?;
+        let (pos, _) = self.point("the light position")?;
         let has_color = self.lex.peek().is_some_and(|t| looks_numeric(t.text));
         let color = if has_color {
             self.vec3("the light colour", RGB)?.0
         } else {
             Vec3::ZERO // set in `finish` once the number of lights is known
         };
+        let (index, line) = (self.lights.len(), self.entity_line);
+        self.scene.sources.lights.add(index, 1, &self.file, line);
         self.lights.push(Light::point(pos, color));
         self.light_has_color.push(has_color);
         Ok(())
     }
 
+    /// A warning when a colour has a channel above 1, the sign of a colour written on a
+    /// 0–255 scale (NFF's colours run from 0 to 1).
+    fn warn_above_one(&self, tok: &Tok<'a>, what: &str, c: Vec3) {
+        if c.max_element() > 1.0 {
+            log::warn!(
+                "{}:{}:{}: the {what} colour {} {} {} has channels above 1; NFF colours run \
+                 from 0 to 1 (a colour on a 0-255 scale is divided by 255)",
+                self.path.display(),
+                tok.line,
+                self.lex.col(tok.line_start, tok.start),
+                c.x,
+                c.y,
+                c.z
+            );
+        }
+    }
+
     fn material(&mut self) -> Result<(), LoadError> {
-        let (color, _) = self.vec3("the fill colour", RGB)?;
+        let (color, color_tok) = self.vec3("the fill colour", RGB)?;
+        self.warn_above_one(&color_tok, "fill", color);
         let (kd, _) = self.num("the diffuse weight Kd")?;
         let (ks, _) = self.num("the specular weight Ks")?;
         let (shine, shine_tok) = self.num("the Phong exponent Shine")?;
@@ -481,6 +585,8 @@ impl<'a> Parser<'a, '_> {
         let (t, _) = self.num("the transmittance T")?;
         let (ior, ior_tok) = self.num("the index of refraction")?;
         self.in_range(&ior_tok, range::check_ior(t, ior))?;
+        let (index, line) = (self.materials.len(), self.entity_line);
+        self.scene.sources.materials.add(index, 1, &self.file, line);
         self.materials.push(Material {
             color,
             ka: kd,
@@ -512,22 +618,24 @@ impl<'a> Parser<'a, '_> {
     }
 
     fn sphere(&mut self) -> Result<(), LoadError> {
-        let (center, _) = self.vec3("the sphere centre", XYZ)?;
+        let (center, _) = self.point("the sphere centre")?;
         let (r, r_tok) = self.num("the sphere radius")?;
         if r == 0.0 {
             return Err(self.err(&r_tok, "sphere radius must not be zero".into()));
         }
         let sphere = Sphere::new(center, r);
-        self.in_range(&r_tok, range::check_bounds("the sphere", &sphere.bounds()))?;
+        let bounds = self.world_bounds(&sphere.bounds());
+        self.in_range(&r_tok, range::check_bounds("the sphere", &bounds))?;
         let m = self.material_index();
+        self.record(Kind::Sphere, 1);
         self.scene.geometry.push(sphere, m);
         Ok(())
     }
 
     fn cone(&mut self) -> Result<(), LoadError> {
-        let (base, _) = self.vec3("the cone base", XYZ)?;
+        let (base, _) = self.point("the cone base")?;
         let (rb, _) = self.num("the cone base radius")?;
-        let (apex, apex_tok) = self.vec3("the cone apex", XYZ)?;
+        let (apex, apex_tok) = self.point("the cone apex")?;
         let (ra, ra_tok) = self.num("the cone apex radius")?;
         if rb == 0.0 && ra == 0.0 {
             return Err(self.err(&ra_tok, "cone radii must not both be zero".into()));
@@ -546,8 +654,10 @@ impl<'a> Parser<'a, '_> {
             return Err(self.err(&apex_tok, "cone apex equals its base".into()));
         }
         let cone = Cone::new(base, rb, apex, ra);
-        self.in_range(&ra_tok, range::check_bounds("the cone", &cone.bounds()))?;
+        let bounds = self.world_bounds(&cone.bounds());
+        self.in_range(&ra_tok, range::check_bounds("the cone", &bounds))?;
         let m = self.material_index();
+        self.record(Kind::Cone, 1);
         self.scene.geometry.push(cone, m);
         Ok(())
     }
@@ -585,8 +695,7 @@ impl<'a> Parser<'a, '_> {
         self.pts.clear();
         self.nrm.clear();
         for _ in 0..n {
-            let (p, p_tok) = self.vec3("the polygon vertex", XYZ)?;
-            self.in_range(&p_tok, range::check_point("the polygon vertex", p))?;
+            let (p, _) = self.point("the polygon vertex")?;
             self.pts.push(p);
             if with_normals {
                 let (nv, n_tok) = self.vec3("the vertex normal", XYZ)?;
@@ -605,6 +714,7 @@ impl<'a> Parser<'a, '_> {
         match self.triangulator.triangulate(&self.pts, &mut self.tris) {
             Ok(()) => {
                 let m = self.material_index();
+                self.record(Kind::Triangle, self.tris.len());
                 for &[a, b, c] in &self.tris {
                     self.scene.geometry.triangles.push(
                         Triangle {
@@ -640,6 +750,14 @@ impl<'a> Parser<'a, '_> {
         Ok(())
     }
 
+    /// The next `count` primitives of `kind` come from the entity being read.
+    fn record(&mut self, kind: Kind, count: usize) {
+        let first = self.scene.geometry.count(kind);
+        let g = &mut self.scene.geometry;
+        g.sources
+            .add(kind, first, count, &self.file, self.entity_line);
+    }
+
     fn finish(mut self) -> Result<Scene, LoadError> {
         let Some(camera) = self.camera else {
             return Err(LoadError {
@@ -670,6 +788,7 @@ impl<'a> Parser<'a, '_> {
         scene.lights = self.lights;
         scene.ambient = Vec3::splat(default);
         scene.materials = self.materials;
+        scene.origin = self.origin;
         Ok(scene)
     }
 }
@@ -727,6 +846,32 @@ mod tests {
         let s = show(&long);
         assert!(s.len() < 60, "{s}");
         assert_eq!(show("abc"), "'abc'");
+    }
+
+    /// Each primitive, material and light knows the line of its entity; a polygon's
+    /// triangles share their `p`'s line; the scene's `Debug` form (the render hash of
+    /// `emray merge`) does not depend on the file's name.
+    #[test]
+    fn primitives_materials_and_lights_know_their_line() {
+        let src = "v from 0 0 5 at 0 0 0 up 0 1 0 angle 40 hither 1 resolution 8 8\n\
+                   l 1 1 1\n\
+                   f 1 0 0 1 0 0 0 0\n\
+                   s 0 0 0 1\n\
+                   # a quad: two triangles\n\
+                   p 4 0 0 0 1 0 0 1 1 0 0 1 0\n\
+                   c 0 0 0 1 0 1 0 1\n";
+        let scene = parse_str(src, Path::new("dir/a.nff")).unwrap();
+        let g = &scene.geometry;
+        let at = |o: Option<crate::scene::Origin>| o.unwrap().to_string();
+        assert_eq!(at(g.sources.get(Kind::Sphere, 0)), "dir/a.nff:4");
+        assert_eq!(g.count(Kind::Triangle), 2);
+        assert_eq!(at(g.sources.get(Kind::Triangle, 0)), "dir/a.nff:6");
+        assert_eq!(at(g.sources.get(Kind::Triangle, 1)), "dir/a.nff:6");
+        assert_eq!(at(g.sources.get(Kind::Cone, 0)), "dir/a.nff:7");
+        assert_eq!(at(scene.sources.materials.get(0)), "dir/a.nff:3");
+        assert_eq!(at(scene.sources.lights.get(0)), "dir/a.nff:2");
+        let elsewhere = parse_str(src, Path::new("b.nff")).unwrap();
+        assert_eq!(format!("{scene:?}"), format!("{elsewhere:?}"));
     }
 
     #[test]

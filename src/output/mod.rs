@@ -1,7 +1,14 @@
 //! Image output: PNG (sRGB-encoded by default) and OpenEXR (linear f32), chosen by the
 //! file extension, always written to a temporary file beside the target and renamed,
-//! so a failed or interrupted write never leaves a truncated image.
+//! so a failed or interrupted write never leaves a truncated image. Besides the colour:
+//! the output variables' EXR channels ([`aov`], [`channels`]) and the cost heat maps
+//! ([`heatmap`]), drawn with the colour maps of [`colormap`].
 
+pub mod aov;
+pub mod channels;
+pub mod colormap;
+mod font;
+pub mod heatmap;
 pub mod part;
 
 // The PNG writer's encodings, defined with the colour curves in `render`.
@@ -71,22 +78,21 @@ pub fn differing_pixels(a: &Film, b: &Film) -> usize {
 /// Write `film` to `path` (format by extension) through a temporary file and a rename.
 pub fn write_image(path: &Path, film: &Film, encoding: Encoding) -> Result<(), OutputError> {
     match Format::from_path(path)? {
-        Format::Png => write_atomic(path, |file| {
-            let mut w = BufWriter::new(file);
-            let enc = image::codecs::png::PngEncoder::new(&mut w);
-            image::ImageEncoder::write_image(
-                enc,
-                &to_rgb8(film, encoding),
-                film.width,
-                film.height,
-                image::ExtendedColorType::Rgb8,
-            )
-            .map_err(|e| e.to_string())?;
-            let file = w.into_inner().map_err(|e| e.into_error().to_string())?;
-            file.sync_all().map_err(|e| e.to_string())
-        }),
+        Format::Png => write_png_rgb8(path, film.width, film.height, &to_rgb8(film, encoding)),
         Format::Exr => part::write_exr(path, film, None),
     }
+}
+
+/// Write `width × height` RGB bytes as a PNG through a temporary file and a rename.
+pub fn write_png_rgb8(path: &Path, width: u32, height: u32, rgb: &[u8]) -> Result<(), OutputError> {
+    write_atomic(path, |file| {
+        let mut w = BufWriter::new(file);
+        let enc = image::codecs::png::PngEncoder::new(&mut w);
+        image::ImageEncoder::write_image(enc, rgb, width, height, image::ExtendedColorType::Rgb8)
+            .map_err(|e| e.to_string())?;
+        let file = w.into_inner().map_err(|e| e.into_error().to_string())?;
+        file.sync_all().map_err(|e| e.to_string())
+    })
 }
 
 /// The folder `path` goes in (`.` for a bare file name).

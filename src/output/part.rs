@@ -30,20 +30,46 @@ pub struct PartInfo {
 /// Write `film` as a linear f32 RGB EXR. With `part`, `film` is `part.region` of a
 /// `part.full` image: the data window says so and the hash is stored.
 pub fn write_exr(path: &Path, film: &Film, part: Option<&PartInfo>) -> Result<(), OutputError> {
-    let (w, h) = (film.width as usize, film.height as usize);
-    let (full, origin) = match part {
-        Some(p) => (
-            (p.full.0 as usize, p.full.1 as usize),
-            (p.region.x0 as i32, p.region.y0 as i32),
-        ),
-        None => ((w, h), (0, 0)),
-    };
+    let w = film.width as usize;
+    let (full, origin) = placement(film, part);
     let px = &film.pixels;
     let channels = SpecificChannels::rgb(|p: Vec2<usize>| {
         let v = px[p.y() * w + p.x()];
         (v.x, v.y, v.z)
     });
-    let mut layer_attributes = LayerAttributes {
+    let layer = Layer::new(
+        (w, film.height as usize),
+        layer_attributes(path, origin, part)?,
+        encoding(),
+        channels,
+    );
+    write_image(
+        path,
+        &Image::new(
+            ImageAttributes::new(IntegerBounds::new((0, 0), full)),
+            layer,
+        ),
+    )
+}
+
+/// The whole image's size and where `film` lies in it: the part's, or the film's own.
+pub(super) fn placement(film: &Film, part: Option<&PartInfo>) -> ((usize, usize), (i32, i32)) {
+    match part {
+        Some(p) => (
+            (p.full.0 as usize, p.full.1 as usize),
+            (p.region.x0 as i32, p.region.y0 as i32),
+        ),
+        None => ((film.width as usize, film.height as usize), (0, 0)),
+    }
+}
+
+/// A layer's attributes: its position in the whole image and the part's hash.
+pub(super) fn layer_attributes(
+    path: &Path,
+    origin: (i32, i32),
+    part: Option<&PartInfo>,
+) -> Result<LayerAttributes, OutputError> {
+    let mut attributes = LayerAttributes {
         layer_position: Vec2(origin.0, origin.1),
         ..LayerAttributes::default()
     };
@@ -52,23 +78,27 @@ pub fn write_exr(path: &Path, film: &Film, part: Option<&PartInfo>) -> Result<()
             path: path.to_path_buf(),
             message: "the part hash is not plain text".into(),
         })?;
-        layer_attributes
+        attributes
             .other
             .insert(Text::from(HASH_ATTRIBUTE), AttributeValue::Text(text));
     }
-    let layer = Layer::new(
-        (w, h),
-        layer_attributes,
-        // Blocks in increasing order: compressed in parallel, they are still written in
-        // one order, so the same image always gives the same bytes.
-        exr::image::Encoding {
-            line_order: exr::meta::attribute::LineOrder::Increasing,
-            ..exr::image::Encoding::FAST_LOSSLESS
-        },
-        channels,
-    );
-    let attributes = ImageAttributes::new(IntegerBounds::new((0, 0), full));
-    let image = Image::new(attributes, layer);
+    Ok(attributes)
+}
+
+/// Lossless compression with blocks in increasing order: compressed in parallel, they
+/// are still written in one order, so the same image always gives the same bytes.
+pub(super) fn encoding() -> exr::image::Encoding {
+    exr::image::Encoding {
+        line_order: exr::meta::attribute::LineOrder::Increasing,
+        ..exr::image::Encoding::FAST_LOSSLESS
+    }
+}
+
+/// Write `image` to `path` atomically (a temporary file, then a rename).
+pub(super) fn write_image<'i, L>(path: &Path, image: &'i Image<L>) -> Result<(), OutputError>
+where
+    L: exr::image::write::layers::WritableLayers<'i>,
+{
     write_atomic(path, |file| {
         let mut bw = BufWriter::new(file);
         image
@@ -95,17 +125,29 @@ pub fn read_exr(path: &Path) -> Result<(Film, PartInfo), String> {
         .all_attributes()
         .from_file(path)
         .map_err(|e| format!("{}: not a readable RGB EXR: {e}", path.display()))?;
-    let display = image.attributes.display_window;
     let layer = image.layer_data;
-    let pos = layer.attributes.layer_position;
+    let film = layer.channel_data.pixels;
+    let size = (film.width as usize, film.height as usize);
+    let info = part_info(path, &image.attributes, &layer.attributes, size)?;
+    Ok((film, info))
+}
+
+/// Where a layer of `size` pixels lies in its image (display window), and its hash.
+pub(crate) fn part_info(
+    path: &Path,
+    image: &ImageAttributes,
+    layer: &LayerAttributes,
+    size: (usize, usize),
+) -> Result<PartInfo, String> {
+    let display = image.display_window;
+    let pos = layer.layer_position;
     let (dx, dy) = (display.position.x(), display.position.y());
     let (fw, fh) = (display.size.x(), display.size.y());
-    let film = layer.channel_data.pixels;
     let (x0, y0) = (pos.x() - dx, pos.y() - dy);
     let fits = x0 >= 0
         && y0 >= 0
-        && x0 as u64 + film.width as u64 <= fw as u64
-        && y0 as u64 + film.height as u64 <= fh as u64;
+        && x0 as u64 + size.0 as u64 <= fw as u64
+        && y0 as u64 + size.1 as u64 <= fh as u64;
     if !fits || fw > u32::MAX as usize || fh > u32::MAX as usize {
         return Err(format!(
             "{}: the data window lies outside the display window",
@@ -114,20 +156,19 @@ pub fn read_exr(path: &Path) -> Result<(Film, PartInfo), String> {
     }
     let region = Region {
         x0: x0 as u32,
-        x1: x0 as u32 + film.width,
+        x1: x0 as u32 + size.0 as u32,
         y0: y0 as u32,
-        y1: y0 as u32 + film.height,
+        y1: y0 as u32 + size.1 as u32,
     };
-    let hash = match layer.attributes.other.get(&Text::from(HASH_ATTRIBUTE)) {
+    let hash = match layer.other.get(&Text::from(HASH_ATTRIBUTE)) {
         Some(AttributeValue::Text(t)) => Some(t.to_string()),
         _ => None,
     };
-    let info = PartInfo {
+    Ok(PartInfo {
         full: (fw as u32, fh as u32),
         region,
         hash,
-    };
-    Ok((film, info))
+    })
 }
 
 #[cfg(test)]

@@ -4,7 +4,7 @@
 use crate::accel::Accel;
 use crate::accel::Backend;
 use crate::geometry::reference as r64;
-use crate::load::nff::parse_str;
+use crate::load::nff::{parse_str, parse_str_at};
 use crate::math::{DRay, DVec3, Ray, Rng, Vec3, next_float_down, offset_ray_origin};
 use crate::render::{Film, RayGen, RenderSettings};
 use crate::run::render_scene;
@@ -188,8 +188,13 @@ pub fn tessellated_sphere(n: u32, center: Vec3) -> Watertight {
             targets.push((p, (p - center).normalize(), 0.5));
         }
     }
-    let scene = parse_str(&mesh_source(&tris, center), Path::new("<stress>"))
-        .expect("generated mesh parses");
+    // In the world's frame: the targets are world points.
+    let scene = parse_str_at(
+        &mesh_source(&tris, center),
+        Path::new("<stress>"),
+        DVec3::ZERO,
+    )
+    .expect("generated mesh parses");
     Watertight {
         scene,
         targets,
@@ -231,8 +236,13 @@ pub fn bipyramid(n: u32, center: Vec3) -> Watertight {
             targets.push((bottom + (a - bottom) * f, down, 0.5));
         }
     }
-    let scene = parse_str(&mesh_source(&tris, center), Path::new("<stress>"))
-        .expect("generated mesh parses");
+    // In the world's frame: the targets are world points.
+    let scene = parse_str_at(
+        &mesh_source(&tris, center),
+        Path::new("<stress>"),
+        DVec3::ZERO,
+    )
+    .expect("generated mesh parses");
     Watertight {
         scene,
         targets,
@@ -639,4 +649,57 @@ fn tangent_ray(
         Some(w) => f.dot(u.cross(w).normalize()).abs(),
     };
     (ray, ((dist - r) / r).abs() < band)
+}
+
+/// How closely a moved or scaled scene's picture matches the original's.
+#[derive(Clone, Copy, Debug, PartialEq)]
+pub struct Invariance {
+    /// Share (0..1) of pixels whose 8-bit sRGB channels all lie within
+    /// [`INVARIANCE_TOLERANCE`] of the original's.
+    pub within: f64,
+    /// Largest 8-bit difference of any channel of any pixel.
+    pub max_diff: u8,
+}
+
+/// The 8-bit difference a pixel of a moved scene may show and still count as the same.
+pub const INVARIANCE_TOLERANCE: u8 = 2;
+
+/// Share of pixels of `b` within [`INVARIANCE_TOLERANCE`] of `a` (8-bit sRGB), and the
+/// largest difference.
+pub fn invariance_of(a: &Film, b: &Film) -> Invariance {
+    use crate::render::color::{Encoding, to_rgb8};
+    let (pa, pb) = (to_rgb8(a, Encoding::Srgb), to_rgb8(b, Encoding::Srgb));
+    let mut within = 0usize;
+    let mut max_diff = 0u8;
+    for (x, y) in pa.chunks(3).zip(pb.chunks(3)) {
+        let d = x
+            .iter()
+            .zip(y)
+            .map(|(p, q)| p.abs_diff(*q))
+            .max()
+            .unwrap_or(0);
+        max_diff = max_diff.max(d);
+        within += usize::from(d <= INVARIANCE_TOLERANCE);
+    }
+    Invariance {
+        within: within as f64 / (pa.len() / 3).max(1) as f64,
+        max_diff,
+    }
+}
+
+/// Render the NFF scene `src` and the same scene moved by `shift` and scaled by `scale`
+/// ([`move_nff`](super::moved::move_nff)) on `backend` at `res × res`, one ray per
+/// pixel centre, and compare the pictures.
+pub fn invariance(src: &str, scale: f64, shift: DVec3, backend: Backend, res: u32) -> Invariance {
+    let moved = super::moved::move_nff(src, scale, shift).expect("an NFF scene that loads");
+    let render_at = |text: &str| {
+        let scene = parse_str(text, Path::new("<invariance>")).expect("the scene loads");
+        let mut st = RenderSettings::for_scene(&scene);
+        st.width = res;
+        st.height = res;
+        render_scene("invariance", &scene, backend, &st, 0.0, None)
+            .expect("backend builds")
+            .0
+    };
+    invariance_of(&render_at(src), &render_at(&moved))
 }

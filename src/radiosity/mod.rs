@@ -211,14 +211,16 @@ impl Solution {
 
     /// The solved mesh as ASCII PLY with sRGB-encoded 8-bit vertex colours (values
     /// scaled by `exposure`), one vertex per element corner so that creases stay sharp.
-    pub fn to_ply(&self, exposure: f32) -> String {
+    /// Positions are the world's: the scene's `origin` ([`crate::scene::Scene::origin`])
+    /// added back, in double precision.
+    pub fn to_ply(&self, exposure: f32, origin: glam::DVec3) -> String {
         use std::fmt::Write;
         let m = &self.mesh;
         let mut s = String::new();
         let _ = write!(
             s,
             "ply\nformat ascii 1.0\ncomment emray radiosity solution\nelement vertex {}\n\
-             property float x\nproperty float y\nproperty float z\n\
+             property double x\nproperty double y\nproperty double z\n\
              property uchar red\nproperty uchar green\nproperty uchar blue\n\
              element face {}\nproperty list uchar int vertex_indices\nend_header\n",
             m.vertices.len(),
@@ -226,6 +228,7 @@ impl Solution {
         );
         let byte = |x: f32| (srgb_encode(x * exposure) * 255.0).round() as u8;
         for (p, c) in m.vertices.iter().zip(&self.vertex_radiosity) {
+            let p = p.as_dvec3() + origin;
             let _ = writeln!(
                 s,
                 "{} {} {} {} {} {}",

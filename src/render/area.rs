@@ -6,6 +6,8 @@
 //! irradiance from the light divided by π, so that a diffuse surface of reflectance
 //! `ρ` shows `ρ ×` it, the same units as the radiosity solution's `B`.
 
+use super::RayCounts;
+use super::record::Recorder;
 use crate::accel::Accel;
 use crate::math::{Ray, Vec3, gamma, hash, hash_unit as unit, next_float_down, offset_ray_origin};
 use crate::scene::{INHERIT, Scene};
@@ -95,6 +97,18 @@ pub fn direct<A: Accel>(
     n: u32,
     seed: u32,
 ) -> (Vec3, u64) {
+    direct_recorded(accel, lights, at, n, seed, &mut RayCounts::default())
+}
+
+/// [`direct`], each light's share reported to `rec` ([`Recorder::area_light`]).
+pub fn direct_recorded<A: Accel, R: Recorder>(
+    accel: &A,
+    lights: &[AreaLight],
+    at: &Receiver,
+    n: u32,
+    seed: u32,
+    rec: &mut R,
+) -> (Vec3, u64) {
     let Receiver { p, err, ng, ns } = *at;
     let n = n.max(1);
     let mut sum = Vec3::ZERO;
@@ -105,6 +119,7 @@ pub fn direct<A: Accel>(
             continue;
         }
         let mut acc = 0.0;
+        let (first, mut visible) = (rays, 0u32);
         for s in 0..n * n {
             let h = hash(seed ^ hash(li as u32) ^ s.wrapping_mul(0x9e37_79b9));
             let a = ((s % n) as f32 + unit(h)) / n as f32;
@@ -128,9 +143,14 @@ pub fn direct<A: Accel>(
             if accel.occluded(&ray) {
                 continue;
             }
+            if R::ACTIVE {
+                visible += 1;
+            }
             acc += cos_s * cos_l / (dist2 * dist2);
         }
-        sum += l.emission * (FRAC_1_PI * acc * l.area / (n * n) as f32);
+        let term = l.emission * (FRAC_1_PI * acc * l.area / (n * n) as f32);
+        rec.area_light(li, (rays - first) as u32, visible, term);
+        sum += term;
     }
     (sum, rays)
 }

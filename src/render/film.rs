@@ -42,13 +42,22 @@ impl Film {
         let mut out = Film::new(w, h);
         for j in 0..h {
             for i in 0..w {
-                let s = self.get(i, j)
-                    + self.get(i + 1, j)
-                    + self.get(i, j + 1)
-                    + self.get(i + 1, j + 1);
-                out.set(i, j, s * 0.25);
+                let k = [
+                    self.get(i, j),
+                    self.get(i + 1, j),
+                    self.get(i, j + 1),
+                    self.get(i + 1, j + 1),
+                ];
+                out.set(i, j, corner_mean(k));
             }
         }
         out
     }
+}
+
+/// The value of an SPD-mode pixel from its corners (top-left, top-right, bottom-left,
+/// bottom-right), summed in that order.
+#[inline(always)]
+pub fn corner_mean(k: [Vec3; 4]) -> Vec3 {
+    (k[0] + k[1] + k[2] + k[3]) * 0.25
 }

@@ -4,23 +4,31 @@
 //! Global illumination comes in through [`GlobalIllumination`] (a radiosity solution
 //! implements it); [`color`] turns the film's linear values into encoded 8-bit ones.
 
+pub mod aov;
 pub mod area;
 mod camera;
 pub mod color;
+mod counts;
+pub mod explain;
 mod film;
 pub mod gi;
+mod grid;
+mod local;
+pub mod media;
+mod optics;
+pub mod record;
 pub mod reference;
+mod shade;
 mod whitted;
 
 pub use camera::RayGen;
+pub use counts::RayCounts;
 pub use film::Film;
 pub use gi::GlobalIllumination;
-pub use whitted::RayCounts;
+pub(crate) use grid::tile_of;
 
 use crate::accel::Accel;
 use crate::scene::Scene;
-use rayon::prelude::*;
-use std::sync::atomic::{AtomicUsize, Ordering};
 
 /// How to render.
 #[derive(Clone, Debug, PartialEq)]
@@ -211,191 +219,15 @@ pub fn render_with_gi<A: Accel>(
     progress: Option<Progress<'_>>,
 ) -> (Film, RenderStats) {
     let start = std::time::Instant::now();
-    let (w, h) = (settings.width, settings.height);
     let tracer = whitted::Tracer::new(scene, accel, settings).with_gi(gi);
-    // Only the samples of the region: every pixel and sample keeps its coordinates in
-    // the whole image, so a part holds exactly the full render's pixels.
-    let r = settings.region.unwrap_or(Region::full(w, h));
     if let (Aa::Adaptive { threshold, depth }, false) = (settings.aa, settings.spd) {
-        // The rays through every pixel corner, then each pixel refined from its four.
-        let raygen = RayGen::new(&scene.camera, w, h);
-        let (cw, ch) = (r.width() + 1, r.height() + 1);
-        let (corners, mut rays) = sample_grid(
-            r.x0,
-            r.y0,
-            cw,
-            ch,
-            settings.tile,
-            None,
-            per_position(|i, j, c| tracer.sample(&raygen, i as f32, j as f32, c)),
-        );
-        let (rw, rh) = (r.width(), r.height());
-        let refine = per_position(|i, j, c| {
-            let (ci, cj) = (i - r.x0, j - r.y0);
-            let k = [
-                corners.get(ci, cj),
-                corners.get(ci + 1, cj),
-                corners.get(ci, cj + 1),
-                corners.get(ci + 1, cj + 1),
-            ];
-            let s = |x: f32, y: f32, c: &mut RayCounts| tracer.sample(&raygen, x, y, c);
-            adaptive(&s, i as f32, j as f32, 1.0, k, threshold, depth, c)
-        });
-        let (film, more) = sample_grid(r.x0, r.y0, rw, rh, settings.tile, progress, refine);
-        rays += more;
+        let (film, rays) = grid::adaptive_render(&tracer, settings, threshold, depth, progress);
         return (film, RenderStats::finish(rays, start));
     }
-    // In SPD mode the sample grid is the pixel corners: one more row and column.
-    let (gw, gh) = if settings.spd { (w + 1, h + 1) } else { (w, h) };
-    let raygen = RayGen::new(&scene.camera, gw, gh);
-    let extra = u32::from(settings.spd);
-    let (rw, rh) = (r.width() + extra, r.height() + extra);
-    let (grid, rays) = sample_grid(r.x0, r.y0, rw, rh, settings.tile, progress, |t, px, c| {
-        tracer.tile(&raygen, t, px, c);
-    });
-    let film = if settings.spd {
-        grid.average_corners()
-    } else {
-        grid
-    };
-    (film, RenderStats::finish(rays, start))
-}
-
-/// A per-position function `f(i, j, counts)` as a tile function for [`sample_grid`]:
-/// the tile's positions row by row.
-fn per_position<F>(f: F) -> impl Fn(Region, &mut Vec<glam::Vec3>, &mut RayCounts) + Sync
-where
-    F: Fn(u32, u32, &mut RayCounts) -> glam::Vec3 + Sync,
-{
-    move |t, px, counts| {
-        for j in t.y0..t.y1 {
-            for i in t.x0..t.x1 {
-                px.push(f(i, j, counts));
-            }
-        }
-    }
-}
-
-/// Evaluate the `gw × gh` grid whose top-left is `(ox, oy)` in parallel square tiles
-/// of edge `tile`, the result independent of the schedule: `f(tile, px, counts)` pushes
-/// the values of the tile's grid positions (absolute coordinates, row by row) onto
-/// `px`, and the film's pixel `(i, j)` is the value of position `(ox + i, oy + j)`.
-fn sample_grid<F>(
-    ox: u32,
-    oy: u32,
-    gw: u32,
-    gh: u32,
-    tile: u32,
-    progress: Option<Progress<'_>>,
-    f: F,
-) -> (Film, RayCounts)
-where
-    F: Fn(Region, &mut Vec<glam::Vec3>, &mut RayCounts) + Sync,
-{
-    let ts = tile.max(1);
-    let tiles: Vec<(u32, u32)> = (0..gh.div_ceil(ts))
-        .flat_map(|ty| (0..gw.div_ceil(ts)).map(move |tx| (tx * ts, ty * ts)))
-        .collect();
-    let done = AtomicUsize::new(0);
-    let total = tiles.len();
-    let results: Vec<(Vec<glam::Vec3>, RayCounts)> = tiles
-        .par_iter()
-        .map(|&(x0, y0)| {
-            let x1 = (x0 + ts).min(gw);
-            let y1 = (y0 + ts).min(gh);
-            let mut counts = RayCounts::default();
-            let mut px = Vec::with_capacity(((x1 - x0) * (y1 - y0)) as usize);
-            let t = Region {
-                x0: ox + x0,
-                y0: oy + y0,
-                x1: ox + x1,
-                y1: oy + y1,
-            };
-            f(t, &mut px, &mut counts);
-            if let Some(p) = progress {
-                p(done.fetch_add(1, Ordering::Relaxed) + 1, total);
-            }
-            (px, counts)
-        })
-        .collect();
-    let mut grid = Film::new(gw, gh);
+    let (film, tiles) = grid::uniform_render(&tracer, settings, progress, RayCounts::default);
     let mut rays = RayCounts::default();
-    for (&(x0, y0), (px, counts)) in tiles.iter().zip(results) {
+    for counts in tiles {
         rays += counts;
-        let x1 = (x0 + ts).min(gw);
-        let mut it = px.into_iter();
-        for j in y0..(y0 + ts).min(gh) {
-            for i in x0..x1 {
-                grid.set(i, j, it.next().expect("tile size"));
-            }
-        }
     }
-    (grid, rays)
-}
-
-/// Whitted's adaptive refinement of the square at `(x, y)` of edge `size` whose corner
-/// values are `k` (top-left, top-right, bottom-left, bottom-right): their mean if they
-/// agree within `threshold` or `depth` is exhausted, else the mean of its four
-/// quarters, the five new points sampled with `sample`.
-#[allow(clippy::too_many_arguments)]
-fn adaptive<S>(
-    sample: &S,
-    x: f32,
-    y: f32,
-    size: f32,
-    k: [glam::Vec3; 4],
-    threshold: f32,
-    depth: u32,
-    c: &mut RayCounts,
-) -> glam::Vec3
-where
-    S: Fn(f32, f32, &mut RayCounts) -> glam::Vec3,
-{
-    let lo = k[0].min(k[1]).min(k[2].min(k[3]));
-    let hi = k[0].max(k[1]).max(k[2].max(k[3]));
-    // A NaN corner compares false: it is not refined (and shows as NaN).
-    if depth == 0 || (hi - lo).max_element() <= threshold {
-        return (k[0] + k[1] + k[2] + k[3]) * 0.25;
-    }
-    let hs = size * 0.5;
-    let top = sample(x + hs, y, c);
-    let left = sample(x, y + hs, c);
-    let mid = sample(x + hs, y + hs, c);
-    let right = sample(x + size, y + hs, c);
-    let bottom = sample(x + hs, y + size, c);
-    let d = depth - 1;
-    let q = [
-        adaptive(sample, x, y, hs, [k[0], top, left, mid], threshold, d, c),
-        adaptive(
-            sample,
-            x + hs,
-            y,
-            hs,
-            [top, k[1], mid, right],
-            threshold,
-            d,
-            c,
-        ),
-        adaptive(
-            sample,
-            x,
-            y + hs,
-            hs,
-            [left, mid, k[2], bottom],
-            threshold,
-            d,
-            c,
-        ),
-        adaptive(
-            sample,
-            x + hs,
-            y + hs,
-            hs,
-            [mid, right, bottom, k[3]],
-            threshold,
-            d,
-            c,
-        ),
-    ];
-    (q[0] + q[1] + q[2] + q[3]) * 0.25
+    (film, RenderStats::finish(rays, start))
 }

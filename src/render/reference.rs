@@ -11,8 +11,8 @@
 //! and triangles; instances; spot lights; media priorities) are refused, never
 //! rendered differently.
 
+use super::RayCounts;
 use super::film::Film;
-use super::whitted::RayCounts;
 use crate::geometry::Kind;
 use crate::geometry::reference as r64;
 use crate::math::DRay;
@@ -317,30 +317,12 @@ fn unit64(x: u64) -> f64 {
 /// Render `scene` at `width × height` with `n × n` stratified jittered samples per
 /// pixel (deterministic), to depth `max_depth`. The scene must be supported.
 pub fn render(scene: &Scene, width: u32, height: u32, n: u32, max_depth: u32) -> (Film, RayCounts) {
-    let n = n.max(1);
-    let cam = Camera64::new(&scene.camera, width, height);
-    let tracer = Reference::new(scene, max_depth);
+    let job = Job::new(scene, width, height, n, max_depth);
     let rows: Vec<(Vec<Vec3>, RayCounts)> = (0..height)
         .into_par_iter()
         .map(|j| {
             let mut c = RayCounts::default();
-            let row = (0..width)
-                .map(|i| {
-                    let mut sum = DVec3::ZERO;
-                    let seed = mix(((j as u64) << 32) | i as u64);
-                    for a in 0..n {
-                        for b in 0..n {
-                            let h = mix(seed ^ ((a * n + b) as u64 + 1));
-                            let sx = (b as f64 + unit64(h)) / n as f64;
-                            let sy = (a as f64 + unit64(mix(h))) / n as f64;
-                            let ray = cam.ray(i as f64 + sx, j as f64 + sy);
-                            c.eye += 1;
-                            sum += tracer.trace(&ray, 1, &[], &mut c);
-                        }
-                    }
-                    (sum / (n * n) as f64).as_vec3()
-                })
-                .collect();
+            let row = (0..width).map(|i| job.pixel(i, j, &mut c)).collect();
             (row, c)
         })
         .collect();
@@ -353,4 +335,73 @@ pub fn render(scene: &Scene, width: u32, height: u32, n: u32, max_depth: u32) ->
         }
     }
     (film, counts)
+}
+
+/// Pixels [`estimate_ms`] traces: enough to average over the picture, few enough to
+/// take a small share of the time of any run worth estimating.
+const ESTIMATE_PIXELS: u32 = 64;
+
+/// The time in milliseconds [`render`] would take with the same arguments on
+/// `threads` threads, extrapolated from [`ESTIMATE_PIXELS`] pixels spread over the
+/// picture (a diagonal-free lattice, so a scene's empty corners and busy centre both
+/// count), traced on this thread.
+pub fn estimate_ms(
+    scene: &Scene,
+    width: u32,
+    height: u32,
+    n: u32,
+    max_depth: u32,
+    threads: usize,
+) -> f64 {
+    let job = Job::new(scene, width, height, n, max_depth);
+    let total = width as u64 * height as u64;
+    let samples = (ESTIMATE_PIXELS as u64).min(total).max(1);
+    let mut c = RayCounts::default();
+    let t0 = std::time::Instant::now();
+    for k in 0..samples {
+        // Pixel number k·total/samples, offset by half a step, of the row-major order.
+        let at = (k * total + total / 2) / samples;
+        job.pixel(
+            (at % width as u64) as u32,
+            (at / width as u64) as u32,
+            &mut c,
+        );
+    }
+    let per_pixel = t0.elapsed().as_secs_f64() * 1e3 / samples as f64;
+    per_pixel * total as f64 / threads.max(1) as f64
+}
+
+/// What every pixel of a reference render shares.
+struct Job<'a> {
+    cam: Camera64,
+    tracer: Reference<'a>,
+    n: u32,
+}
+
+impl<'a> Job<'a> {
+    fn new(scene: &'a Scene, width: u32, height: u32, n: u32, max_depth: u32) -> Self {
+        Job {
+            cam: Camera64::new(&scene.camera, width, height),
+            tracer: Reference::new(scene, max_depth),
+            n: n.max(1),
+        }
+    }
+
+    /// Pixel `(i, j)`: the mean of its `n × n` jittered strata.
+    fn pixel(&self, i: u32, j: u32, c: &mut RayCounts) -> Vec3 {
+        let n = self.n;
+        let mut sum = DVec3::ZERO;
+        let seed = mix(((j as u64) << 32) | i as u64);
+        for a in 0..n {
+            for b in 0..n {
+                let h = mix(seed ^ ((a * n + b) as u64 + 1));
+                let sx = (b as f64 + unit64(h)) / n as f64;
+                let sy = (a as f64 + unit64(mix(h))) / n as f64;
+                let ray = self.cam.ray(i as f64 + sx, j as f64 + sy);
+                c.eye += 1;
+                sum += self.tracer.trace(&ray, 1, &[], c);
+            }
+        }
+        (sum / (n * n) as f64).as_vec3()
+    }
 }

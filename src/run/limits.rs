@@ -28,6 +28,20 @@ pub fn estimate_bytes(scene: &Scene, settings: &RenderSettings) -> u64 {
     samples * 12 * 2 + r.width() as u64 * r.height() as u64 * 15 + prims * ACCEL_BYTES_PER_PRIM
 }
 
+/// Bytes per sample-grid position that gathering output variables adds (`--aov`,
+/// `--heatmap`): the positions' records and their grid, the variables of each pixel,
+/// and their EXR channels, with room to spare.
+pub const AOV_BYTES_PER_SAMPLE: u64 = 320;
+
+/// The estimated bytes that gathering output variables adds to a render.
+pub fn aov_bytes(settings: &RenderSettings) -> u64 {
+    let r = settings
+        .region
+        .unwrap_or(Region::full(settings.width, settings.height));
+    let extra = u64::from(settings.spd);
+    (r.width() as u64 + extra) * (r.height() as u64 + extra) * AOV_BYTES_PER_SAMPLE
+}
+
 /// The default limit: three quarters of the machine's memory (`/proc/meminfo`), else
 /// 16 GiB.
 pub fn default_max_memory() -> u64 {
@@ -112,7 +126,19 @@ pub fn check(
     settings: &RenderSettings,
     max: u64,
 ) -> Result<(), MemoryLimitError> {
-    let need = estimate_bytes(scene, settings);
+    check_with(scene_path, scene, settings, 0, max)
+}
+
+/// [`check`] for a render that needs `extra` bytes besides (output variables:
+/// [`aov_bytes`]).
+pub fn check_with(
+    scene_path: &Path,
+    scene: &Scene,
+    settings: &RenderSettings,
+    extra: u64,
+    max: u64,
+) -> Result<(), MemoryLimitError> {
+    let need = estimate_bytes(scene, settings).saturating_add(extra);
     if need > max {
         return Err(MemoryLimitError {
             scene: scene_path.to_path_buf(),
@@ -164,5 +190,12 @@ mod tests {
             e.ends_with("over the memory limit of 1.0 GiB (--max-memory)"),
             "{e}"
         );
+        // Output variables need more: a render that fits may not with them.
+        s.width = 4000;
+        s.height = 4000;
+        let max = estimate_bytes(&scene, &s) + 1;
+        assert!(check(Path::new("t.nff"), &scene, &s, max).is_ok());
+        let extra = aov_bytes(&s);
+        assert!(check_with(Path::new("t.nff"), &scene, &s, extra, max).is_err());
     }
 }

@@ -2,15 +2,17 @@
 //! loaders in [`crate::load`] build it and the backends in [`crate::accel`] read it.
 
 use crate::geometry::{Kind, Param, SurfacePoint};
-use crate::math::{Ray, Vec3, Xform};
+use crate::math::{DVec3, Ray, Vec3, Xform};
 use glam::Vec2;
 
 mod hit;
 pub mod range;
+mod sources;
 mod store;
 pub mod texture;
 
 pub use hit::{Hit, NO_INSTANCE};
+pub use sources::{Origin, PrimSources, Sources};
 pub use store::{Geometry, GeometryMark, KindVisitor, Prims, ShapeEntry};
 
 pub use texture::{Environment, Maps, NO_TEXTURE, Texture};
@@ -209,6 +211,27 @@ pub struct Scene {
     pub textures: Vec<Texture>,
     /// Environment map for rays that leave the scene (replaces `background`).
     pub environment: Option<Environment>,
+    /// Where the scene's zero lies in the world its file describes. The loaders read
+    /// coordinates in double precision and translate the whole scene (geometry, lights,
+    /// camera, instance transforms) by this one origin, the camera's eye, before they
+    /// become single precision: the picture then keeps its detail however far from the
+    /// world's origin the scene is. Everything in the scene is in this frame; add the
+    /// origin back for world coordinates ([`Scene::to_world`]).
+    pub origin: DVec3,
+    /// Where the materials, lights and instances were defined (the primitives' origins
+    /// are in each [`Geometry`]'s `sources`).
+    pub sources: SceneSources,
+}
+
+/// Where the items of a scene's lists were defined, as far as the loader recorded it.
+#[derive(Clone, Debug, Default, PartialEq, Eq)]
+pub struct SceneSources {
+    /// Per material index.
+    pub materials: Sources,
+    /// Per point light.
+    pub lights: Sources,
+    /// Per instance.
+    pub instances: Sources,
 }
 
 /// Render settings a scene file may carry; `None` leaves the renderer's default.
@@ -257,7 +280,15 @@ impl Scene {
             load_stats: LoadStats::default(),
             textures: Vec::new(),
             environment: None,
+            origin: DVec3::ZERO,
+            sources: SceneSources::default(),
         }
+    }
+
+    /// The world point of `p`, a point of the scene's frame (see [`Scene::origin`]).
+    #[inline]
+    pub fn to_world(&self, p: Vec3) -> DVec3 {
+        p.as_dvec3() + self.origin
     }
 
     /// Number of primitives of `kind` a ray can meet: the top level's and each
@@ -286,6 +317,7 @@ impl Scene {
     /// The surface at a hit reported by a backend for `ray` (world space).
     pub fn surface(&self, hit: &Hit, ray: &Ray) -> Surface {
         if hit.inst_id == NO_INSTANCE {
+            let hit = &self.geometry.exact_hit(hit, ray);
             let mut surf = self.geometry.surface(hit, ray);
             if self.textured(surf.material) {
                 surf.param = Some(self.geometry.param(hit, &surf));
@@ -294,7 +326,9 @@ impl Scene {
         }
         let inst = &self.instances[hit.inst_id as usize];
         let object = &self.objects[inst.object as usize];
-        let local = object.surface(hit, &inst.xform.ray_to_object(ray));
+        let local_ray = inst.xform.ray_to_object(ray);
+        let hit = &object.exact_hit(hit, &local_ray);
+        let local = object.surface(hit, &local_ray);
         let point = inst.xform.surface_to_world(&local.point);
         let ns = inst.xform.normal_to_world(local.ns).normalize_or(point.ng);
         let material = if local.material == INHERIT {
@@ -342,7 +376,8 @@ impl Scene {
 
     fn apply_maps(&self, m: &mut Material, prm: &Param, surf: &Surface) -> Vec3 {
         let maps = m.maps;
-        let p = surf.point.p;
+        // Solid textures are of the world point, wherever the frame's origin lies.
+        let p = self.to_world(surf.point.p).as_vec3();
         let [su, sv] = maps.uv_scale;
         let prm = &Param {
             uv: prm.uv * Vec2::new(su, sv),

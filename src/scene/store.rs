@@ -9,7 +9,7 @@
 //! read one list, and [`Geometry::visit`]/[`Geometry::visit_all`] to run code on a
 //! list at its static type (a [`KindVisitor`], as the backends do to build).
 
-use super::{Hit, Surface};
+use super::{Hit, PrimSources, Surface};
 use crate::geometry::{
     AaBox, Analytic, CappedCone, Cone, Csg, Kind, OBox, Param, Plane, Polyhedron, QuadUv, Quadric,
     Shape, ShapeHit, Sphere, Torus, Triangle, for_each_kind,
@@ -110,6 +110,9 @@ macro_rules! define_store {
             /// Textured quad faces (OBJ faces of four vertices with `vt`, planar and
             /// convex).
             pub quads: Vec<QuadUv>,
+            /// Where each primitive was defined (file and line), as far as the loader
+            /// recorded it.
+            pub sources: PrimSources,
             $(#[doc = $doc] $field: Prims<$t>,)*
         }
 
@@ -169,6 +172,13 @@ for_each_kind!(define_store);
 /// The primitive counts of a [`Geometry`] at one moment ([`Geometry::mark`]), per kind.
 #[derive(Clone, Copy, Debug, Default, PartialEq, Eq)]
 pub struct GeometryMark([usize; Kind::ALL.len()]);
+
+impl GeometryMark {
+    /// How many primitives of `kind` there were.
+    pub fn count(&self, kind: Kind) -> usize {
+        self.0[kind as usize]
+    }
+}
 
 impl Geometry {
     /// Add an analytic primitive of a statically known kind.
@@ -305,6 +315,34 @@ impl Geometry {
         match self.visit(kind, &mut SurfaceAt { i, hit, ray }) {
             Some(surface) => surface,
             None => self.triangle_surface(i, hit),
+        }
+    }
+
+    /// `hit` with a triangle's barycentrics and distance computed by emray's own
+    /// watertight test ([`Triangle::intersect`]) on the triangle the backend reported,
+    /// so that a hit is the same point whichever backend found it (Embree's triangle
+    /// arithmetic differs from the BVH's in the last bits, and reflections between
+    /// curved meshes magnify that into visible differences a few bounces down). When
+    /// the test does not confirm the hit (a ray within rounding of the triangle's edge,
+    /// which the backend gave to this triangle and the test to its neighbour), the
+    /// backend's values stay. Other kinds are computed by emray's intersectors on both
+    /// backends already.
+    #[inline]
+    pub fn exact_hit(&self, hit: &Hit, ray: &Ray) -> Hit {
+        if hit.geom_id != Kind::Triangle as u32 {
+            return *hit;
+        }
+        let Some(tri) = self.triangles.items.get(hit.prim_id as usize) else {
+            return *hit;
+        };
+        match tri.intersect(ray) {
+            Some(h) => Hit {
+                t: h.t,
+                u: h.u,
+                v: h.v,
+                ..*hit
+            },
+            None => *hit,
         }
     }
 

@@ -56,9 +56,10 @@ impl EmbreeAccel {
     }
 
     /// Build with an Embree device configuration string, e.g. `"threads=2"` (see
-    /// `rtcNewDevice`).
+    /// `rtcNewDevice`), the default build quality and robust traversal (emray's
+    /// defaults).
     pub fn build_with_config(scene: &Scene, config: &str) -> Result<EmbreeAccel, EmbreeError> {
-        EmbreeAccel::build_with(scene, config, EmbreeQuality::default(), false)
+        EmbreeAccel::build_with(scene, config, EmbreeQuality::default(), true)
     }
 
     /// Build with a device configuration string, a build quality, and with or without

@@ -284,7 +284,7 @@ pub struct LightDef {
 }
 
 /// One step of a `transform` list: exactly one of `translate`, `rotate` (with `angle`),
-/// `scale` or `matrix`.
+/// `scale`, `mirror` or `matrix`.
 #[derive(Clone, Debug, Default, PartialEq, Serialize, Deserialize)]
 #[serde(deny_unknown_fields)]
 pub struct TransformStep {
@@ -300,9 +300,24 @@ pub struct TransformStep {
     /// Scale: one number (uniform) or three.
     #[serde(default, skip_serializing_if = "Option::is_none")]
     pub scale: Option<Spanned<Scale>>,
+    /// A reflection about a plane.
+    #[serde(default, skip_serializing_if = "Option::is_none")]
+    pub mirror: Option<Spanned<MirrorDef>>,
     /// An affine matrix, 4 rows of 4, the last row `[0, 0, 0, 1]`.
     #[serde(default, skip_serializing_if = "Option::is_none")]
     pub matrix: Option<Spanned<[[Real; 4]; 4]>>,
+}
+
+/// The plane a `mirror` step reflects about: through `point` (default the origin), with
+/// normal `normal` (any length but zero).
+#[derive(Clone, Debug, PartialEq, Serialize, Deserialize)]
+#[serde(deny_unknown_fields)]
+pub struct MirrorDef {
+    /// A point of the plane.
+    #[serde(default, skip_serializing_if = "Option::is_none")]
+    pub point: Option<Spanned<V3>>,
+    /// The plane's normal.
+    pub normal: Spanned<V3>,
 }
 
 /// A scale factor: one number for all axes, or one per axis.

@@ -66,7 +66,20 @@ pub fn parse_str_with_settings(
 ) -> Result<(Scene, SceneSettings), LoadError> {
     let source = Source::new(path, src);
     let file = parse_file_in(&source)?;
-    build::build(&file, &source)
+    build::build(&file, &source, None)
+}
+
+/// [`parse_str`] in the frame whose origin is the world point `origin` rather than the
+/// camera's eye (see [`Scene::origin`]): with [`glam::DVec3::ZERO`], the scene holds the
+/// file's own coordinates (rounded to single precision), which is what tests of the
+/// format compare with.
+///
+/// # Errors
+/// As [`parse_str`].
+pub fn parse_str_at(src: &str, path: &Path, origin: glam::DVec3) -> Result<Scene, LoadError> {
+    let source = Source::new(path, src);
+    let file = parse_file_in(&source)?;
+    build::build(&file, &source, Some(origin)).map(|(scene, _)| scene)
 }
 
 /// Read TOML text into the format structures only (no names resolved, nothing built):
@@ -178,7 +191,63 @@ fn serde_message(msg: &str) -> String {
     if let Some(rest) = msg.strip_prefix("missing field ") {
         return format!("missing key {rest}");
     }
-    msg
+    type_message(&msg).unwrap_or(msg)
+}
+
+/// serde's type errors (`invalid type: map, expected a sequence`) in TOML's own terms,
+/// expectation first: `expected an array, found a table`.
+fn type_message(msg: &str) -> Option<String> {
+    let (found, expected) = if let Some(rest) = msg
+        .strip_prefix("invalid type: ")
+        .or_else(|| msg.strip_prefix("invalid value: "))
+    {
+        let (found, expected) = rest.split_once(", expected ")?;
+        (toml_found(found), expected)
+    } else {
+        let rest = msg.strip_prefix("invalid length ")?;
+        let (n, expected) = rest.split_once(", expected ")?;
+        let values = if n == "1" { "value" } else { "values" };
+        (format!("an array of {n} {values}"), expected)
+    };
+    Some(format!(
+        "expected {}, found {found}",
+        toml_expected(expected)
+    ))
+}
+
+/// What serde says it found (`serde::de::Unexpected`), in TOML's terms.
+fn toml_found(found: &str) -> String {
+    let unquote = |s: &str| s.trim_matches('`').to_string();
+    match found.split_once(' ') {
+        _ if found == "map" => "a table".into(),
+        _ if found == "sequence" => "an array".into(),
+        Some(("string", s)) => format!("the string {s}"),
+        Some(("integer", v)) => format!("the whole number {}", unquote(v)),
+        Some(("floating", v)) => format!("the number {}", unquote(v.trim_start_matches("point "))),
+        Some(("boolean", v)) => format!("the boolean {}", unquote(v)),
+        _ => found.to_string(),
+    }
+}
+
+/// What serde says it expected, in TOML's terms.
+fn toml_expected(expected: &str) -> String {
+    if let Some(n) = expected
+        .strip_prefix("an array of length ")
+        .or_else(|| expected.strip_prefix("a tuple of size "))
+    {
+        return format!("an array of {n} values");
+    }
+    if expected.starts_with("struct ") || expected == "a map" {
+        return "a table".into();
+    }
+    match expected {
+        "a sequence" => "an array".into(),
+        "u8" | "u16" | "u32" | "u64" | "usize" => "a whole number, 0 or more".into(),
+        "i8" | "i16" | "i32" | "i64" | "isize" => "a whole number".into(),
+        "f32" | "f64" => "a number".into(),
+        "a boolean" | "bool" => "true or false".into(),
+        other => other.to_string(),
+    }
 }
 
 /// The candidate closest to `word` by edit distance, if close enough to be a likely
@@ -273,5 +342,46 @@ mod tests {
             "{m}"
         );
         assert!(m.contains("docs/scene-format.md"), "{m}");
+    }
+
+    #[test]
+    fn type_errors_speak_toml() {
+        let cases = [
+            (
+                "invalid type: map, expected an array of length 3",
+                "expected an array of 3 values, found a table",
+            ),
+            (
+                "invalid length 2, expected an array of length 3",
+                "expected an array of 3 values, found an array of 2 values",
+            ),
+            (
+                "invalid type: integer `5`, expected a sequence",
+                "expected an array, found the whole number 5",
+            ),
+            (
+                "invalid type: floating point `1.5`, expected u32",
+                "expected a whole number, 0 or more, found the number 1.5",
+            ),
+            (
+                "invalid value: integer `-5`, expected u32",
+                "expected a whole number, 0 or more, found the whole number -5",
+            ),
+            (
+                "invalid type: integer `5`, expected struct CameraDef",
+                "expected a table, found the whole number 5",
+            ),
+            (
+                "invalid type: string \"x\", expected a number",
+                "expected a number, found the string \"x\"",
+            ),
+            (
+                "invalid type: boolean `true`, expected a number",
+                "expected a number, found the boolean true",
+            ),
+        ];
+        for (serde, toml) in cases {
+            assert_eq!(serde_message(serde), toml);
+        }
     }
 }

@@ -1,0 +1,152 @@
+//! The options of `emray render` that look inside a render: `--aov` (output variables
+//! in the EXR beside the colour) and `--heatmap` (a false-colour PNG of a per-pixel
+//! cost): parsing, the checks made before any render, and writing what they ask for.
+
+use anyhow::{Result, bail};
+use emray::output::heatmap::{Quantity, write_heatmap};
+use emray::output::{self, Format};
+use emray::render::aov::{AovFilm, AovSet};
+use std::path::{Path, PathBuf};
+
+/// `--aov LIST`: comma-separated names of [`AovSet::NAMES`], or `all`.
+pub fn parse_aov(s: &str) -> Result<AovSet, String> {
+    let mut set = AovSet::default();
+    for name in s.split(',').map(str::trim) {
+        if name == "all" {
+            for n in AovSet::NAMES {
+                set.add(n);
+            }
+        } else if !set.add(name) {
+            return Err(format!(
+                "unknown output variable '{name}' (one or more of {}, or all)",
+                AovSet::NAMES.join(", ")
+            ));
+        }
+    }
+    Ok(set)
+}
+
+/// One `--heatmap WHAT FILE`: the quantity and the file (a template with `{stem}`
+/// when several scenes render).
+#[derive(Clone, Debug, PartialEq)]
+pub struct HeatmapArg {
+    /// What it shows.
+    pub quantity: Quantity,
+    /// Where it goes.
+    pub file: String,
+}
+
+/// The `--heatmap` pairs (`WHAT FILE` each), checked: a known quantity and a `.png`
+/// file, with `{stem}` when `scenes` scenes render (more than one).
+pub fn heatmaps(values: &[String], scenes: usize) -> Result<Vec<HeatmapArg>> {
+    let mut out = Vec::new();
+    for pair in values.chunks(2) {
+        let [what, file] = pair else {
+            bail!("--heatmap takes two values: WHAT (rays, time or depth) and FILE.png");
+        };
+        let Some(quantity) = Quantity::from_name(what) else {
+            bail!(
+                "--heatmap {what}: unknown quantity (one of {})",
+                Quantity::NAMES.join(", ")
+            );
+        };
+        if Format::from_path(Path::new(file))? != Format::Png {
+            bail!("--heatmap {what} {file}: a heat map is a PNG (name it FILE.png)");
+        }
+        if scenes > 1 && !file.contains("{stem}") {
+            bail!(
+                "{scenes} scenes but one heat map file '{file}': use a template such as \
+                 '{{stem}}-{what}.png'"
+            );
+        }
+        out.push(HeatmapArg {
+            quantity,
+            file: file.clone(),
+        });
+    }
+    Ok(out)
+}
+
+/// Refuse `--aov` whose output cannot hold it: output variables are EXR channels.
+pub fn check_aov_output(set: &AovSet, out: &Path) -> Result<()> {
+    if set.any() && Format::from_path(out)? != Format::Exr {
+        bail!(
+            "--aov writes its layers beside the colour in an OpenEXR file, and '{}' is a \
+             PNG: name the output NAME.exr",
+            out.display()
+        );
+    }
+    Ok(())
+}
+
+/// The variables to gather for `set` and the heat maps `maps` (rays are always
+/// counted; time is measured only when asked for).
+pub fn gathered(set: AovSet, maps: &[HeatmapArg]) -> AovSet {
+    let mut g = set;
+    for m in maps {
+        match m.quantity {
+            Quantity::Rays => {}
+            Quantity::Time => g.time = true,
+            Quantity::Depth => g.tree_depth = true,
+        }
+    }
+    g
+}
+
+/// The heat map files of one scene whose stem is `stem`.
+pub fn heatmap_files(maps: &[HeatmapArg], stem: &str) -> Vec<(Quantity, PathBuf)> {
+    maps.iter()
+        .map(|m| (m.quantity, PathBuf::from(m.file.replace("{stem}", stem))))
+        .collect()
+}
+
+/// Write the heat maps `files` of a render's variables `aov`.
+pub fn write_heatmaps(aov: &AovFilm, files: &[(Quantity, PathBuf)]) -> Result<()> {
+    for (q, path) in files {
+        let values = match q {
+            Quantity::Rays => &aov.rays,
+            Quantity::Time => &aov.time,
+            Quantity::Depth => &aov.tree_depth,
+        };
+        write_heatmap(path, values, aov.width, aov.height, *q)?;
+        log::info!("wrote {}", path.display());
+    }
+    Ok(())
+}
+
+/// Make sure the heat maps can be written before any render (as the images are).
+pub fn prepare_heatmaps(files: &[(Quantity, PathBuf)]) -> Result<()> {
+    for (_, path) in files {
+        output::prepare(path)?;
+    }
+    Ok(())
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+
+    #[test]
+    fn aov_lists_parse_and_unknown_names_are_refused() {
+        let s = parse_aov("depth,normal, id").unwrap();
+        assert!(s.depth && s.normal && s.id && !s.time);
+        let all = parse_aov("all").unwrap();
+        assert!(all.albedo && all.position && all.rays && all.time);
+        let e = parse_aov("depth,colour").unwrap_err();
+        assert!(e.contains("unknown output variable 'colour'"), "{e}");
+    }
+
+    #[test]
+    fn heatmaps_are_checked() {
+        let v = |s: &[&str]| s.iter().map(|x| x.to_string()).collect::<Vec<_>>();
+        let h = heatmaps(&v(&["rays", "r.png", "time", "t.png"]), 1).unwrap();
+        assert_eq!(h.len(), 2);
+        assert_eq!(h[1].quantity, Quantity::Time);
+        assert!(heatmaps(&v(&["colour", "r.png"]), 1).is_err());
+        assert!(heatmaps(&v(&["rays", "r.exr"]), 1).is_err());
+        assert!(heatmaps(&v(&["rays", "r.png"]), 2).is_err());
+        assert!(heatmaps(&v(&["rays", "{stem}-r.png"]), 2).is_ok());
+        let files = heatmap_files(&h, "balls");
+        assert_eq!(files[0].1, PathBuf::from("r.png"));
+    }
+}

@@ -1,0 +1,668 @@
+//! The OBJ statement parser: one pass over the text gives the elements (`v`, `vt`,
+//! `vn`), the faces and lines with their index triples, and the statements that apply
+//! to faces (`usemtl`, `mtllib`, `s`, `g`, `o`), after checking every statement.
+//!
+//! The first problem stops the parse with its `line:col`. Numbers are looked at after
+//! the structure: a structural problem is reported unless a number on an earlier line
+//! is bad (see [`super::numbers`]). Indices are resolved as written: a negative index
+//! counts back from the last element defined before the face, a positive one may name
+//! an element defined later in the file (checked at the end of the file here, and at
+//! the end of the face's run by [`super::runs`]).
+
+use super::located::{Located, article, comment_hint, name_after_space, show};
+use super::numbers::{self, Element};
+use glam::{DVec3, Vec2, Vec3};
+
+/// Index of an element a corner does not name.
+pub(super) const NONE: usize = usize::MAX;
+
+/// A vertex of a face: 0-based indices of its position, texture coordinate and normal
+/// ([`NONE`] when absent).
+#[derive(Clone, Copy, Debug, PartialEq, Eq)]
+pub(super) struct Corner {
+    pub v: usize,
+    pub vt: usize,
+    pub vn: usize,
+}
+
+/// A face (`f`) or line (`l`) statement.
+#[derive(Clone, Debug, PartialEq)]
+pub(super) struct Face {
+    pub line: usize,
+    /// Index of its first corner in [`Obj::corners`].
+    pub first: usize,
+    pub arity: usize,
+    pub is_line: bool,
+    /// Every vertex has a normal index.
+    pub all_normals: bool,
+    /// Every vertex has a texture coordinate index.
+    pub all_texcoords: bool,
+    /// The file had defined texture coordinates (normals) when the face's run ended:
+    /// without, its indices of them are not used (set by [`super::runs`]).
+    pub texcoords_defined: bool,
+    pub normals_defined: bool,
+}
+
+/// Elements defined at a point of the file.
+#[derive(Clone, Copy, Debug, Default, PartialEq, Eq)]
+pub(super) struct Counts {
+    pub v: usize,
+    pub vt: usize,
+    pub vn: usize,
+    /// Vertex colour components read.
+    pub colours: usize,
+}
+
+/// A `usemtl` statement.
+#[derive(Clone, Debug, PartialEq)]
+pub(super) struct UseMtl {
+    /// Index of the first face after it.
+    pub first_face: usize,
+    /// The material name: the rest of the line after the first space, trimmed.
+    pub name: String,
+    pub line: usize,
+}
+
+/// An `mtllib` statement.
+#[derive(Clone, Debug, PartialEq)]
+pub(super) struct MtlLib {
+    /// The library name(s): the rest of the line after the first space, trimmed.
+    pub name: String,
+    pub line: usize,
+}
+
+/// A statement that may end a run of faces: `g`, `o`, or a `usemtl`.
+#[derive(Clone, Debug, PartialEq)]
+pub(super) struct Cut {
+    /// Index of the first face after it.
+    pub first_face: usize,
+    pub line: usize,
+    /// Elements defined so far.
+    pub counts: Counts,
+    /// For a `usemtl`: its index in [`Obj::usemtl`].
+    pub usemtl: Option<usize>,
+}
+
+/// Everything read from an OBJ file.
+#[derive(Debug, Default)]
+pub(super) struct Obj {
+    /// Vertex positions, divided by their weights, in the frame of [`Obj::recentre`]
+    /// (until then the world's).
+    pub positions: Vec<Vec3>,
+    /// Vertex positions in the world, in double precision.
+    pub world: Vec<DVec3>,
+    pub texcoords: Vec<Vec2>,
+    pub normals: Vec<Vec3>,
+    pub corners: Vec<Corner>,
+    /// Faces and lines in file order.
+    pub faces: Vec<Face>,
+    pub usemtl: Vec<UseMtl>,
+    pub mtllibs: Vec<MtlLib>,
+    /// Smoothing-group statements (`s`) as (index of the first face after it, group;
+    /// 0 = off), in file order.
+    pub smoothing: Vec<(usize, u32)>,
+    pub cuts: Vec<Cut>,
+    /// Number of `l` statements.
+    pub lines: usize,
+    /// Elements defined by the whole file.
+    pub counts: Counts,
+    /// The first `v` whose colour (x y z r g b) is present where the first `v`'s is
+    /// not, or the other way round.
+    pub colour_mismatch: Option<Located>,
+    /// The first bad number of the file (see [`super::numbers`]).
+    pub first_bad_number: Option<Located>,
+}
+
+/// Element kinds that faces index: vertices, texture coordinates, normals.
+const KINDS: [(&str, &str); 3] = [
+    ("vertex", "vertices"),
+    ("texture coordinate", "texture coordinates"),
+    ("normal", "normals"),
+];
+
+/// A positive index beyond the elements defined so far: valid only if the file defines
+/// enough elements later.
+#[derive(Debug)]
+struct ForwardRef {
+    index: usize,
+    at: Located,
+}
+
+/// The parser's state between lines.
+#[derive(Default)]
+struct Parser {
+    obj: Obj,
+    /// Per kind: forward references, each larger than the one before (the first that
+    /// turns out out of range is always among them).
+    forward: [Vec<ForwardRef>; 3],
+    /// Whether the first `v` has a colour, and its line.
+    first_has_colour: Option<(bool, usize)>,
+    /// A number that does not parse (or a weight of 0) was met.
+    fatal_number: bool,
+}
+
+/// The words of a statement after its keyword: how many, and the first seven.
+struct Words<'a> {
+    n: usize,
+    first: [&'a str; 7],
+}
+
+impl<'a> Words<'a> {
+    fn new(words: std::str::SplitWhitespace<'a>) -> Self {
+        let mut w = Words {
+            n: 0,
+            first: [""; 7],
+        };
+        for word in words {
+            if let Some(slot) = w.first.get_mut(w.n) {
+                *slot = word;
+            }
+            w.n += 1;
+        }
+        w
+    }
+
+    fn kept(&self) -> &[&'a str] {
+        &self.first[..self.n.min(self.first.len())]
+    }
+
+    /// The `k`-th word (0-based), if kept.
+    fn get(&self, k: usize) -> Option<&'a str> {
+        self.kept().get(k).copied()
+    }
+}
+
+/// Parse the OBJ text (lines split as [`str::lines`] does).
+///
+/// # Errors
+/// The first problem, at its line and column (see the module documentation).
+impl Obj {
+    /// The centre of the box around the finite vertex positions (the origin 0 when
+    /// there is none): where a model alone is re-centred.
+    pub fn centre(&self) -> DVec3 {
+        let finite = self.world.iter().filter(|p| p.is_finite());
+        let (lo, hi) = finite.fold((DVec3::INFINITY, DVec3::NEG_INFINITY), |(lo, hi), p| {
+            (lo.min(*p), hi.max(*p))
+        });
+        if lo.cmple(hi).all() {
+            (lo + hi) * 0.5
+        } else {
+            DVec3::ZERO
+        }
+    }
+
+    /// Move the positions into the frame whose origin is the world point `origin`:
+    /// each becomes `world − origin`, computed in double precision.
+    pub fn recentre(&mut self, origin: DVec3) {
+        for (p, w) in self.positions.iter_mut().zip(&self.world) {
+            *p = (*w - origin).as_vec3();
+        }
+    }
+}
+
+pub(super) fn parse(text: &str) -> Result<Obj, Located> {
+    let mut p = Parser::default();
+    for (i, line) in text.lines().enumerate() {
+        if let Err(e) = p.statement(i + 1, line) {
+            return Err(p.first_bad_before(e));
+        }
+    }
+    p.finish()
+}
+
+impl Parser {
+    /// `e`, or a bad number on an earlier line.
+    fn first_bad_before(&mut self, e: Located) -> Located {
+        match self.obj.first_bad_number.take() {
+            Some(b) if b.line < e.line => b,
+            _ => e,
+        }
+    }
+
+    fn statement(&mut self, ln: usize, line: &str) -> Result<(), Located> {
+        let mut words = line.split_whitespace();
+        let Some(kw) = words.next() else {
+            return Ok(());
+        };
+        match kw {
+            "v" => self.vertex(ln, line, kw, &Words::new(words))?,
+            "vt" => self.element(Element::Texture, ln, line, &Words::new(words))?,
+            "vn" => self.element(Element::Normal, ln, line, &Words::new(words))?,
+            "f" | "l" => self.face(ln, line, kw == "l", words)?,
+            "usemtl" => self.usemtl(ln, line)?,
+            "mtllib" => self.obj.mtllibs.push(MtlLib {
+                name: name_after_space(line).to_string(),
+                line: ln,
+            }),
+            "s" => {
+                // `s off`, `s 0` or no number: off; any other word names a group.
+                let group = match words.next() {
+                    None | Some("off") | Some("0") => 0,
+                    Some(w) => w.parse::<u32>().unwrap_or(u32::MAX).max(1),
+                };
+                self.obj.smoothing.push((self.obj.faces.len(), group));
+            }
+            "g" | "o" => self.cut(ln, None),
+            _ => {}
+        }
+        Ok(())
+    }
+
+    /// A statement that may end a run of faces.
+    fn cut(&mut self, ln: usize, usemtl: Option<usize>) {
+        self.obj.cuts.push(Cut {
+            first_face: self.obj.faces.len(),
+            line: ln,
+            counts: self.obj.counts,
+            usemtl,
+        });
+    }
+
+    /// `v x y z`, `v x y z w` or `v x y z r g b`.
+    fn vertex(&mut self, ln: usize, line: &str, kw: &str, w: &Words) -> Result<(), Located> {
+        let err = |tok: Option<&str>, message: String| Located::at_token(ln, line, tok, message);
+        let n = w.n;
+        if n < 3 {
+            let message = format!("expected 3 vertex coordinates (x y z), found {n}");
+            return Err(err(None, message));
+        }
+        if n == 5 || n > 6 {
+            let tok = w.get(if n == 5 { 3 } else { 6 });
+            let hint = tok.map_or("", comment_hint);
+            let message =
+                format!("a vertex is 'x y z', 'x y z w' or 'x y z r g b', found {n} numbers{hint}");
+            return Err(err(tok, message));
+        }
+        self.note_colour(n == 6, ln, || err(Some(kw), String::new()));
+        let read = self.numbers(Element::Vertex, ln, line, w);
+        self.obj.positions.push(Vec3::from(read.values));
+        self.obj.world.push(DVec3::from(read.exact));
+        self.obj.counts.v += 1;
+        self.obj.counts.colours += read.colours;
+        Ok(())
+    }
+
+    /// Note whether this vertex has a colour, and the first that differs from the
+    /// first vertex in this.
+    fn note_colour(&mut self, has_colour: bool, ln: usize, at: impl Fn() -> Located) {
+        let Some((first, first_ln)) = self.first_has_colour else {
+            self.first_has_colour = Some((has_colour, ln));
+            return;
+        };
+        if first == has_colour || self.obj.colour_mismatch.is_some() {
+            return;
+        }
+        let (this, that) = if has_colour {
+            ("has a colour", "has none")
+        } else {
+            ("has no colour", "has one")
+        };
+        self.obj.colour_mismatch = Some(Located {
+            message: format!(
+                "this vertex {this} but the first one (line {first_ln}) {that}: vertex colours \
+                 must be on every vertex or on none"
+            ),
+            ..at()
+        });
+    }
+
+    /// `vt u v [w]` or `vn x y z`.
+    fn element(&mut self, kind: Element, ln: usize, line: &str, w: &Words) -> Result<(), Located> {
+        let n = w.n;
+        let (need, message) = match kind {
+            Element::Texture => (2, "expected 2 texture coordinates (u v)"),
+            _ => (3, "expected 3 normal components (x y z)"),
+        };
+        if n < need {
+            return Err(Located::at_token(
+                ln,
+                line,
+                None,
+                format!("{message}, found {n}"),
+            ));
+        }
+        let [a, b, c] = self.numbers(kind, ln, line, w).values;
+        if kind == Element::Texture {
+            self.obj.texcoords.push(Vec2::new(a, b));
+            self.obj.counts.vt += 1;
+        } else {
+            self.obj.normals.push(Vec3::new(a, b, c));
+            self.obj.counts.vn += 1;
+        }
+        Ok(())
+    }
+
+    /// Read the numbers of an element statement, keeping the file's first problem.
+    fn numbers(&mut self, kind: Element, ln: usize, line: &str, w: &Words) -> numbers::Numbers {
+        let mut read = numbers::read(kind, ln, line, w.kept(), w.n);
+        self.fatal_number |= read.fatal;
+        if self.obj.first_bad_number.is_none() {
+            self.obj.first_bad_number = read.bad.take();
+        }
+        read
+    }
+
+    /// `usemtl NAME`.
+    fn usemtl(&mut self, ln: usize, line: &str) -> Result<(), Located> {
+        let name = name_after_space(line);
+        if name.is_empty() {
+            return Err(Located::at_token(
+                ln,
+                line,
+                None,
+                "expected a material name after 'usemtl' (separated by a space)".into(),
+            ));
+        }
+        let k = self.obj.usemtl.len();
+        self.obj.usemtl.push(UseMtl {
+            first_face: self.obj.faces.len(),
+            name: name.to_string(),
+            line: ln,
+        });
+        self.cut(ln, Some(k));
+        Ok(())
+    }
+
+    /// `f v/vt/vn ...` or `l v/vt ...`.
+    fn face(
+        &mut self,
+        ln: usize,
+        line: &str,
+        is_line: bool,
+        words: std::str::SplitWhitespace,
+    ) -> Result<(), Located> {
+        let first = self.obj.corners.len();
+        let mut all_normals = true;
+        let mut all_texcoords = true;
+        for tok in words {
+            let (corner, normal, texcoord) = self.corner(ln, line, tok)?;
+            self.obj.corners.push(corner);
+            all_normals &= normal;
+            all_texcoords &= texcoord;
+        }
+        let arity = self.obj.corners.len() - first;
+        if is_line {
+            self.obj.lines += 1;
+        } else if arity == 0 {
+            return Err(Located::at_token(
+                ln,
+                line,
+                None,
+                "face without vertices".into(),
+            ));
+        }
+        self.obj.faces.push(Face {
+            line: ln,
+            first,
+            arity,
+            is_line,
+            all_normals: all_normals && !is_line,
+            all_texcoords: all_texcoords && !is_line,
+            texcoords_defined: false,
+            normals_defined: false,
+        });
+        Ok(())
+    }
+
+    /// One vertex of a face, `v`, `v/vt`, `v//vn` or `v/vt/vn`, with whether it has a
+    /// normal index and a texture coordinate index.
+    fn corner(
+        &mut self,
+        ln: usize,
+        line: &str,
+        tok: &str,
+    ) -> Result<(Corner, bool, bool), Located> {
+        let err = |message: String| Located::at_token(ln, line, Some(tok), message);
+        let mut idx = [NONE; 3];
+        let mut parts = 0;
+        let mut last_empty = false;
+        for (k, part) in tok.split('/').enumerate() {
+            parts += 1;
+            last_empty = part.is_empty();
+            let Some(slot) = idx.get_mut(k) else {
+                return Err(err(format!(
+                    "vertex {} has more than 3 indices (v/vt/vn){}",
+                    show(tok),
+                    comment_hint(tok)
+                )));
+            };
+            if part.is_empty() {
+                if k == 0 {
+                    return Err(err(format!("missing vertex index in {}", show(tok))));
+                }
+                continue;
+            }
+            *slot = self.index(k, part, tok, &err)?;
+        }
+        let [v, vt, vn] = idx;
+        let normal = parts >= 3 && !last_empty;
+        Ok((Corner { v, vt, vn }, normal, vt != NONE))
+    }
+
+    /// The 0-based element index of `part`, index `k` (v, vt, vn) of the vertex `tok`.
+    fn index(
+        &mut self,
+        k: usize,
+        part: &str,
+        tok: &str,
+        err: &impl Fn(String) -> Located,
+    ) -> Result<usize, Located> {
+        let (one, many) = KINDS.get(k).copied().unwrap_or(KINDS[0]);
+        let Ok(x) = part.parse::<isize>() else {
+            return Err(err(format!(
+                "expected {} index, found {}{}",
+                article(one),
+                show(part),
+                comment_hint(tok)
+            )));
+        };
+        let count = match k {
+            0 => self.obj.counts.v,
+            1 => self.obj.counts.vt,
+            _ => self.obj.counts.vn,
+        };
+        if x == 0 {
+            return Err(err(format!(
+                "{one} index 0 is invalid (OBJ indices start at 1)"
+            )));
+        }
+        if x < 0 {
+            return count.checked_sub(x.unsigned_abs()).ok_or_else(|| {
+                err(format!(
+                    "relative {one} index {x} reaches before the first {one} ({count} {} \
+                     defined so far)",
+                    if count == 1 { one } else { many }
+                ))
+            });
+        }
+        let x = x.unsigned_abs();
+        if x > count {
+            self.forward_ref(k, x, err(String::new()));
+        }
+        Ok(x - 1)
+    }
+
+    fn forward_ref(&mut self, k: usize, index: usize, at: Located) {
+        let Some(refs) = self.forward.get_mut(k) else {
+            return;
+        };
+        if refs.last().is_none_or(|r| r.index < index) {
+            refs.push(ForwardRef { index, at });
+        }
+    }
+
+    /// Check the forward references against the whole file, and that every number
+    /// parses.
+    fn finish(mut self) -> Result<Obj, Located> {
+        let counts = self.obj.counts;
+        let totals = [counts.v, counts.vt, counts.vn];
+        // Forward references beyond the end: report the first in the file.
+        let mut worst: Option<Located> = None;
+        for ((refs, (one, many)), total) in self.forward.iter().zip(KINDS).zip(totals) {
+            let Some(r) = refs.iter().find(|r| r.index > total) else {
+                continue;
+            };
+            let at = Located {
+                message: format!(
+                    "{one} index {} is out of range: the file has {total} {}",
+                    r.index,
+                    if total == 1 { one } else { many }
+                ),
+                ..r.at.clone()
+            };
+            if worst
+                .as_ref()
+                .is_none_or(|w| (at.line, at.col) < (w.line, w.col))
+            {
+                worst = Some(at);
+            }
+        }
+        if let Some(w) = worst {
+            return Err(self.first_bad_before(w));
+        }
+        if self.fatal_number {
+            if let Some(bad) = self.obj.first_bad_number.take() {
+                return Err(bad);
+            }
+        }
+        Ok(self.obj)
+    }
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+
+    #[test]
+    fn records_faces_materials_and_libraries() {
+        let src = "\
+mtllib a.mtl
+v 0 0 0
+v 1 0 0
+v 0 1 0
+vt 0 0
+vn 0 0 1
+f 1 2 3
+usemtl m1
+f 1//1 2//1 3//1
+f 1/1/1 2/1/1 3/1
+l 1 2
+mtllib b.mtl
+usemtl m 2
+f -3/-1/-1 -2/1/1 -1//1
+";
+        let obj = parse(src).unwrap();
+        let flags: Vec<(bool, bool, bool, usize)> = obj
+            .faces
+            .iter()
+            .map(|f| (f.is_line, f.all_normals, f.all_texcoords, f.line))
+            .collect();
+        assert_eq!(
+            flags,
+            [
+                (false, false, false, 7),
+                (false, true, false, 9),
+                (false, false, true, 10),
+                (true, false, false, 11),
+                (false, true, false, 14)
+            ]
+        );
+        assert_eq!(obj.lines, 1);
+        let libs: Vec<(usize, &str)> = obj
+            .mtllibs
+            .iter()
+            .map(|l| (l.line, l.name.as_str()))
+            .collect();
+        assert_eq!(libs, [(1, "a.mtl"), (12, "b.mtl")]);
+        let u: Vec<(usize, &str, usize)> = obj
+            .usemtl
+            .iter()
+            .map(|u| (u.first_face, u.name.as_str(), u.line))
+            .collect();
+        assert_eq!(u, [(1, "m1", 8), (4, "m 2", 13)]);
+        assert!(obj.colour_mismatch.is_none());
+        // Relative indices count back from the last element defined.
+        let last = &obj.corners[obj.faces[4].first..];
+        let c = |v, vt, vn| Corner { v, vt, vn };
+        assert_eq!(last, [c(0, 0, 0), c(1, 0, 0), c(2, NONE, 0)]);
+        assert_eq!(obj.positions[1], Vec3::X);
+    }
+
+    #[test]
+    fn errors() {
+        let err = |src: &str| parse(src).unwrap_err();
+        // Texture and normal indices are checked too.
+        let e = err("v 0 0 0\nvt 0 0\nf 1/0 1/1 1/1\n");
+        assert_eq!((e.line, e.col), (3, 3));
+        assert!(
+            e.message.contains("texture coordinate index 0"),
+            "{}",
+            e.message
+        );
+        let e = err("v 0 0 0\nvn 0 0 1\nf 1//1 1//-2 1//1\n");
+        assert_eq!((e.line, e.col), (3, 8));
+        assert!(
+            e.message.contains("relative normal index -2"),
+            "{}",
+            e.message
+        );
+        let e = err("v 0 0 0\nf /1 1 1\n");
+        assert!(e.message.contains("missing vertex index"), "{}", e.message);
+        let e = err("v 0 0 0\nf 1 1 99999999999999999999999\n");
+        assert!(
+            e.message.contains("expected a vertex index"),
+            "{}",
+            e.message
+        );
+        let e = err("v 0 0 0\nf 1 1/1/1/ 1\n");
+        assert!(e.message.contains("more than 3 indices"), "{}", e.message);
+        // The earliest of several forward references beyond the end.
+        let e = err("f 1/1 1/1 1/1\nf 7 1 1\nf 1 1 1/9\nv 0 0 0\nvt 0 0\n");
+        assert_eq!((e.line, e.col), (2, 3));
+        // Columns count characters.
+        let e = err("g é\nv 0 0 0\nf 1 1 é\n");
+        assert_eq!((e.line, e.col), (3, 7));
+        // Mixed vertex colours are noted (an error only when a face lacks a colour).
+        let obj = parse("v 0 0 0 1 0 0\nv 1 0 0\n").unwrap();
+        let m = obj.colour_mismatch.unwrap();
+        assert_eq!((m.line, m.col), (2, 1));
+        // An `l` may have no vertex, an `f` may not.
+        assert!(parse("l\n").is_ok());
+        assert_eq!(err("f  \n").col, 2);
+    }
+
+    #[test]
+    fn bad_numbers_come_first_when_earlier() {
+        // A bad number before a structural problem is the error.
+        let e = parse("v 0 0 zero\nf 1 2 3\n").unwrap_err();
+        assert_eq!((e.line, e.col), (1, 7));
+        // On the same line, the structure is.
+        let e = parse("v x 0\n").unwrap_err();
+        assert!(e.message.contains("expected 3 vertex"), "{}", e.message);
+        // A number that does not parse is an error wherever it is, even unused.
+        let e = parse("v 0 0 0\nvt 0 0\nvt 0 u\n").unwrap_err();
+        assert_eq!((e.line, e.col), (3, 6));
+        // Non-finite numbers are noted, not errors (unless used: see `runs`).
+        let obj = parse("v 0 0 0\nv inf 0 0\nv 0 1e39 0\n").unwrap();
+        assert_eq!(obj.first_bad_number.unwrap().line, 2);
+        // But then the first bad number is the error.
+        let e = parse("v 0 0 0\nv inf 0 0\nv 0 1e39 0\nv 0 0 x\n").unwrap_err();
+        assert_eq!(e.line, 2);
+    }
+
+    #[test]
+    fn smoothing_groups_and_cuts() {
+        let obj = parse("s 1\nf 1 1 1\ns off\ns x\ng a\no\ns\ns 0\nusemtl m\nv 0 0 0\n").unwrap();
+        assert_eq!(
+            obj.smoothing,
+            [(0, 1), (1, 0), (1, u32::MAX), (1, 0), (1, 0)]
+        );
+        let cuts: Vec<(usize, Option<usize>, usize)> = obj
+            .cuts
+            .iter()
+            .map(|c| (c.line, c.usemtl, c.counts.v))
+            .collect();
+        assert_eq!(cuts, [(5, None, 0), (6, None, 0), (9, Some(0), 0)]);
+        assert_eq!(obj.counts.v, 1);
+    }
+}

@@ -1,0 +1,307 @@
+//! The sample grid of a render cut into square tiles rendered in parallel, the result
+//! independent of the schedule: uniform sampling (the pixels, or the pixel corners in
+//! SPD mode) and Whitted's adaptive subdivision. Each tile records with its own
+//! [`Recorder`]: a plain render's counts, or the per-pixel output variables.
+
+use super::record::Recorder;
+use super::whitted::Tracer;
+use super::{Film, Progress, RayCounts, RayGen, Region, RenderSettings};
+use crate::accel::Accel;
+use glam::Vec3;
+use rayon::prelude::*;
+use std::sync::atomic::{AtomicUsize, Ordering};
+
+/// The positions a render samples: the pixels of its region, or in SPD mode the
+/// region's pixel corners (one more row and column), in the whole image's grid.
+pub(super) struct Positions {
+    /// The grid's top-left position.
+    pub origin: (u32, u32),
+    /// Its size.
+    pub size: (u32, u32),
+    /// The size of the whole image's grid (the eye rays' frame).
+    pub full: (u32, u32),
+}
+
+impl Positions {
+    pub(super) fn of(settings: &RenderSettings) -> Self {
+        let (w, h) = (settings.width, settings.height);
+        // Only the samples of the region: every pixel and sample keeps its coordinates
+        // in the whole image, so a part holds exactly the full render's pixels.
+        let r = settings.region.unwrap_or(Region::full(w, h));
+        let extra = u32::from(settings.spd);
+        Positions {
+            origin: (r.x0, r.y0),
+            size: (r.width() + extra, r.height() + extra),
+            full: (w + extra, h + extra),
+        }
+    }
+}
+
+/// Render `settings`' region with uniform samples (SPD corners averaged into pixels),
+/// each tile recording with a recorder from `new`; the recorders are returned in the
+/// order of [`tiles`].
+pub(super) fn uniform_render<A, R, N>(
+    tracer: &Tracer<'_, A>,
+    settings: &RenderSettings,
+    progress: Option<Progress<'_>>,
+    new: N,
+) -> (Film, Vec<R>)
+where
+    A: Accel,
+    R: Recorder + Send,
+    N: Fn() -> R + Sync,
+{
+    let at = Positions::of(settings);
+    let raygen = RayGen::new(&tracer.scene.camera, at.full.0, at.full.1);
+    let (ox, oy) = at.origin;
+    let (gw, gh) = at.size;
+    let (grid, recs) = sample_grid(ox, oy, gw, gh, settings.tile, progress, new, |t, px, r| {
+        tracer.tile(&raygen, t, px, r);
+    });
+    let film = if settings.spd {
+        grid.average_corners()
+    } else {
+        grid
+    };
+    (film, recs)
+}
+
+/// Render `settings`' region with Whitted's adaptive subdivision: the rays through
+/// every pixel corner, then each pixel refined from its four.
+pub(super) fn adaptive_render<A: Accel>(
+    tracer: &Tracer<'_, A>,
+    settings: &RenderSettings,
+    threshold: f32,
+    depth: u32,
+    progress: Option<Progress<'_>>,
+) -> (Film, RayCounts) {
+    let (w, h) = (settings.width, settings.height);
+    let r = settings.region.unwrap_or(Region::full(w, h));
+    let raygen = RayGen::new(&tracer.scene.camera, w, h);
+    let (cw, ch) = (r.width() + 1, r.height() + 1);
+    let corner = per_position(|i, j, c| tracer.sample(&raygen, i as f32, j as f32, c));
+    let (corners, tiles) = sample_grid(
+        r.x0,
+        r.y0,
+        cw,
+        ch,
+        settings.tile,
+        None,
+        RayCounts::default,
+        corner,
+    );
+    let (rw, rh) = (r.width(), r.height());
+    let refine = per_position(|i, j, c| {
+        let (ci, cj) = (i - r.x0, j - r.y0);
+        let k = [
+            corners.get(ci, cj),
+            corners.get(ci + 1, cj),
+            corners.get(ci, cj + 1),
+            corners.get(ci + 1, cj + 1),
+        ];
+        let s = |x: f32, y: f32, c: &mut RayCounts| tracer.sample(&raygen, x, y, c);
+        adaptive(&s, i as f32, j as f32, 1.0, k, threshold, depth, c)
+    });
+    let (film, more) = sample_grid(
+        r.x0,
+        r.y0,
+        rw,
+        rh,
+        settings.tile,
+        progress,
+        RayCounts::default,
+        refine,
+    );
+    let mut rays = RayCounts::default();
+    for counts in tiles.into_iter().chain(more) {
+        rays += counts;
+    }
+    (film, rays)
+}
+
+/// A per-position function `f(i, j, counts)` as a tile function for [`sample_grid`]:
+/// the tile's positions row by row.
+fn per_position<F>(f: F) -> impl Fn(Region, &mut Vec<Vec3>, &mut RayCounts) + Sync
+where
+    F: Fn(u32, u32, &mut RayCounts) -> Vec3 + Sync,
+{
+    move |t, px, counts| {
+        for j in t.y0..t.y1 {
+            for i in t.x0..t.x1 {
+                px.push(f(i, j, counts));
+            }
+        }
+    }
+}
+
+/// The tile of edge `tile` holding position `(i, j)` of a `gw × gh` sample grid, cut
+/// from the grid's top-left corner as [`sample_grid`] cuts a whole image.
+pub(crate) fn tile_of(i: u32, j: u32, gw: u32, gh: u32, tile: u32) -> Region {
+    let ts = tile.max(1);
+    let (x0, y0) = (i / ts * ts, j / ts * ts);
+    Region {
+        x0,
+        y0,
+        x1: (x0 + ts).min(gw),
+        y1: (y0 + ts).min(gh),
+    }
+}
+
+/// The tiles of edge `tile` of a `gw × gh` grid, as the top-left position of each
+/// relative to the grid's, row by row.
+pub(super) fn tiles(gw: u32, gh: u32, tile: u32) -> Vec<(u32, u32)> {
+    let ts = tile.max(1);
+    (0..gh.div_ceil(ts))
+        .flat_map(|ty| (0..gw.div_ceil(ts)).map(move |tx| (tx * ts, ty * ts)))
+        .collect()
+}
+
+/// Put per-tile values (each tile's positions row by row, tiles in the order of
+/// [`tiles`]) into a `gw × gh` row-major grid.
+pub(super) fn scatter<T: Copy + Default>(
+    gw: u32,
+    gh: u32,
+    tile: u32,
+    per_tile: impl IntoIterator<Item = Vec<T>>,
+) -> Vec<T> {
+    let ts = tile.max(1);
+    let mut grid = vec![T::default(); gw as usize * gh as usize];
+    for ((x0, y0), values) in tiles(gw, gh, tile).into_iter().zip(per_tile) {
+        let x1 = (x0 + ts).min(gw);
+        let mut it = values.into_iter();
+        for j in y0..(y0 + ts).min(gh) {
+            for i in x0..x1 {
+                grid[(j * gw + i) as usize] = it.next().expect("tile size");
+            }
+        }
+    }
+    grid
+}
+
+/// Evaluate the `gw × gh` grid whose top-left is `(ox, oy)` in parallel square tiles
+/// of edge `tile`, the result independent of the schedule: `f(tile, px, rec)` pushes
+/// the values of the tile's grid positions (absolute coordinates, row by row) onto
+/// `px`, recording with a recorder `new` makes for the tile, and the film's pixel
+/// `(i, j)` is the value of position `(ox + i, oy + j)`. The recorders come back in the
+/// order of [`tiles`].
+#[allow(clippy::too_many_arguments)]
+fn sample_grid<R, N, F>(
+    ox: u32,
+    oy: u32,
+    gw: u32,
+    gh: u32,
+    tile: u32,
+    progress: Option<Progress<'_>>,
+    new: N,
+    f: F,
+) -> (Film, Vec<R>)
+where
+    R: Send,
+    N: Fn() -> R + Sync,
+    F: Fn(Region, &mut Vec<Vec3>, &mut R) + Sync,
+{
+    let ts = tile.max(1);
+    let tiles = tiles(gw, gh, tile);
+    let done = AtomicUsize::new(0);
+    let total = tiles.len();
+    let results: Vec<(Vec<Vec3>, R)> = tiles
+        .par_iter()
+        .map(|&(x0, y0)| {
+            let x1 = (x0 + ts).min(gw);
+            let y1 = (y0 + ts).min(gh);
+            let mut rec = new();
+            let mut px = Vec::with_capacity(((x1 - x0) * (y1 - y0)) as usize);
+            let t = Region {
+                x0: ox + x0,
+                y0: oy + y0,
+                x1: ox + x1,
+                y1: oy + y1,
+            };
+            f(t, &mut px, &mut rec);
+            if let Some(p) = progress {
+                p(done.fetch_add(1, Ordering::Relaxed) + 1, total);
+            }
+            (px, rec)
+        })
+        .collect();
+    let mut grid = Film::new(gw, gh);
+    let mut recs = Vec::with_capacity(total);
+    for (&(x0, y0), (px, rec)) in tiles.iter().zip(results) {
+        recs.push(rec);
+        let x1 = (x0 + ts).min(gw);
+        let mut it = px.into_iter();
+        for j in y0..(y0 + ts).min(gh) {
+            for i in x0..x1 {
+                grid.set(i, j, it.next().expect("tile size"));
+            }
+        }
+    }
+    (grid, recs)
+}
+
+/// Whitted's adaptive refinement of the square at `(x, y)` of edge `size` whose corner
+/// values are `k` (top-left, top-right, bottom-left, bottom-right): their mean if they
+/// agree within `threshold` or `depth` is exhausted, else the mean of its four
+/// quarters, the five new points sampled with `sample`.
+#[allow(clippy::too_many_arguments)]
+fn adaptive<S>(
+    sample: &S,
+    x: f32,
+    y: f32,
+    size: f32,
+    k: [Vec3; 4],
+    threshold: f32,
+    depth: u32,
+    c: &mut RayCounts,
+) -> Vec3
+where
+    S: Fn(f32, f32, &mut RayCounts) -> Vec3,
+{
+    let lo = k[0].min(k[1]).min(k[2].min(k[3]));
+    let hi = k[0].max(k[1]).max(k[2].max(k[3]));
+    // A NaN corner compares false: it is not refined (and shows as NaN).
+    if depth == 0 || (hi - lo).max_element() <= threshold {
+        return (k[0] + k[1] + k[2] + k[3]) * 0.25;
+    }
+    let hs = size * 0.5;
+    let top = sample(x + hs, y, c);
+    let left = sample(x, y + hs, c);
+    let mid = sample(x + hs, y + hs, c);
+    let right = sample(x + size, y + hs, c);
+    let bottom = sample(x + hs, y + size, c);
+    let d = depth - 1;
+    let q = [
+        adaptive(sample, x, y, hs, [k[0], top, left, mid], threshold, d, c),
+        adaptive(
+            sample,
+            x + hs,
+            y,
+            hs,
+            [top, k[1], mid, right],
+            threshold,
+            d,
+            c,
+        ),
+        adaptive(
+            sample,
+            x,
+            y + hs,
+            hs,
+            [left, mid, k[2], bottom],
+            threshold,
+            d,
+            c,
+        ),
+        adaptive(
+            sample,
+            x + hs,
+            y + hs,
+            hs,
+            [mid, right, bottom, k[3]],
+            threshold,
+            d,
+            c,
+        ),
+    ];
+    (q[0] + q[1] + q[2] + q[3]) * 0.25
+}

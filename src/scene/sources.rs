@@ -1,0 +1,219 @@
+//! Where things were defined: for each index of a list (the primitives of one kind, the
+//! materials), the file and line of the source entity that made it, so that a hit can
+//! be traced back to the NFF line, the TOML object or the OBJ face it came from
+//! (`emray explain`, the id layer of `--aov`).
+//!
+//! The table is compact whatever the scene's size: it stores runs, not one entry per
+//! index. A run is a block of consecutive indices made by consecutive lines of one file
+//! that each made the same number of them (an OBJ mesh of quads split into two
+//! triangles each, an NFF file of spheres), so a million-triangle mesh whose faces are
+//! written one per line is a handful of runs.
+//!
+//! Where a scene was read from is not part of what it is: the tables of two scenes
+//! always compare equal (a scene file and its rewrite in another file build equal
+//! scenes), and a table's `Debug` form shows nothing of it (the hash that ties the
+//! parts of an image together, `emray merge`, is taken from that form: the same scene
+//! read from another path is the same render).
+
+use crate::geometry::Kind;
+use std::sync::Arc;
+
+/// Where one item was defined.
+#[derive(Clone, Debug, PartialEq, Eq)]
+pub struct Origin {
+    /// The file (as the loader was given it; `spd:NAME` for a generated database).
+    pub file: Arc<str>,
+    /// 1-based line.
+    pub line: u32,
+}
+
+impl std::fmt::Display for Origin {
+    fn fmt(&self, f: &mut std::fmt::Formatter<'_>) -> std::fmt::Result {
+        write!(f, "{}:{}", self.file, self.line)
+    }
+}
+
+/// Consecutive indices `first..first + count`, item `k` of them made by line
+/// `line + k / per` of file `file`.
+#[derive(Clone, Copy, Debug, PartialEq, Eq)]
+struct Run {
+    first: u32,
+    count: u32,
+    per: u32,
+    file: u32,
+    line: u32,
+}
+
+/// The origins of one list's items, as runs (see the module documentation).
+#[derive(Clone, Default)]
+pub struct Sources {
+    files: Vec<Arc<str>>,
+    runs: Vec<Run>,
+}
+
+/// Always equal: see the module documentation.
+impl PartialEq for Sources {
+    fn eq(&self, _: &Self) -> bool {
+        true
+    }
+}
+
+impl Eq for Sources {}
+
+impl std::fmt::Debug for Sources {
+    fn fmt(&self, f: &mut std::fmt::Formatter<'_>) -> std::fmt::Result {
+        f.write_str("Sources")
+    }
+}
+
+impl Sources {
+    /// Items `first..first + count` were made by line `line` of `file`. Items must be
+    /// recorded in increasing order of index; an index recorded twice, or past
+    /// `u32::MAX`, is left out.
+    pub fn add(&mut self, first: usize, count: usize, file: &Arc<str>, line: u32) {
+        let (Ok(first), Ok(count)) = (u32::try_from(first), u32::try_from(count)) else {
+            return;
+        };
+        if count == 0 || first.checked_add(count).is_none() {
+            return;
+        }
+        if let Some(last) = self.runs.last() {
+            if first < last.first + last.count {
+                return;
+            }
+        }
+        let file = self.file_index(file);
+        if let Some(last) = self.runs.last_mut() {
+            let next_line = last.line as u64 + (last.count / last.per) as u64;
+            let continues = last.file == file
+                && last.per == count
+                && last.first + last.count == first
+                && next_line == line as u64;
+            if continues {
+                last.count += count;
+                return;
+            }
+        }
+        self.runs.push(Run {
+            first,
+            count,
+            per: count,
+            file,
+            line,
+        });
+    }
+
+    fn file_index(&mut self, file: &Arc<str>) -> u32 {
+        match self.files.iter().rposition(|f| f == file) {
+            Some(k) => k as u32,
+            None => {
+                self.files.push(file.clone());
+                self.files.len() as u32 - 1
+            }
+        }
+    }
+
+    /// Where item `index` was defined, if it was recorded.
+    pub fn get(&self, index: u32) -> Option<Origin> {
+        let k = self.runs.partition_point(|r| r.first <= index);
+        let run = self.runs.get(k.checked_sub(1)?)?;
+        let offset = index - run.first;
+        if offset >= run.count {
+            return None;
+        }
+        Some(Origin {
+            file: self.files[run.file as usize].clone(),
+            line: run.line + offset / run.per,
+        })
+    }
+
+    /// The number of runs stored (what the table costs).
+    pub fn runs(&self) -> usize {
+        self.runs.len()
+    }
+}
+
+/// The origins of a [`Geometry`](super::Geometry)'s primitives, one [`Sources`] per kind.
+#[derive(Clone, Default)]
+pub struct PrimSources {
+    kinds: Vec<Sources>,
+}
+
+impl std::fmt::Debug for PrimSources {
+    fn fmt(&self, f: &mut std::fmt::Formatter<'_>) -> std::fmt::Result {
+        f.write_str("PrimSources")
+    }
+}
+
+/// Always equal: see the module documentation.
+impl PartialEq for PrimSources {
+    fn eq(&self, _: &Self) -> bool {
+        true
+    }
+}
+
+impl Eq for PrimSources {}
+
+impl PrimSources {
+    /// Primitives `first..first + count` of `kind` were made by line `line` of `file`.
+    pub fn add(&mut self, kind: Kind, first: usize, count: usize, file: &Arc<str>, line: u32) {
+        let k = kind as usize;
+        if self.kinds.len() <= k {
+            self.kinds.resize_with(k + 1, Sources::default);
+        }
+        self.kinds[k].add(first, count, file, line);
+    }
+
+    /// Where primitive `prim` of `kind` was defined, if it was recorded.
+    pub fn get(&self, kind: Kind, prim: u32) -> Option<Origin> {
+        self.kinds.get(kind as usize)?.get(prim)
+    }
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+
+    #[test]
+    fn runs_of_lines_that_make_as_many_items_merge() {
+        let f: Arc<str> = Arc::from("mesh.obj");
+        let g: Arc<str> = Arc::from("other.nff");
+        let mut s = Sources::default();
+        // 1000 quads on lines 10.., two triangles each: one run.
+        for k in 0..1000 {
+            s.add(2 * k, 2, &f, 10 + k as u32);
+        }
+        assert_eq!(s.runs(), 1);
+        assert_eq!(s.get(0).unwrap().line, 10);
+        assert_eq!(s.get(1).unwrap().line, 10);
+        assert_eq!(s.get(1999).unwrap().to_string(), "mesh.obj:1009");
+        // A pentagon (three triangles) breaks the run; another file too.
+        s.add(2000, 3, &f, 1010);
+        s.add(2003, 1, &g, 4);
+        assert_eq!(s.runs(), 3);
+        assert_eq!(s.get(2002).unwrap().line, 1010);
+        assert_eq!(s.get(2003).unwrap().to_string(), "other.nff:4");
+        assert_eq!(s.get(2004), None);
+        // A gap (a line that made nothing, such as a dropped polygon) starts a run.
+        s.add(2004, 1, &g, 9);
+        assert_eq!(s.get(2004).unwrap().line, 9);
+    }
+
+    #[test]
+    fn unrecorded_and_repeated_indices() {
+        let f: Arc<str> = Arc::from("a");
+        let mut s = Sources::default();
+        assert_eq!(s.get(0), None);
+        s.add(5, 2, &f, 1);
+        assert_eq!(s.get(4), None);
+        assert_eq!(s.get(7), None);
+        s.add(6, 1, &f, 2);
+        assert_eq!(s.get(6).unwrap().line, 1, "the first record stays");
+        s.add(9, 0, &f, 3);
+        assert_eq!(s.runs(), 1);
+        let mut p = PrimSources::default();
+        p.add(Kind::Sphere, 0, 1, &f, 7);
+        assert_eq!(p.get(Kind::Sphere, 0).unwrap().line, 7);
+        assert_eq!(p.get(Kind::Triangle, 0), None);
+    }
+}
