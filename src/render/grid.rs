@@ -204,8 +204,12 @@ where
     let tiles = tiles(gw, gh, tile);
     let done = AtomicUsize::new(0);
     let total = tiles.len();
+    // One task per tile: rayon otherwise splits the list only as far as it sees
+    // threads steal, and a run of costly tiles (glass, mirrors) left in one thread's
+    // last piece keeps it busy while the other waits with nothing to take.
     let results: Vec<(Vec<Vec3>, R)> = tiles
         .par_iter()
+        .with_max_len(1)
         .map(|&(x0, y0)| {
             let x1 = (x0 + ts).min(gw);
             let y1 = (y0 + ts).min(gh);
