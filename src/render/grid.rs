@@ -55,8 +55,8 @@ where
     let raygen = RayGen::new(&tracer.scene.camera, at.full.0, at.full.1);
     let (ox, oy) = at.origin;
     let (gw, gh) = at.size;
-    let (grid, recs) = sample_grid(ox, oy, gw, gh, settings.tile, progress, new, |t, px, r| {
-        tracer.tile(&raygen, t, px, r);
+    let (grid, recs) = sample_grid(ox, oy, gw, gh, settings.tile, progress, new, |t, out, r| {
+        tracer.tile(&raygen, t, &mut |v| out.push(v), r);
     });
     let film = if settings.spd {
         grid.average_corners()
@@ -121,14 +121,14 @@ pub(super) fn adaptive_render<A: Accel>(
 
 /// A per-position function `f(i, j, counts)` as a tile function for [`sample_grid`]:
 /// the tile's positions row by row.
-fn per_position<F>(f: F) -> impl Fn(Region, &mut Vec<Vec3>, &mut RayCounts) + Sync
+fn per_position<F>(f: F) -> impl Fn(Region, &mut TileRows<'_>, &mut RayCounts) + Sync
 where
     F: Fn(u32, u32, &mut RayCounts) -> Vec3 + Sync,
 {
-    move |t, px, counts| {
+    move |t, out, counts| {
         for j in t.y0..t.y1 {
             for i in t.x0..t.x1 {
-                px.push(f(i, j, counts));
+                out.push(f(i, j, counts));
             }
         }
     }
@@ -179,11 +179,12 @@ pub(super) fn scatter<T: Copy + Default>(
 }
 
 /// Evaluate the `gw × gh` grid whose top-left is `(ox, oy)` in parallel square tiles
-/// of edge `tile`, the result independent of the schedule: `f(tile, px, rec)` pushes
-/// the values of the tile's grid positions (absolute coordinates, row by row) onto
-/// `px`, recording with a recorder `new` makes for the tile, and the film's pixel
-/// `(i, j)` is the value of position `(ox + i, oy + j)`. The recorders come back in the
-/// order of [`tiles`].
+/// of edge `tile`, the result independent of the schedule: `f(tile, out, rec)` gives
+/// the values of the tile's grid positions (absolute coordinates, row by row) to
+/// `out`, recording with a recorder `new` makes for the tile, and the film's pixel
+/// `(i, j)` is the value of position `(ox + i, oy + j)`. Each tile writes straight into
+/// its rows of the film: no buffer per tile, nothing left to assemble after the
+/// parallel part. The recorders come back in the order of [`tiles`].
 #[allow(clippy::too_many_arguments)]
 fn sample_grid<R, N, F>(
     ox: u32,
@@ -198,49 +199,91 @@ fn sample_grid<R, N, F>(
 where
     R: Send,
     N: Fn() -> R + Sync,
-    F: Fn(Region, &mut Vec<Vec3>, &mut R) + Sync,
+    F: Fn(Region, &mut TileRows<'_>, &mut R) + Sync,
 {
     let ts = tile.max(1);
     let tiles = tiles(gw, gh, tile);
     let done = AtomicUsize::new(0);
     let total = tiles.len();
+    let mut film = Film::new(gw, gh);
+    let rows = tile_rows(&mut film.pixels, gw, ts);
     // One task per tile: rayon otherwise splits the list only as far as it sees
     // threads steal, and a run of costly tiles (glass, mirrors) left in one thread's
     // last piece keeps it busy while the other waits with nothing to take.
-    let results: Vec<(Vec<Vec3>, R)> = tiles
-        .par_iter()
+    let recs: Vec<R> = rows
+        .into_par_iter()
+        .zip(tiles.par_iter())
         .with_max_len(1)
-        .map(|&(x0, y0)| {
-            let x1 = (x0 + ts).min(gw);
-            let y1 = (y0 + ts).min(gh);
+        .map(|(rows, &(x0, y0))| {
             let mut rec = new();
-            let mut px = Vec::with_capacity(((x1 - x0) * (y1 - y0)) as usize);
             let t = Region {
                 x0: ox + x0,
                 y0: oy + y0,
-                x1: ox + x1,
-                y1: oy + y1,
+                x1: ox + (x0 + ts).min(gw),
+                y1: oy + (y0 + ts).min(gh),
             };
-            f(t, &mut px, &mut rec);
+            let mut out = TileRows::new(rows);
+            f(t, &mut out, &mut rec);
+            debug_assert!(out.is_full(), "a tile function gave too few values");
             if let Some(p) = progress {
                 p(done.fetch_add(1, Ordering::Relaxed) + 1, total);
             }
-            (px, rec)
+            rec
         })
         .collect();
-    let mut grid = Film::new(gw, gh);
-    let mut recs = Vec::with_capacity(total);
-    for (&(x0, y0), (px, rec)) in tiles.iter().zip(results) {
-        recs.push(rec);
-        let x1 = (x0 + ts).min(gw);
-        let mut it = px.into_iter();
-        for j in y0..(y0 + ts).min(gh) {
-            for i in x0..x1 {
-                grid.set(i, j, it.next().expect("tile size"));
-            }
+    (film, recs)
+}
+
+/// The rows of each tile of edge `ts` of a `gw`-wide row-major grid, as disjoint
+/// slices of `pixels`, tiles in the order of [`tiles`].
+fn tile_rows(pixels: &mut [Vec3], gw: u32, ts: u32) -> Vec<Vec<&mut [Vec3]>> {
+    let (gw, ts) = (gw as usize, ts as usize);
+    let across = gw.div_ceil(ts);
+    let down = (pixels.len() / gw.max(1)).div_ceil(ts);
+    let mut out: Vec<Vec<&mut [Vec3]>> =
+        (0..across * down).map(|_| Vec::with_capacity(ts)).collect();
+    for (j, row) in pixels.chunks_mut(gw.max(1)).enumerate() {
+        let first = j / ts * across;
+        for (k, part) in row.chunks_mut(ts).enumerate() {
+            out[first + k].push(part);
         }
     }
-    (grid, recs)
+    out
+}
+
+/// Where a tile function puts its values: the tile's rows of the film, filled
+/// position by position, row by row.
+pub(super) struct TileRows<'a> {
+    rows: Vec<&'a mut [Vec3]>,
+    row: usize,
+    col: usize,
+}
+
+impl<'a> TileRows<'a> {
+    fn new(rows: Vec<&'a mut [Vec3]>) -> Self {
+        TileRows {
+            rows,
+            row: 0,
+            col: 0,
+        }
+    }
+
+    /// The value of the next position.
+    #[inline]
+    pub(super) fn push(&mut self, v: Vec3) {
+        let row = &mut self.rows[self.row];
+        row[self.col] = v;
+        self.col += 1;
+        if self.col == row.len() {
+            self.col = 0;
+            self.row += 1;
+        }
+    }
+
+    /// Whether every position has its value.
+    fn is_full(&self) -> bool {
+        self.row == self.rows.len()
+    }
 }
 
 /// Whitted's adaptive refinement of the square at `(x, y)` of edge `size` whose corner
@@ -308,4 +351,46 @@ where
         ),
     ];
     (q[0] + q[1] + q[2] + q[3]) * 0.25
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+
+    #[test]
+    fn every_tile_writes_its_own_positions_into_the_film() {
+        for (gw, gh, tile) in [(1, 1, 16), (7, 5, 2), (33, 17, 16), (16, 16, 16), (5, 9, 1)] {
+            let (ox, oy) = (3, 11);
+            let (film, recs) = sample_grid(
+                ox,
+                oy,
+                gw,
+                gh,
+                tile,
+                None,
+                Vec::new,
+                |t, out, rec: &mut Vec<Region>| {
+                    rec.push(t);
+                    for j in t.y0..t.y1 {
+                        for i in t.x0..t.x1 {
+                            out.push(Vec3::new(i as f32, j as f32, 1.0));
+                        }
+                    }
+                },
+            );
+            for j in 0..gh {
+                for i in 0..gw {
+                    let want = Vec3::new((ox + i) as f32, (oy + j) as f32, 1.0);
+                    assert_eq!(film.get(i, j), want, "{gw}×{gh} tile {tile}: ({i}, {j})");
+                }
+            }
+            let origins: Vec<(u32, u32)> =
+                recs.iter().map(|r| (r[0].x0 - ox, r[0].y0 - oy)).collect();
+            assert_eq!(
+                origins,
+                tiles(gw, gh, tile),
+                "recorders in the order of the tiles"
+            );
+        }
+    }
 }

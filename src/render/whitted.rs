@@ -121,7 +121,7 @@ impl<'a, A: Accel> Tracer<'a, A> {
         sum / n as f32
     }
 
-    /// The values of the grid positions of tile `t`, row by row, pushed onto `px`: as
+    /// The values of the grid positions of tile `t`, row by row, given to `out`: as
     /// [`Tracer::pixel`] gives them, but with one sample per pixel the tile's eye rays
     /// are cast together first (packets on backends that have them; see
     /// [`Accel::intersect_coherent`]), then each is shaded from its hit.
@@ -129,7 +129,7 @@ impl<'a, A: Accel> Tracer<'a, A> {
         &self,
         raygen: &RayGen,
         t: Region,
-        px: &mut Vec<Vec3>,
+        out: &mut impl FnMut(Vec3),
         rec: &mut R,
     ) {
         if self.spp != 1 {
@@ -138,7 +138,7 @@ impl<'a, A: Accel> Tracer<'a, A> {
                     rec.position(i, j);
                     let v = self.pixel(raygen, i, j, rec);
                     rec.position_end(v);
-                    px.push(v);
+                    out(v);
                 }
             }
             return;
@@ -159,7 +159,7 @@ impl<'a, A: Accel> Tracer<'a, A> {
             let v = self.trace_from(ray, hit, 1, path, Media::AIR, Vec3::ONE, rec);
             rec.ray_end(v);
             rec.position_end(v);
-            px.push(v);
+            out(v);
         }
     }
 
