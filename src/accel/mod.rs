@@ -69,6 +69,14 @@ pub fn kinds_summary(kinds: &[(Kind, usize)]) -> String {
 
 /// A ray-query structure built over a [`Scene`].
 pub trait Accel: Sync {
+    /// Whether the top-level triangle hits this backend reports carry the watertight
+    /// test's own `t`, `u`, `v` for the ray as given, bit for bit, so that
+    /// [`Scene::surface_of`](crate::scene::Scene::surface_of) need not test the triangle again to make every backend's
+    /// hits the same ([`crate::scene::Geometry::exact_hit`]).
+    #[inline(always)]
+    fn exact_triangle_hits(&self) -> bool {
+        false
+    }
     /// The nearest hit with `t` in `(ray.tmin, ray.tmax)`.
     fn intersect(&self, ray: &Ray) -> Option<Hit>;
     /// Whether anything lies in `(ray.tmin, ray.tmax)` (any-hit, for shadow rays).

@@ -237,7 +237,7 @@ impl<'a, A: Accel> Tracer<'a, A> {
                 rec.miss(sky);
                 return sky;
             };
-            let surf = scene.surface(&hit, &ray);
+            let surf = scene.surface_of(&hit, &ray, self.accel.exact_triangle_hits());
             let m = &scene.materials[surf.material as usize];
             let d = ray.dir.normalize();
             let entering = surf.point.ng.dot(d) < 0.0;

@@ -316,8 +316,21 @@ impl Scene {
 
     /// The surface at a hit reported by a backend for `ray` (world space).
     pub fn surface(&self, hit: &Hit, ray: &Ray) -> Surface {
+        self.surface_of(hit, ray, false)
+    }
+
+    /// [`Scene::surface`], where `exact` says that a top-level triangle hit is the
+    /// watertight test's own already (see [`crate::accel::Accel::exact_triangle_hits`]).
+    #[inline]
+    pub fn surface_of(&self, hit: &Hit, ray: &Ray, exact: bool) -> Surface {
         if hit.inst_id == NO_INSTANCE {
-            let hit = &self.geometry.exact_hit(hit, ray);
+            let tested;
+            let hit = if exact {
+                hit
+            } else {
+                tested = self.geometry.exact_hit(hit, ray);
+                &tested
+            };
             let mut surf = self.geometry.surface(hit, ray);
             if self.textured(surf.material) {
                 surf.param = Some(self.geometry.param(hit, &surf));
