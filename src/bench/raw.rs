@@ -95,6 +95,10 @@ impl<A: Accel> Accel for Recorder<'_, A> {
         self.inner.intersect_coherent(rays, hits);
     }
 
+    fn exact_triangle_hits(&self) -> bool {
+        self.inner.exact_triangle_hits()
+    }
+
     fn stats(&self) -> AccelStats {
         self.inner.stats()
     }
