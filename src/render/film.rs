@@ -15,12 +15,17 @@ pub struct Film {
 }
 
 impl Film {
-    /// A black film.
+    /// A black film, zeroed by the threads of the current rayon pool: a large film's
+    /// memory is first touched here, and one thread faulting its pages in while the
+    /// others wait was a serial stretch of a short render.
     pub fn new(width: u32, height: u32) -> Self {
+        let n = width as usize * height as usize;
+        let mut pixels = Vec::with_capacity(n);
+        pixels.par_extend(rayon::iter::repeat_n(Vec3::ZERO, n));
         Film {
             width,
             height,
-            pixels: vec![Vec3::ZERO; width as usize * height as usize],
+            pixels,
         }
     }
 
