@@ -159,6 +159,12 @@ impl Cone {
         if self.line_passes_wide(ray) {
             return None;
         }
+        self.first_exact(ray)
+    }
+
+    /// [`Cone::first`] by the exact test alone.
+    #[inline(always)]
+    fn first_exact(&self, ray: &Ray) -> Option<(f32, f32)> {
         let q = self.quadratic(ray);
         let (entry, exit) = q.roots()?;
         let candidates = if self.inside_only {
@@ -312,25 +318,6 @@ mod tests {
     use super::*;
     use crate::math::Rng;
 
-    /// The exact test without the distance filter.
-    fn exact(cone: &Cone, ray: &Ray) -> Option<(f32, f32)> {
-        let q = cone.quadratic(ray);
-        let (entry, exit) = q.roots()?;
-        let candidates = if cone.inside_only {
-            [exit, f64::NAN]
-        } else if entry <= exit {
-            [entry, exit]
-        } else {
-            [exit, entry]
-        };
-        candidates.into_iter().find_map(|root| {
-            let t = (q.t0 + root) as f32;
-            let sigma = q.fs + root * q.ds;
-            (t > ray.tmin && t < ray.tmax && (0.0..=q.hh).contains(&sigma))
-                .then(|| (t, (sigma / q.hh) as f32))
-        })
-    }
-
     #[test]
     fn the_distance_filter_refuses_only_rays_that_miss() {
         let mut rng = Rng::new(17);
@@ -358,7 +345,7 @@ mod tests {
                     (target - org) * rng.range(0.1, 10.0)
                 };
                 let ray = Ray::new(org, dir);
-                let want = exact(&cone, &ray);
+                let want = cone.first_exact(&ray);
                 hits += usize::from(want.is_some());
                 if cone.line_passes_wide(&ray) {
                     refused += 1;
