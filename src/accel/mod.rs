@@ -71,8 +71,9 @@ pub fn kinds_summary(kinds: &[(Kind, usize)]) -> String {
 pub trait Accel: Sync {
     /// Whether the top-level triangle hits this backend reports carry the watertight
     /// test's own `t`, `u`, `v` for the ray as given, bit for bit, so that
-    /// [`Scene::surface_of`](crate::scene::Scene::surface_of) need not test the triangle again to make every backend's
-    /// hits the same ([`crate::scene::Geometry::exact_hit`]).
+    /// [`Scene::surface_of`](crate::scene::Scene::surface_of) need not test the
+    /// triangle again to make every backend's hits the same
+    /// ([`crate::scene::Geometry::exact_hit`]).
     #[inline(always)]
     fn exact_triangle_hits(&self) -> bool {
         false

@@ -42,22 +42,25 @@ impl Film {
     }
 
     /// The `(w−1) × (h−1)` film whose pixels are the means of this film's 2×2 blocks of
-    /// neighbouring samples (SPD corner-ray mode), rows in parallel.
+    /// neighbouring samples (SPD corner-ray mode), computed in parallel straight into
+    /// the new film.
     pub fn average_corners(&self) -> Film {
         let (w, h) = (self.width - 1, self.height - 1);
-        let mut out = Film::new(w, h);
-        let stride = self.width as usize;
-        out.pixels
-            .par_chunks_mut(w.max(1) as usize)
-            .enumerate()
-            .for_each(|(j, row)| {
-                let top = &self.pixels[j * stride..(j + 1) * stride];
-                let bottom = &self.pixels[(j + 1) * stride..(j + 2) * stride];
-                for (i, px) in row.iter_mut().enumerate() {
-                    *px = corner_mean([top[i], top[i + 1], bottom[i], bottom[i + 1]]);
-                }
-            });
-        out
+        let (cols, stride) = (w as usize, self.width as usize);
+        let pixels = (0..cols * h as usize)
+            .into_par_iter()
+            .map(|k| {
+                let top = k / cols * stride + k % cols;
+                let bottom = top + stride;
+                let p = &self.pixels;
+                corner_mean([p[top], p[top + 1], p[bottom], p[bottom + 1]])
+            })
+            .collect();
+        Film {
+            width: w,
+            height: h,
+            pixels,
+        }
     }
 }
 
