@@ -1,5 +1,7 @@
 use super::{ShapeHit, SurfacePoint};
-use crate::math::{Aabb, Ray, Vec3, gamma};
+use crate::math::{Aabb, Ray, Vec3, gamma, gamma64};
+use glam::Vec4;
+use std::ops::{Add, Mul};
 
 /// A triangle. Its front side is the one from which the vertices appear
 /// counterclockwise; the geometric normal `(p1 − p0) × (p2 − p0)` points to it.
@@ -15,6 +17,8 @@ pub struct Triangle {
 #[derive(Clone, Copy, Debug)]
 pub struct WatertightRay {
     org: Vec3,
+    /// The direction itself, for the f64 fallback ([`refine_in_f64`]).
+    dir: Vec3,
     k: [usize; 3],
     shear: Vec3,
     tmin: f32,
@@ -43,6 +47,7 @@ impl WatertightRay {
         let dz = d[kz];
         WatertightRay {
             org: ray.org,
+            dir: ray.dir,
             k: [kx, ky, kz],
             shear: Vec3::new(d[kx] / dz, d[ky] / dz, 1.0 / dz),
             tmin: ray.tmin,
@@ -123,29 +128,29 @@ impl Triangle {
         let tt = u * az + v * bz + w * cz;
         let inv = 1.0 / det;
         let t = tt * inv;
-        if !(t > r.tmin && t < r.tmax) {
+        if !(t < r.tmax) {
             return None;
         }
-        // Reject t within its own rounding error of zero (pbrt §6.8.7), so that a ray
-        // leaving the surface from a robustly offset origin cannot re-hit it. The sheared
-        // x and y are lengths, with an error relative to |x| + |z| before z is divided
-        // by the direction's z (|Sx·z| ≤ |z| as |d[kx]| ≤ |d[kz]|); pbrt adds the divided
-        // z there, which makes the bound depend on the direction's length: a shadow ray
-        // towards a light (an unnormalised direction) in a scene 10⁻⁴ units across then
-        // found its blocker "within rounding of 0" and passed through it.
-        let max_zt = az.abs().max(bz.abs()).max(cz.abs());
-        let max_z = a[kz].abs().max(b[kz].abs()).max(c[kz].abs());
-        let max_xt = ax.abs().max(bx.abs()).max(cx.abs());
-        let max_yt = ay.abs().max(by.abs()).max(cy.abs());
-        let delta_z = gamma(3) * max_zt;
-        let delta_x = gamma(5) * (max_xt + max_z);
-        let delta_y = gamma(5) * (max_yt + max_z);
-        let delta_e = 2.0 * (gamma(2) * max_xt * max_yt + delta_y * max_xt + delta_x * max_yt);
-        let max_e = u.abs().max(v.abs()).max(w.abs());
-        let delta_t =
-            3.0 * (gamma(3) * max_e * max_zt + delta_e * max_zt + delta_z * max_e) * inv.abs();
-        if t <= delta_t {
-            return None;
+        let delta_t = distance_error(
+            [ax, ay, bx, by, cx, cy],
+            [a[kz], b[kz], c[kz]],
+            [az, bz, cz],
+            [u, v, w],
+            inv,
+        );
+        if !(t > delta_t && t > r.tmin) {
+            // Too close to the start of the interval for f32 to tell which side the
+            // hit is on (a huge triangle, or one seen edge-on, near the origin):
+            // decide it in f64 unless it is certainly before the interval.
+            if t + delta_t <= r.tmin.max(0.0) {
+                return None;
+            }
+            return refine_in_f64(&self.p, r).map(|(t, u, v)| ShapeHit {
+                t,
+                u,
+                v,
+                ng: self.normal(),
+            });
         }
         Some(ShapeHit {
             t,
@@ -182,4 +187,157 @@ impl Triangle {
             ng: self.normal().normalize_or_zero(),
         }
     }
+}
+
+/// The arithmetic of [`distance_error`]: f32 (the scalar test), four f32 lanes
+/// ([`Triangle4`](super::Triangle4)) or f64 ([`refine_in_f64`]), each with its own
+/// `max` and its own unit roundoff.
+pub(crate) trait BoundArith: Copy + Add<Output = Self> + Mul<Output = Self> {
+    fn abs(self) -> Self;
+    fn max(self, other: Self) -> Self;
+    /// The constant `v` in every lane.
+    fn splat(v: f32) -> Self;
+    /// γₙ in this type's precision.
+    fn gamma(n: u32) -> Self;
+}
+
+impl BoundArith for f32 {
+    #[inline(always)]
+    fn abs(self) -> f32 {
+        f32::abs(self)
+    }
+    #[inline(always)]
+    fn max(self, other: f32) -> f32 {
+        f32::max(self, other)
+    }
+    #[inline(always)]
+    fn splat(v: f32) -> f32 {
+        v
+    }
+    #[inline(always)]
+    fn gamma(n: u32) -> f32 {
+        gamma(n)
+    }
+}
+
+impl BoundArith for Vec4 {
+    #[inline(always)]
+    fn abs(self) -> Vec4 {
+        Vec4::abs(self)
+    }
+    #[inline(always)]
+    fn max(self, other: Vec4) -> Vec4 {
+        Vec4::max(self, other)
+    }
+    #[inline(always)]
+    fn splat(v: f32) -> Vec4 {
+        Vec4::splat(v)
+    }
+    #[inline(always)]
+    fn gamma(n: u32) -> Vec4 {
+        Vec4::splat(gamma(n))
+    }
+}
+
+impl BoundArith for f64 {
+    #[inline(always)]
+    fn abs(self) -> f64 {
+        f64::abs(self)
+    }
+    #[inline(always)]
+    fn max(self, other: f64) -> f64 {
+        f64::max(self, other)
+    }
+    #[inline(always)]
+    fn splat(v: f32) -> f64 {
+        f64::from(v)
+    }
+    #[inline(always)]
+    fn gamma(n: u32) -> f64 {
+        gamma64(n)
+    }
+}
+
+/// The bound on the rounding error of the watertight test's distance `t` (pbrt §6.8.7),
+/// from the sheared vertex coordinates `xy` (`ax, ay, bx, by, cx, cy`), the vertices'
+/// coordinates `z` along the ray's major axis before and `zt` after the scale by
+/// `1/d[kz]`, the edge functions `uvw` and `inv = 1/(u + v + w)`.
+///
+/// A hit closer than this is rejected, so that a ray leaving the surface from a
+/// robustly offset origin cannot re-hit it. The sheared x and y are lengths, with an
+/// error relative to |x| + |z| before z is divided by the direction's z (|Sx·z| ≤ |z|
+/// as |d[kx]| ≤ |d[kz]|); pbrt adds the divided z there, which makes the bound depend
+/// on the direction's length: a shadow ray towards a light (an unnormalised direction)
+/// in a scene 10⁻⁴ units across then found its blocker "within rounding of 0" and
+/// passed through it.
+#[inline(always)]
+pub(crate) fn distance_error<T: BoundArith>(
+    xy: [T; 6],
+    z: [T; 3],
+    zt: [T; 3],
+    uvw: [T; 3],
+    inv: T,
+) -> T {
+    let [ax, ay, bx, by, cx, cy] = xy;
+    let max3 = |[a, b, c]: [T; 3]| a.abs().max(b.abs()).max(c.abs());
+    let max_zt = max3(zt);
+    let max_z = max3(z);
+    let max_xt = max3([ax, bx, cx]);
+    let max_yt = max3([ay, by, cy]);
+    let delta_z = T::gamma(3) * max_zt;
+    let delta_x = T::gamma(5) * (max_xt + max_z);
+    let delta_y = T::gamma(5) * (max_yt + max_z);
+    let delta_e =
+        T::splat(2.0) * (T::gamma(2) * max_xt * max_yt + delta_y * max_xt + delta_x * max_yt);
+    let max_e = max3(uvw);
+    T::splat(3.0) * (T::gamma(3) * max_e * max_zt + delta_e * max_zt + delta_z * max_e) * inv.abs()
+}
+
+/// The watertight test's distance and barycentrics recomputed in f64, for a ray whose
+/// f32 distance is within its own rounding error of the start of its interval: a
+/// triangle huge beside its distance from the origin (a floor a million units wide
+/// seen from a metre above it), or seen so obliquely that its sheared image is a
+/// sliver (an eye a few hundredths above a long triangle), makes that error larger
+/// than the distance itself, and f32 cannot tell a hit ahead from one behind.
+///
+/// The edge functions' signs (inside or outside) were decided in f32 already and stay
+/// decided: they are what keeps two triangles sharing an edge watertight. Only the
+/// distance, its error bound (now 2²⁹ times smaller) and the barycentrics are
+/// recomputed; the hit is kept if the f64 distance is beyond its own error and inside
+/// the interval.
+#[cold]
+#[inline(never)]
+pub(crate) fn refine_in_f64(p: &[Vec3; 3], r: &WatertightRay) -> Option<(f32, f32, f32)> {
+    let [kx, ky, kz] = r.k;
+    let org = r.org.as_dvec3();
+    let d = r.dir.as_dvec3().to_array();
+    let rel = |v: Vec3| (v.as_dvec3() - org).to_array();
+    let (a, b, c) = (rel(p[0]), rel(p[1]), rel(p[2]));
+    let (sx, sy, sz) = (d[kx] / d[kz], d[ky] / d[kz], 1.0 / d[kz]);
+    let ax = a[kx] - sx * a[kz];
+    let ay = a[ky] - sy * a[kz];
+    let bx = b[kx] - sx * b[kz];
+    let by = b[ky] - sy * b[kz];
+    let cx = c[kx] - sx * c[kz];
+    let cy = c[ky] - sy * c[kz];
+    let u = cx * by - cy * bx;
+    let v = ax * cy - ay * cx;
+    let w = bx * ay - by * ax;
+    let det = u + v + w;
+    if det == 0.0 {
+        return None;
+    }
+    let (az, bz, cz) = (sz * a[kz], sz * b[kz], sz * c[kz]);
+    let inv = 1.0 / det;
+    let t = (u * az + v * bz + w * cz) * inv;
+    let delta_t = distance_error(
+        [ax, ay, bx, by, cx, cy],
+        [a[kz], b[kz], c[kz]],
+        [az, bz, cz],
+        [u, v, w],
+        inv,
+    );
+    let t32 = t as f32;
+    (t > delta_t && t32 > r.tmin.max(0.0) && t32 < r.tmax)
+        .then(|| (t32, (v * inv) as f32, (w * inv) as f32))
 }

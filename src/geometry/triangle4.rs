@@ -11,9 +11,8 @@
 //! which treats NaN differently from `f32::max`; a NaN can only reach it when the
 //! distance itself is infinite or NaN, which the interval test rejects either way.
 
-use super::triangle::WatertightRay;
+use super::triangle::{WatertightRay, distance_error, refine_in_f64};
 use super::{ShapeHit, Triangle};
-use crate::math::gamma;
 use glam::{BVec4A, Vec4};
 
 /// Up to four triangles, structure-of-arrays. Unused lanes repeat the last triangle, so
@@ -36,6 +35,8 @@ pub struct WatertightRay4 {
     shear: [Vec4; 3],
     tmin: Vec4,
     tmax: Vec4,
+    /// The scalar ray, for the f64 fallback of lanes whose f32 distance is uncertain.
+    ray: WatertightRay,
 }
 
 impl WatertightRay4 {
@@ -49,6 +50,7 @@ impl WatertightRay4 {
             shear: [shear.x, shear.y, shear.z].map(Vec4::splat),
             tmin: Vec4::splat(tmin),
             tmax: Vec4::splat(tmax),
+            ray: *ray,
         }
     }
 
@@ -56,6 +58,7 @@ impl WatertightRay4 {
     #[inline]
     pub fn set_tmax(&mut self, tmax: f32) {
         self.tmax = Vec4::splat(tmax);
+        self.ray.set_tmax(tmax);
     }
 }
 
@@ -192,32 +195,53 @@ impl Triangle4 {
         let tt = u * az + v * bz + w * cz;
         let inv = det.recip();
         let t = tt * inv;
-        mask &= (t.cmpgt(r.tmin) & t.cmplt(r.tmax)).bitmask();
+        mask &= t.cmplt(r.tmax).bitmask();
         if mask == 0 {
             return Hits4::NONE;
         }
-        // Reject t within its own rounding error of zero (see `Triangle::intersect_wt`).
-        // The x and y errors are relative to the unscaled z, as in the scalar test.
-        let max_zt = az.abs().max(bz.abs()).max(cz.abs());
-        let max_z = a_z.abs().max(b_z.abs()).max(c_z.abs());
-        let max_xt = ax.abs().max(bx.abs()).max(cx.abs());
-        let max_yt = ay.abs().max(by.abs()).max(cy.abs());
-        let g = |n: u32| Vec4::splat(gamma(n));
-        let delta_z = g(3) * max_zt;
-        let delta_x = g(5) * (max_xt + max_z);
-        let delta_y = g(5) * (max_yt + max_z);
-        let delta_e =
-            Vec4::splat(2.0) * (g(2) * max_xt * max_yt + delta_y * max_xt + delta_x * max_yt);
-        let max_e = u.abs().max(v.abs()).max(w.abs());
-        let delta_t = Vec4::splat(3.0)
-            * (g(3) * max_e * max_zt + delta_e * max_zt + delta_z * max_e)
-            * inv.abs();
-        mask &= !t.cmple(delta_t).bitmask();
-        Hits4 {
+        let delta_t = distance_error(
+            [ax, ay, bx, by, cx, cy],
+            [a_z, b_z, c_z],
+            [az, bz, cz],
+            [u, v, w],
+            inv,
+        );
+        let sure = (t.cmpgt(delta_t) & t.cmpgt(r.tmin)).bitmask();
+        let before = (t + delta_t).cmple(r.tmin.max(zero)).bitmask();
+        let unsure = mask & !sure & !before;
+        mask &= sure;
+        let hits = Hits4 {
             mask,
             t,
             u: v * inv,
             v: w * inv,
+        };
+        if unsure == 0 {
+            hits
+        } else {
+            self.refine_lanes(hits, unsure, &r.ray)
+        }
+    }
+
+    /// `hits` with the lanes in `unsure` decided in f64, as the scalar test decides
+    /// them when its f32 distance is within rounding of the interval's start
+    /// ([`refine_in_f64`]).
+    #[cold]
+    #[inline(never)]
+    fn refine_lanes(&self, hits: Hits4, unsure: u32, ray: &WatertightRay) -> Hits4 {
+        let mut mask = hits.mask;
+        let [mut t, mut u, mut v] = [hits.t, hits.u, hits.v].map(|x| x.to_array());
+        for i in (0..4).filter(|i| unsure & (1 << i) != 0) {
+            if let Some((ti, ui, vi)) = refine_in_f64(&self.triangle(i).p, ray) {
+                mask |= 1 << i;
+                (t[i], u[i], v[i]) = (ti, ui, vi);
+            }
+        }
+        Hits4 {
+            mask,
+            t: Vec4::from_array(t),
+            u: Vec4::from_array(u),
+            v: Vec4::from_array(v),
         }
     }
 
@@ -342,6 +366,38 @@ mod tests {
             assert_eq!(pack.nearest(&WatertightRay4::new(&wt)), want_nearest);
         }
         assert!(exact_edges > 100, "rays on edges: {exact_edges}");
+    }
+
+    /// Lanes whose f32 distance is within rounding of zero (huge, sliver and grazing
+    /// triangles, origins near the plane) are decided in f64, and still equal the
+    /// scalar test bit for bit.
+    #[test]
+    fn lanes_decided_in_f64_equal_the_scalar_test() {
+        use crate::quality::hard_triangles::{hard_cases, known_cases};
+        let mut cases = known_cases(64);
+        cases.extend(hard_cases(200, 16, 5));
+        let mut compared = 0;
+        for pair in cases.chunks(4) {
+            let tris: Vec<Triangle> = pair.iter().map(|c| c.triangle).collect();
+            let pack = Triangle4::new(&tris);
+            for ray in pair.iter().flat_map(|c| &c.rays) {
+                let wt = WatertightRay::new(ray);
+                let hits = pack.intersect(&WatertightRay4::new(&wt));
+                for (i, tri) in tris.iter().enumerate() {
+                    let want = tri.intersect_wt(&wt);
+                    assert_eq!(hits.mask & (1 << i) != 0, want.is_some(), "lane {i}");
+                    if let Some(w) = want {
+                        let (t, u, v) = hits.lane(i);
+                        assert_eq!(
+                            (t.to_bits(), u.to_bits(), v.to_bits()),
+                            (w.t.to_bits(), w.u.to_bits(), w.v.to_bits())
+                        );
+                        compared += 1;
+                    }
+                }
+            }
+        }
+        assert!(compared > 2000, "{compared} hits compared");
     }
 
     #[test]

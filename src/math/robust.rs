@@ -13,6 +13,14 @@ pub const fn gamma(n: u32) -> f32 {
     nu / (1.0 - nu)
 }
 
+/// `n·u / (1 − n·u)` with `u = 2⁻⁵³`: the relative error bound of `n` f64 operations
+/// (the f64 fallbacks of the f32 tests).
+#[inline]
+pub const fn gamma64(n: u32) -> f64 {
+    let nu = n as f64 * (f64::EPSILON * 0.5);
+    nu / (1.0 - nu)
+}
+
 /// The next representable f32 above `v` (`+inf` stays).
 #[inline]
 pub fn next_float_up(v: f32) -> f32 {

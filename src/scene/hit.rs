@@ -28,6 +28,18 @@ pub struct Hit {
 pub const NO_INSTANCE: u32 = u32::MAX;
 
 impl Hit {
+    /// Whether this hit, at the same distance as `current` and on the same level (the
+    /// scene's top level, or the same instance), is the one to keep: the rule for
+    /// coincident primitives, which both backends apply to their analytic shapes. The
+    /// primitive defined first wins: the lower index within a kind, and between kinds
+    /// the kind listed first in the kinds table.
+    #[inline]
+    pub fn wins_tie_with(&self, current: &Hit) -> bool {
+        self.t == current.t
+            && self.inst_id == current.inst_id
+            && (self.geom_id, self.prim_id) < (current.geom_id, current.prim_id)
+    }
+
     /// The primitive kind hit.
     pub fn kind(&self) -> Kind {
         Kind::from_id(self.geom_id).expect("invalid geometry id")

@@ -17,7 +17,7 @@ mod wide;
 use crate::accel::unbounded::Unbounded;
 use crate::accel::{Accel, AccelStats, Hit, NO_INSTANCE};
 use crate::geometry::{Analytic, Intersect, Kind, ShapeHit, WatertightRay, WatertightRay4};
-use crate::math::{Aabb, Ray, Xform};
+use crate::math::{Aabb, Ray, Xform, next_float_up};
 use crate::scene::{Geometry, KindVisitor, Prims, Scene};
 use leaf::{Leaf, LeafData, Other, Prim};
 use std::sync::Arc;
@@ -207,10 +207,18 @@ impl LeafRay {
 }
 
 impl Bvh {
-    /// The nearest hit among `leaf`'s primitives in `(ray.tmin, tmax)`, if any: its
-    /// triangle packs in order, then its other primitives.
+    /// The nearest hit among `leaf`'s primitives in `(ray.tmin, tmax)`, or at `tmax`
+    /// when it wins the tie with `found`, the nearest hit of the hierarchy so far
+    /// ([`Hit::wins_tie_with`]: analytic shapes only), if any: its triangle packs in
+    /// order, then its other primitives.
     #[inline]
-    fn leaf_nearest(&self, leaf: &Leaf, r: &mut LeafRay, mut tmax: f32) -> Option<Hit> {
+    fn leaf_nearest(
+        &self,
+        leaf: &Leaf,
+        r: &mut LeafRay,
+        mut tmax: f32,
+        found: Option<Hit>,
+    ) -> Option<Hit> {
         let mut best = None;
         for p in leaf.packs() {
             if let Some((lane, h)) = self.leaves.packs[p].nearest(r.watertight(tmax)) {
@@ -220,9 +228,21 @@ impl Bvh {
             }
         }
         for o in &self.leaves.others[leaf.others()] {
-            if let Some(h) = self.other_nearest(o, &Ray { tmax, ..r.ray }) {
-                tmax = h.t;
-                best = Some(h);
+            let current = best.or(found).filter(|c| c.t == tmax);
+            // With a hit at `tmax` already, look up to and including `tmax` for a
+            // coincident primitive defined before it.
+            let reach = current.map_or(tmax, |_| next_float_up(tmax));
+            if let Some(h) = self.other_nearest(
+                o,
+                &Ray {
+                    tmax: reach,
+                    ..r.ray
+                },
+            ) {
+                if h.t < tmax || current.is_some_and(|c| h.wins_tie_with(&c)) {
+                    tmax = h.t;
+                    best = Some(h);
+                }
             }
         }
         best
@@ -263,20 +283,23 @@ impl Bvh {
         if !ray.is_traceable() {
             return None;
         }
-        let mut best = self.unbounded.nearest(ray);
-        let tmax = best.map_or(ray.tmax, |h| h.t);
+        // The unbounded primitives first: the hierarchy is searched up to the nearest
+        // of them, and one at the same distance as theirs does not displace it.
+        let unbounded = self.unbounded.nearest(ray);
+        let tmax = unbounded.map_or(ray.tmax, |h| h.t);
         let ray = Ray { tmax, ..*ray };
         let mut r = LeafRay::new(ray);
+        let mut found = None;
         self.traverse::<true>(&ray, |leaf, tmax| {
-            match self.leaf_nearest(leaf, &mut r, tmax) {
+            match self.leaf_nearest(leaf, &mut r, tmax, found) {
                 Some(h) => {
-                    best = Some(h);
+                    found = Some(h);
                     Visit::Continue(h.t)
                 }
                 None => Visit::Continue(tmax),
             }
         });
-        best
+        found.or(unbounded)
     }
 
     /// Whether anything is hit; nothing is for a ray that is not

@@ -39,7 +39,7 @@ use std::sync::OnceLock;
 
 use super::sys;
 use crate::geometry::Analytic;
-use crate::math::{Aabb, Ray, Vec3};
+use crate::math::{Aabb, Ray, Vec3, next_float_up};
 
 /// The user data of one user geometry: its primitives, indexed by Embree's `primID`.
 /// Lives in a `Box` owned by the `EmbreeAccel`, so the pointer Embree holds stays valid
@@ -410,8 +410,21 @@ pub(super) unsafe extern "C" fn bounds<T: Analytic>(args: *const sys::RTCBoundsF
     }
 }
 
-/// `RTCIntersectFunctionN`: nearest hit with primitive `primID` for each active ray; on
-/// a hit, writes `tfar`, `u`, `v`, `Ng`, `primID`, `geomID` and `instID`.
+/// The hit ray `i` of an `RTCHitN` packet holds so far, as `(geomID, primID, instID[0])`,
+/// or `None` before any.
+///
+/// # Safety
+/// `hits` is the hit part of a live `RTCRayHitN` packet and `i < n`.
+#[inline(always)]
+unsafe fn current_hit(hits: Packet, i: usize) -> Option<(u32, u32, u32)> {
+    // SAFETY: by the caller's contract, the hit members exist for ray `i`.
+    let word = |field| unsafe { hits.word(field, i).read() };
+    let geom = word(soa::GEOM_ID);
+    (geom != sys::INVALID_GEOMETRY_ID).then(|| (geom, word(soa::PRIM_ID), word(soa::INST_ID)))
+}
+
+/// `RTCIntersectFunctionN`: nearest hit with primitive `primID` for each active ray (or
+/// one at the current `tfar` that wins the tie with the hit there); on a hit, writes `tfar`, `u`, `v`, `Ng`, `primID`, `geomID` and `instID`.
 pub(super) unsafe extern "C" fn intersect<T: Analytic>(
     args: *const sys::RTCIntersectFunctionNArguments,
 ) {
@@ -442,7 +455,15 @@ pub(super) unsafe extern "C" fn intersect<T: Analytic>(
             continue;
         }
         // SAFETY: `rayhit` is a live `RTCRayHitN` packet of `N` rays and `i < N`.
-        let ray = unsafe { packet.ray(i) };
+        let mut ray = unsafe { packet.ray(i) };
+        // SAFETY: as above; the hit members follow the ray's.
+        let current = unsafe { current_hit(packet.hits(), i) };
+        // A hit at `tfar` already: look up to and including `tfar` for a coincident
+        // primitive that wins the tie (`Hit::wins_tie_with`), as the BVH does.
+        let tfar = ray.tmax;
+        if current.is_some() {
+            ray.tmax = next_float_up(tfar);
+        }
         let hit = catch_unwind(AssertUnwindSafe(|| {
             #[cfg(test)]
             maybe_injected_panic(Callback::Intersect);
@@ -451,6 +472,12 @@ pub(super) unsafe extern "C" fn intersect<T: Analytic>(
         .unwrap_or_else(|payload| {
             record_query_panic(Callback::Intersect, T::KIND.name(), &*payload);
             None
+        })
+        .filter(|h| {
+            h.t < tfar
+                || current.is_some_and(|(geom, prim, level)| {
+                    h.t == tfar && level == inst[0] && (args.geomID, prim_id) < (geom, prim)
+                })
         });
         match hit {
             Some(h) => {
