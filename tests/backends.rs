@@ -250,8 +250,8 @@ fn coincident_analytic_primitives_resolve_to_the_one_defined_first() {
     for copy in 0..4u32 {
         s.materials.push(Material::default());
         for (sphere, cone) in &shapes {
-            s.geometry.push(sphere.clone(), copy);
-            s.geometry.push(cone.clone(), copy);
+            s.geometry.push(*sphere, copy);
+            s.geometry.push(*cone, copy);
         }
     }
     let bvh = Bvh::build(&s);

@@ -128,7 +128,9 @@ impl Triangle {
         let tt = u * az + v * bz + w * cz;
         let inv = 1.0 / det;
         let t = tt * inv;
-        if !(t < r.tmax) {
+        // NaN fails this too.
+        let before_tmax = t < r.tmax;
+        if !before_tmax {
             return None;
         }
         let delta_t = distance_error(
@@ -338,6 +340,6 @@ pub(crate) fn refine_in_f64(p: &[Vec3; 3], r: &WatertightRay) -> Option<(f32, f3
         inv,
     );
     let t32 = t as f32;
-    (t > delta_t && t32 > r.tmin.max(0.0) && t32 < r.tmax)
-        .then(|| (t32, (v * inv) as f32, (w * inv) as f32))
+    let (bary1, bary2) = ((v * inv) as f32, (w * inv) as f32);
+    (t > delta_t && t32 > r.tmin.max(0.0) && t32 < r.tmax).then_some((t32, bary1, bary2))
 }
