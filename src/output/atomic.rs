@@ -1,7 +1,8 @@
 //! Atomic writes: every output file is written to a temporary file beside it
 //! (`.NAME.XXXXXXXX.tmp`, in the same folder so that the rename is atomic), then renamed
 //! over the target, so a failed or interrupted write never leaves a truncated file under
-//! the target's name. Also the check made before any work goes into a file
+//! the target's name. The file gets the permissions the process's umask gives any new
+//! file. Also the check made before any work goes into a file
 //! ([`prepare`]), and the removal of temporary files a killed process left
 //! ([`remove_stale_temps`]).
 
@@ -17,18 +18,42 @@ pub(super) fn folder_of(path: &Path) -> &Path {
     }
 }
 
-/// A new temporary file beside `path`, named `.NAME.XXXXXXXX.tmp`; deleted when dropped
-/// unless persisted.
+/// A new temporary file beside `path`, named `.NAME.XXXXXXXX.tmp`, with the permissions
+/// of any new file (see [`new_file_permissions`]); deleted when dropped unless
+/// persisted.
 fn temp_beside(path: &Path) -> std::io::Result<tempfile::NamedTempFile> {
     let name = path
         .file_name()
         .map(|n| n.to_string_lossy().into_owned())
         .unwrap_or_default();
-    tempfile::Builder::new()
-        .prefix(&format!(".{name}."))
+    let prefix = format!(".{name}.");
+    let mut builder = tempfile::Builder::new();
+    builder
+        .prefix(&prefix)
         .suffix(TEMP_SUFFIX)
-        .rand_bytes(TEMP_RAND)
-        .tempfile_in(folder_of(path))
+        .rand_bytes(TEMP_RAND);
+    if let Some(p) = new_file_permissions() {
+        builder.permissions(p);
+    }
+    builder.tempfile_in(folder_of(path))
+}
+
+/// The mode a temporary file is created with, which the rename keeps: read and write
+/// for everyone, less what the process's umask takes away, as any program creating a
+/// file gets (0644 under umask 022, 0600 under 077). The system applies the umask when
+/// it creates the file, so it is never read or changed here (changing it to read it
+/// would race with other threads creating files). `tempfile`'s own default, 0600
+/// whatever the umask, would leave images on a shared folder unreadable to others.
+#[cfg(unix)]
+fn new_file_permissions() -> Option<fs::Permissions> {
+    use std::os::unix::fs::PermissionsExt;
+    Some(fs::Permissions::from_mode(0o666))
+}
+
+/// Elsewhere a new file gets the system's defaults.
+#[cfg(not(unix))]
+fn new_file_permissions() -> Option<fs::Permissions> {
+    None
 }
 
 /// Make sure `path` can be written before any work goes into it: create its folder if

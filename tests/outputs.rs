@@ -1,0 +1,125 @@
+//! The files every command writes, through the binary: the permissions they get.
+
+use std::path::Path;
+use std::process::{Command, Output};
+
+mod common;
+use common::stderr;
+
+const SCENE: &str = "v\nfrom 0 0 10\nat 0 0 0\nup 0 1 0\nangle 30\nhither 1\nresolution 40 30\n\
+                     b 0.1 0.2 0.3\nl 3 3 10\nf 1 0 0 1 0 0 0 1\ns 0 0 0 2\n";
+
+/// Run the `emray` binary with `args` in `dir` under the shell's `umask`.
+#[cfg(unix)]
+fn emray_under_umask(dir: &Path, umask: &str, args: &[&str]) -> Output {
+    Command::new("sh")
+        .current_dir(dir)
+        .arg("-c")
+        .arg(format!("umask {umask} && exec \"$@\""))
+        .arg("sh")
+        .arg(env!("CARGO_BIN_EXE_emray"))
+        .args(args)
+        .output()
+        .expect("run sh")
+}
+
+/// Every file under `dir` but `except`, with its permission bits.
+#[cfg(unix)]
+fn modes(dir: &Path, except: &[&str]) -> Vec<(String, u32)> {
+    use std::os::unix::fs::PermissionsExt;
+    let mut out = Vec::new();
+    for e in std::fs::read_dir(dir).unwrap() {
+        let e = e.unwrap();
+        let name = e.file_name().to_string_lossy().into_owned();
+        let meta = e.metadata().unwrap();
+        if meta.is_dir() {
+            for (sub, mode) in modes(&e.path(), except) {
+                out.push((format!("{name}/{sub}"), mode));
+            }
+        } else if !except.contains(&name.as_str()) {
+            out.push((name, meta.permissions().mode() & 0o777));
+        }
+    }
+    out.sort();
+    out
+}
+
+#[cfg(unix)]
+#[test]
+fn every_output_gets_the_mode_the_umask_gives_a_new_file() {
+    let mut commands: Vec<Vec<&str>> = vec![
+        vec!["render", "a.nff", "-o", "a.png"],
+        vec![
+            "render",
+            "a.nff",
+            "-o",
+            "aov.exr",
+            "--aov",
+            "depth,id",
+            "--heatmap",
+            "rays",
+            "heat.png",
+            "--stats-json",
+            "stats.jsonl",
+        ],
+        vec![
+            "render", "a.nff", "--tile", "0/2", "--aov", "id", "-o", "p0.exr",
+        ],
+        vec![
+            "render", "a.nff", "--tile", "1/2", "--aov", "id", "-o", "p1.exr",
+        ],
+        vec!["merge", "p0.exr", "p1.exr", "-o", "merged.exr"],
+        vec!["gen", "tetra", "-s", "1", "-o", "t.nff"],
+        vec![
+            "batch",
+            "a.nff",
+            "-o",
+            "batch/{stem}.png",
+            "--report",
+            "r.json",
+        ],
+    ];
+    if cfg!(feature = "quality") {
+        commands.push(vec!["compare", "a.png", "a.png", "--diff", "diff.png"]);
+        commands.push(vec![
+            "study",
+            "a.nff",
+            "--out",
+            "study",
+            "--res",
+            "8x6",
+            "--reference-strata",
+            "1",
+        ]);
+    }
+    for (umask, mode) in [("022", 0o644), ("077", 0o600)] {
+        let dir = tempfile::tempdir().unwrap();
+        let d = dir.path();
+        std::fs::write(d.join("a.nff"), SCENE).unwrap();
+        for args in &commands {
+            let o = emray_under_umask(d, umask, args);
+            assert!(o.status.success(), "{args:?}: {}", stderr(&o));
+        }
+        let found = modes(d, &["a.nff"]);
+        for name in [
+            "a.png",
+            "aov.exr",
+            "aov.exr.ids.json",
+            "heat.png",
+            "stats.jsonl",
+            "merged.exr",
+            "merged.exr.ids.json",
+            "t.nff",
+            "batch/a.png",
+            "r.json",
+        ] {
+            assert!(found.iter().any(|(n, _)| n == name), "{name}: {found:?}");
+        }
+        let wrong: Vec<String> = found
+            .iter()
+            .filter(|(_, m)| *m != mode)
+            .map(|(n, m)| format!("{n} {m:o}"))
+            .collect();
+        assert!(wrong.is_empty(), "umask {umask}: want {mode:o}: {wrong:?}");
+    }
+}
