@@ -226,8 +226,8 @@ fn input_errors_exit_1_with_one_line_and_write_nothing() {
             "emray: error: nope.toml: cannot read",
         ),
         (
-            vec!["gen", "tetra", "-o", "nodir/t.nff"],
-            "emray: error: nodir/t.nff: cannot write",
+            vec!["gen", "tetra", "-o", "a.nff/t.nff"],
+            "emray: error: a.nff/t.nff: cannot write",
         ),
     ] {
         let o = emray(dir.path(), &args);

@@ -4,7 +4,7 @@ use std::path::Path;
 use std::process::{Command, Output};
 
 mod common;
-use common::stderr;
+use common::{emray, stderr};
 
 const SCENE: &str = "v\nfrom 0 0 10\nat 0 0 0\nup 0 1 0\nangle 30\nhither 1\nresolution 40 30\n\
                      b 0.1 0.2 0.3\nl 3 3 10\nf 1 0 0 1 0 0 0 1\ns 0 0 0 2\n";
@@ -121,5 +121,91 @@ fn every_output_gets_the_mode_the_umask_gives_a_new_file() {
             .map(|(n, m)| format!("{n} {m:o}"))
             .collect();
         assert!(wrong.is_empty(), "umask {umask}: want {mode:o}: {wrong:?}");
+    }
+}
+
+/// The Cornell box of `scenes/`, whose light is an emitting polygon.
+fn cornell_box() -> String {
+    format!("{}/scenes/cornell-box.toml", env!("CARGO_MANIFEST_DIR"))
+}
+
+#[test]
+fn every_command_creates_a_missing_output_folder() {
+    let dir = tempfile::tempdir().unwrap();
+    let d = dir.path();
+    std::fs::write(d.join("a.nff"), SCENE).unwrap();
+    let cornell = cornell_box();
+    let mut commands: Vec<Vec<&str>> = vec![
+        vec!["gen", "tetra", "-s", "1", "-o", "gen/t.nff"],
+        vec![
+            "render",
+            "a.nff",
+            "-o",
+            "render/a.exr",
+            "--aov",
+            "id",
+            "--heatmap",
+            "rays",
+            "heat/a.png",
+            "--stats-json",
+            "stats/s.jsonl",
+        ],
+        vec!["render", "a.nff", "--tile", "0/1", "-o", "part.exr"],
+        vec!["merge", "part.exr", "-o", "merge/m.png"],
+        vec![
+            "batch",
+            "a.nff",
+            "-o",
+            "batch/{stem}.png",
+            "--report",
+            "report/r.json",
+        ],
+        vec![
+            "radiosity",
+            &cornell,
+            "--patch-size",
+            "300",
+            "--res",
+            "8x8",
+            "--spp",
+            "1",
+            "-o",
+            "rad/c.png",
+            "--ply",
+            "ply/c.ply",
+            "--stats-json",
+            "radstats/s.jsonl",
+        ],
+    ];
+    if cfg!(feature = "quality") {
+        commands.push(vec![
+            "compare",
+            "part.exr",
+            "part.exr",
+            "--diff",
+            "diff/d.png",
+        ]);
+    }
+    for args in &commands {
+        let o = emray(d, args);
+        assert!(o.status.success(), "{args:?}: {}", stderr(&o));
+    }
+    for file in [
+        "gen/t.nff",
+        "render/a.exr",
+        "render/a.exr.ids.json",
+        "heat/a.png",
+        "stats/s.jsonl",
+        "merge/m.png",
+        "batch/a.png",
+        "report/r.json",
+        "rad/c.png",
+        "ply/c.ply",
+        "radstats/s.jsonl",
+    ] {
+        assert!(d.join(file).is_file(), "{file}");
+    }
+    if cfg!(feature = "quality") {
+        assert!(d.join("diff/d.png").is_file());
     }
 }

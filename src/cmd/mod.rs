@@ -110,9 +110,11 @@ fn thread_pool(threads: Option<u32>) -> anyhow::Result<rayon::ThreadPool> {
     builder.build().context("cannot start the worker threads")
 }
 
-/// Append `value` as one JSON line to `path` (the `--stats-json` log: one record per run).
+/// Append `value` as one JSON line to `path` (the `--stats-json` log: one record per
+/// run), creating its folder if missing.
 fn append_json_line(path: &Path, value: &impl serde::Serialize) -> anyhow::Result<()> {
     let line = serde_json::to_string(value).expect("report serialises");
+    emray::output::create_folder(path)?;
     let mut f = std::fs::OpenOptions::new()
         .create(true)
         .append(true)

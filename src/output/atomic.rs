@@ -56,6 +56,15 @@ fn new_file_permissions() -> Option<fs::Permissions> {
     None
 }
 
+/// Create the folder `path` goes in, and the folders above it, if missing: the one
+/// way every command makes its outputs' folders.
+pub fn create_folder(path: &Path) -> Result<(), OutputError> {
+    fs::create_dir_all(folder_of(path)).map_err(|e| OutputError::Write {
+        path: path.to_path_buf(),
+        message: e.to_string(),
+    })
+}
+
 /// Make sure `path` can be written before any work goes into it: create its folder if
 /// missing, and create (then remove) a temporary file there, as the final write will.
 pub fn prepare(path: &Path) -> Result<(), OutputError> {
@@ -63,7 +72,7 @@ pub fn prepare(path: &Path) -> Result<(), OutputError> {
         path: path.to_path_buf(),
         message,
     };
-    std::fs::create_dir_all(folder_of(path)).map_err(|e| err(e.to_string()))?;
+    create_folder(path)?;
     if path.is_dir() {
         return Err(err("it is a folder".into()));
     }
@@ -82,8 +91,8 @@ fn os_message(e: &std::io::Error) -> String {
 }
 
 /// Write `path` through a temporary file beside it (`.NAME.XXXXXX.tmp`, so that the
-/// rename is atomic) that `write` fills, then a rename; on failure the temporary file is
-/// removed and the target left as it was.
+/// rename is atomic) that `write` fills, then a rename, creating its folder if missing;
+/// on failure the temporary file is removed and the target left as it was.
 pub(crate) fn write_atomic(
     path: &Path,
     write: impl FnOnce(fs::File) -> Result<(), String>,
@@ -92,6 +101,7 @@ pub(crate) fn write_atomic(
         path: path.to_path_buf(),
         message,
     };
+    create_folder(path)?;
     // Dropping an unpersisted temporary file deletes it.
     let tmp = temp_beside(path).map_err(|e| err(os_message(&e)))?;
     let file = tmp.reopen().map_err(|e| err(e.to_string()))?;

@@ -13,7 +13,7 @@ pub mod heatmap;
 pub mod part;
 
 pub(crate) use atomic::write_atomic;
-pub use atomic::{prepare, remove_stale_temps};
+pub use atomic::{create_folder, prepare, remove_stale_temps};
 
 // The PNG writer's encodings, defined with the colour curves in `render`.
 use crate::render::Film;

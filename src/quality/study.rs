@@ -11,7 +11,7 @@ use crate::render::{Aa, RenderSettings};
 use crate::run::{render_reference, render_scene};
 use crate::scene::Scene;
 use std::fmt::Write as _;
-use std::path::{Path, PathBuf};
+use std::path::Path;
 
 /// Why the study could not be run or written.
 #[derive(Debug, thiserror::Error)]
@@ -22,14 +22,6 @@ pub enum StudyError {
     /// A backend could not be built.
     #[error(transparent)]
     Accel(#[from] AccelError),
-    /// The output directory could not be created.
-    #[error("{}: cannot create: {message}", dir.display())]
-    CreateDir {
-        /// The directory.
-        dir: PathBuf,
-        /// Why.
-        message: String,
-    },
     /// The plot could not be drawn.
     #[error("plotting: {0}")]
     Plot(String),
@@ -301,10 +293,6 @@ pub fn write(
     backends: &[Backend],
 ) -> Result<Vec<Row>, StudyError> {
     let rows = run(scene, w, h, strata, backends)?;
-    std::fs::create_dir_all(dir).map_err(|e| StudyError::CreateDir {
-        dir: dir.to_path_buf(),
-        message: e.to_string(),
-    })?;
     let title = format!("{name}, {w}x{h}: error vs time");
     crate::output::write_text(&dir.join("study.csv"), &csv(&rows))?;
     crate::output::write_text(&dir.join("study.svg"), &svg(&rows, &title)?)?;
