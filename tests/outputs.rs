@@ -209,3 +209,51 @@ fn every_command_creates_a_missing_output_folder() {
         assert!(d.join("diff/d.png").is_file());
     }
 }
+
+/// The temporary files in `dir` (`.NAME.XXXXXXXX.tmp`), with their sizes.
+fn temporary_files(dir: &Path) -> Vec<(String, u64)> {
+    std::fs::read_dir(dir)
+        .unwrap()
+        .filter_map(|e| {
+            let e = e.ok()?;
+            let name = e.file_name().to_string_lossy().into_owned();
+            let size = e.metadata().ok()?.len();
+            name.ends_with(".tmp").then_some((name, size))
+        })
+        .collect()
+}
+
+#[cfg(unix)]
+#[test]
+fn a_signal_during_a_long_write_leaves_no_temporary_file() {
+    use nix::sys::signal::{Signal, kill};
+    use std::process::Stdio;
+    use std::time::{Duration, Instant};
+    for signal in [Signal::SIGINT, Signal::SIGTERM] {
+        let dir = tempfile::tempdir().unwrap();
+        let d = dir.path();
+        std::fs::write(d.join("a.nff"), SCENE).unwrap();
+        // Every output variable of a million pixels: an EXR of some 30 MB, which takes
+        // a while to compress and write.
+        let mut child = Command::new(env!("CARGO_BIN_EXE_emray"))
+            .current_dir(d)
+            .args(["render", "a.nff", "--res", "1024x1024", "--aov", "all"])
+            .args(["-o", "big.exr", "-q"])
+            .stderr(Stdio::piped())
+            .spawn()
+            .unwrap();
+        // The write has begun once its temporary file holds something (the check of
+        // the output before the render leaves an empty one for a moment).
+        let t0 = Instant::now();
+        let writing = || temporary_files(d).iter().any(|(_, size)| *size > 0);
+        while !writing() && t0.elapsed() < Duration::from_secs(120) {
+            assert!(child.try_wait().unwrap().is_none(), "ended before writing");
+            std::thread::sleep(Duration::from_millis(1));
+        }
+        let pid = nix::unistd::Pid::from_raw(child.id().try_into().unwrap());
+        kill(pid, signal).unwrap();
+        let o = child.wait_with_output().unwrap();
+        assert_eq!(o.status.code(), Some(130), "{signal}: {}", stderr(&o));
+        assert_eq!(temporary_files(d), [], "{signal}");
+    }
+}

@@ -1,10 +1,10 @@
 //! `emray batch`: many scenes (arguments, globs or a manifest) rendered as isolated,
-//! resumable jobs, optionally one shard of them; Ctrl-C stops it after writing the
-//! report of what finished.
+//! resumable jobs, optionally one shard of them; Ctrl-C or SIGTERM stops it after
+//! writing the report of what finished (a second one at once).
 
 use super::args::{BackendArg, EncodingArg, parse_res};
 use super::error::print;
-use super::interrupt::cancel_on_ctrl_c;
+use super::interrupt::stop_flag;
 use super::progress::BatchDisplay;
 use super::{Error, init_log};
 use emray::accel::Backend;
@@ -124,7 +124,7 @@ pub fn run(b: Args) -> Result<(), Error> {
             .unwrap_or_else(emray::run::limits::default_max_memory),
         shard: b.shard,
     };
-    let cancel = cancel_on_ctrl_c();
+    let cancel = stop_flag();
     let mut display = BatchDisplay::new(jobs.len(), b.quiet);
     let report = batch::run(jobs, &opts, &cancel, &mut display);
     if report.interrupted && !b.quiet {

@@ -2,6 +2,7 @@
 //! in the EXR beside the colour) and `--heatmap` (a false-colour PNG of a per-pixel
 //! cost): parsing, the checks made before any render, and writing what they ask for.
 
+use super::progress::TileBar;
 use anyhow::{Result, bail};
 use emray::output::heatmap::{Quantity, write_heatmap};
 use emray::output::{self, Format};
@@ -100,9 +101,10 @@ pub fn heatmap_files(maps: &[HeatmapArg], stem: &str) -> Vec<(Quantity, PathBuf)
         .collect()
 }
 
-/// Write the heat maps `files` of a render's variables `aov`.
-pub fn write_heatmaps(aov: &AovFilm, files: &[(Quantity, PathBuf)]) -> Result<()> {
+/// Write the heat maps `files` of a render's variables `aov`, saying so on `bar`.
+pub fn write_heatmaps(aov: &AovFilm, files: &[(Quantity, PathBuf)], bar: &TileBar) -> Result<()> {
     for (q, path) in files {
+        bar.writing(path);
         let values = match q {
             Quantity::Rays => &aov.rays,
             Quantity::Time => &aov.time,

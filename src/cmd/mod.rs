@@ -1,8 +1,8 @@
 //! The commands of the `emray` binary, one module each with its own arguments and a
 //! `run(args) -> Result<(), Error>`; [`args`] holds the argument types several share,
 //! [`error`] how a failure becomes a message and an exit status, [`progress`] and
-//! [`interrupt`] the terminal's progress bars and the Ctrl-C handler (neither of which
-//! the library has).
+//! [`interrupt`] the terminal's progress bars and the handler of Ctrl-C and SIGTERM
+//! (neither of which the library has).
 
 mod args;
 mod batch;
@@ -69,8 +69,10 @@ pub enum Command {
     Explain(explain::Args),
 }
 
-/// Run the command line's command (a bare `emray` renders the default scene).
+/// Run the command line's command (a bare `emray` renders the default scene), Ctrl-C
+/// and SIGTERM caught for it ([`interrupt`]).
 pub fn run(cli: Cli) -> Result<(), Error> {
+    interrupt::install();
     match cli.command {
         None => render::run(render::Args::default_scene()),
         Some(Command::Render(a)) => render::run(a),

@@ -1,5 +1,6 @@
 //! Progress bars on a terminal: the tiles of one render, and the jobs of a batch with
-//! a bar per running job and a line per finished one.
+//! a bar per running job and a line per finished one; each says when its image is
+//! being written.
 
 use super::error::error_line;
 use emray::batch::{Job, JobRecord, JobStatus, Observer};
@@ -7,6 +8,8 @@ use emray::output::OutputError;
 use indicatif::{MultiProgress, ProgressBar, ProgressStyle};
 use std::collections::HashMap;
 use std::io::IsTerminal;
+use std::path::Path;
+use std::time::Duration;
 
 /// Bars are drawn unless `quiet`, and only on a terminal.
 fn shown(quiet: bool) -> bool {
@@ -22,6 +25,15 @@ fn bar(len: u64, template: &str) -> ProgressBar {
             .progress_chars("=> "),
     );
     b
+}
+
+/// Turn `b` into a spinner saying that `path` is being written.
+fn writing(b: &ProgressBar, path: &Path) {
+    b.set_style(
+        ProgressStyle::with_template("{spinner} {msg} {elapsed_precise}").expect("static template"),
+    );
+    b.set_message(format!("writing {} …", path.display()));
+    b.enable_steady_tick(Duration::from_millis(100));
 }
 
 /// The tiles of one render.
@@ -48,7 +60,15 @@ impl TileBar {
         }
     }
 
-    /// The render is done: clear the bar.
+    /// The render is done and `path` is being written: say so (writing a large EXR
+    /// takes seconds).
+    pub fn writing(&self, path: &Path) {
+        if let Some(b) = &self.0 {
+            writing(b, path);
+        }
+    }
+
+    /// Everything is written: clear the bar.
     pub fn finish(&self) {
         if let Some(b) = &self.0 {
             b.finish_and_clear();
@@ -114,6 +134,12 @@ impl Observer for BatchDisplay {
         if let Some(b) = self.job_bars.get(&index) {
             b.set_length(total as u64);
             b.set_position(done as u64);
+        }
+    }
+
+    fn writing(&mut self, index: usize, job: &Job) {
+        if let Some(b) = self.job_bars.get(&index) {
+            writing(b, &job.output);
         }
     }
 

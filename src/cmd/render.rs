@@ -417,7 +417,7 @@ fn render_one(args: &Args, scene_path: Option<&Path>, out: &Path) -> Result<()> 
     let options = backend_options(args);
     let bar = TileBar::new(&name, args.quiet);
     let (film, aov, report) = trace(args, &name, &scene, &settings, options, load_ms, &bar)?;
-    bar.finish();
+    bar.writing(out);
     let part = settings.region.map(|region| part::PartInfo {
         full: (settings.width, settings.height),
         region,
@@ -435,8 +435,9 @@ fn render_one(args: &Args, scene_path: Option<&Path>, out: &Path) -> Result<()> 
         (_, None) => output::write_image(out, &film, args.encoding.into())?,
     }
     if let Some(aov) = &aov {
-        insight::write_heatmaps(aov, &heatmap_files(args, scene_path))?;
+        insight::write_heatmaps(aov, &heatmap_files(args, scene_path), &bar)?;
     }
+    bar.finish();
     if args.stats {
         print(format_args!(
             "{}\noutput     {}\n",

@@ -2,11 +2,13 @@
 //! (`.NAME.XXXXXXXX.tmp`, in the same folder so that the rename is atomic), then renamed
 //! over the target, so a failed or interrupted write never leaves a truncated file under
 //! the target's name. The file gets the permissions the process's umask gives any new
-//! file. Also the check made before any work goes into a file
+//! file. Temporary files are registered while they exist, so that a process told to stop
+//! can remove them ([`super::pending`]). Also the check made before any work goes into a file
 //! ([`prepare`]), and the removal of temporary files a killed process left
 //! ([`remove_stale_temps`]).
 
 use super::OutputError;
+use super::pending::PendingFile;
 use std::fs;
 use std::path::Path;
 
@@ -19,9 +21,9 @@ pub(super) fn folder_of(path: &Path) -> &Path {
 }
 
 /// A new temporary file beside `path`, named `.NAME.XXXXXXXX.tmp`, with the permissions
-/// of any new file (see [`new_file_permissions`]); deleted when dropped unless
-/// persisted.
-fn temp_beside(path: &Path) -> std::io::Result<tempfile::NamedTempFile> {
+/// of any new file (see [`new_file_permissions`]), registered as a write in progress
+/// (see [`super::pending`]); deleted when dropped unless persisted.
+fn temp_beside(path: &Path) -> std::io::Result<PendingFile> {
     let name = path
         .file_name()
         .map(|n| n.to_string_lossy().into_owned())
@@ -35,7 +37,7 @@ fn temp_beside(path: &Path) -> std::io::Result<tempfile::NamedTempFile> {
     if let Some(p) = new_file_permissions() {
         builder.permissions(p);
     }
-    builder.tempfile_in(folder_of(path))
+    PendingFile::create(|| builder.tempfile_in(folder_of(path)))
 }
 
 /// The mode a temporary file is created with, which the rename keeps: read and write
@@ -106,7 +108,7 @@ pub(crate) fn write_atomic(
     let tmp = temp_beside(path).map_err(|e| err(os_message(&e)))?;
     let file = tmp.reopen().map_err(|e| err(e.to_string()))?;
     write(file).map_err(err)?;
-    tmp.persist(path).map_err(|e| err(e.error.to_string()))?;
+    tmp.persist(path).map_err(|e| err(e.to_string()))?;
     Ok(())
 }
 

@@ -1,8 +1,10 @@
 //! Image output: PNG (sRGB-encoded by default) and OpenEXR (linear f32), chosen by the
 //! file extension, always written to a temporary file beside the target and renamed,
-//! so a failed or interrupted write never leaves a truncated image. Besides the colour:
-//! the output variables' EXR channels ([`aov`], [`channels`]) and the cost heat maps
-//! ([`heatmap`]), drawn with the colour maps of [`colormap`].
+//! so a failed or interrupted write never leaves a truncated image, and
+//! [`abandon_writes`] removes the temporary files of the writes in progress for a
+//! process about to end. Besides the colour: the output variables' EXR channels
+//! ([`aov`], [`channels`]) and the cost heat maps ([`heatmap`]), drawn with the colour
+//! maps of [`colormap`].
 
 pub mod aov;
 mod atomic;
@@ -11,9 +13,11 @@ pub mod colormap;
 mod font;
 pub mod heatmap;
 pub mod part;
+mod pending;
 
 pub(crate) use atomic::write_atomic;
 pub use atomic::{create_folder, prepare, remove_stale_temps};
+pub use pending::abandon_writes;
 
 // The PNG writer's encodings, defined with the colour curves in `render`.
 use crate::render::Film;
