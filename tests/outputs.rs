@@ -257,3 +257,125 @@ fn a_signal_during_a_long_write_leaves_no_temporary_file() {
         assert_eq!(temporary_files(d), [], "{signal}");
     }
 }
+
+/// One command whose output cannot be written: its arguments, the file the message
+/// names, the exit status, and files it must not have written.
+struct Unwritable {
+    args: Vec<String>,
+    names: &'static str,
+    status: i32,
+    absent: &'static [&'static str],
+}
+
+fn unwritable(args: &str, names: &'static str, absent: &'static [&'static str]) -> Unwritable {
+    Unwritable {
+        args: args.split(' ').map(String::from).collect(),
+        names,
+        status: 1,
+        absent,
+    }
+}
+
+/// A folder for one case of [`an_unwritable_output_is_refused_before_any_work`]: the
+/// scene `a.nff`, the image `ref.png`, a regular file `file` where a folder would have
+/// to be, and a folder where the ids file of `taken.exr` would go.
+fn unwritable_fixture(png: &[u8]) -> tempfile::TempDir {
+    let dir = tempfile::tempdir().unwrap();
+    let d = dir.path();
+    std::fs::write(d.join("a.nff"), SCENE).unwrap();
+    std::fs::write(d.join("ref.png"), png).unwrap();
+    std::fs::write(d.join("file"), "").unwrap();
+    std::fs::create_dir(d.join("taken.exr.ids.json")).unwrap();
+    dir
+}
+
+#[test]
+fn an_unwritable_output_is_refused_before_any_work() {
+    let dir = tempfile::tempdir().unwrap();
+    std::fs::write(dir.path().join("a.nff"), SCENE).unwrap();
+    let o = emray(dir.path(), &["render", "a.nff", "-o", "ref.png", "-q"]);
+    assert!(o.status.success(), "{}", stderr(&o));
+    let png = std::fs::read(dir.path().join("ref.png")).unwrap();
+    let cornell = cornell_box();
+    let bench = "bench nope.nff --reps 1 --res 8x8 --backend bvh -t 1 --no-raw --no-peer";
+    let mut cases = vec![
+        unwritable(
+            "render a.nff -o a.png --stats --stats-json file/s.jsonl",
+            "file/s.jsonl",
+            &["a.png"],
+        ),
+        // Checked before the scene is read.
+        unwritable(
+            "render nope.nff -o a.png --stats-json file/s.jsonl",
+            "file/s.jsonl",
+            &[],
+        ),
+        unwritable(
+            "render a.nff -o a.png --stats --heatmap rays file/h.png",
+            "file/h.png",
+            &["a.png"],
+        ),
+        unwritable("render a.nff -o file/a.exr --aov depth", "file/a.exr", &[]),
+        unwritable(
+            "render a.nff -o taken.exr --stats --aov id",
+            "taken.exr.ids.json",
+            &["taken.exr"],
+        ),
+        unwritable(
+            "batch a.nff -o b.png --report file/r.json",
+            "file/r.json",
+            &["b.png"],
+        ),
+        unwritable(
+            "batch a.nff -o file/{stem}.png --report r.json",
+            "file/a.png",
+            &["r.json"],
+        ),
+        unwritable(
+            "radiosity nope.toml -o rad.png --ply file/c.ply",
+            "file/c.ply",
+            &[],
+        ),
+        unwritable(
+            &format!(
+                "radiosity {cornell} --patch-size 300 --res 8x8 -o rad.png --stats-json file/s.jsonl"
+            ),
+            "file/s.jsonl",
+            &["rad.png"],
+        ),
+        unwritable("merge nope.exr -o file/m.png", "file/m.png", &[]),
+        unwritable(&format!("{bench} --csv file/b.csv"), "file/b.csv", &[]),
+        unwritable(&format!("{bench} --json file/b.json"), "file/b.json", &[]),
+        unwritable("gen tetra -o file/t.nff", "file/t.nff", &[]),
+    ];
+    if cfg!(feature = "quality") {
+        cases.push(unwritable(
+            "study nope.nff --out file/st",
+            "file/st/study.csv",
+            &[],
+        ));
+        cases.push(Unwritable {
+            status: 2,
+            ..unwritable(
+                "compare ref.png ref.png --diff file/d.png",
+                "file/d.png",
+                &[],
+            )
+        });
+    }
+    for case in &cases {
+        let dir = unwritable_fixture(&png);
+        let d = dir.path();
+        let args: Vec<&str> = case.args.iter().map(String::as_str).collect();
+        let o = emray(d, &args);
+        let e = stderr(&o);
+        assert_eq!(o.status.code(), Some(case.status), "{args:?}: {e}");
+        let wanted = format!("emray: error: {}: cannot write", case.names);
+        assert!(e.starts_with(&wanted), "{args:?}: {e}");
+        assert_eq!(e.lines().count(), 1, "{args:?}: one line: {e}");
+        assert_eq!(String::from_utf8_lossy(&o.stdout), "", "{args:?}: no work");
+        for f in case.absent {
+            assert!(!d.join(f).exists(), "{args:?}: {f} was written");
+        }
+    }
+}

@@ -6,9 +6,9 @@ use super::args::{BackendArg, EncodingArg, parse_res};
 use super::error::print;
 use super::interrupt::stop_flag;
 use super::progress::BatchDisplay;
-use super::{Error, init_log};
+use super::{Error, init_log, outputs};
 use emray::accel::Backend;
-use emray::batch::{self, BatchOptions, Job, JobSettings};
+use emray::batch::{self, BatchOptions, BatchReport, Job, JobSettings};
 use emray::output::Encoding;
 use emray::run::RenderRequest;
 use std::path::PathBuf;
@@ -124,6 +124,8 @@ pub fn run(b: Args) -> Result<(), Error> {
             .unwrap_or_else(emray::run::limits::default_max_memory),
         shard: b.shard,
     };
+    let images = jobs.iter().map(|j| j.output.as_path());
+    outputs::prepare(opts.report.as_deref().into_iter().chain(images))?;
     let cancel = stop_flag();
     let mut display = BatchDisplay::new(jobs.len(), b.quiet);
     let report = batch::run(jobs, &opts, &cancel, &mut display);
@@ -134,12 +136,22 @@ pub fn run(b: Args) -> Result<(), Error> {
             report.total
         );
     }
-    let failed = (report.failed > 0)
-        .then(|| anyhow::anyhow!("{} of {} jobs failed", report.failed, report.total));
+    let failed = failure(&report, display.report_error());
     match (report.interrupted, failed) {
         (true, failed) => Err(Error::Interrupted(failed)),
         (false, Some(failed)) => Err(Error::Failed(failed)),
         (false, None) => Ok(()),
+    }
+}
+
+/// What went wrong in a batch that ran: failed jobs, a report that could not be
+/// written.
+fn failure(report: &BatchReport, report_error: Option<&str>) -> Option<anyhow::Error> {
+    let jobs =
+        (report.failed > 0).then(|| format!("{} of {} jobs failed", report.failed, report.total));
+    match (jobs, report_error) {
+        (Some(jobs), Some(r)) => Some(anyhow::anyhow!("{jobs}; {r}")),
+        (jobs, r) => jobs.as_deref().or(r).map(|e| anyhow::anyhow!("{e}")),
     }
 }
 

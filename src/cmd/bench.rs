@@ -1,9 +1,9 @@
 //! `emray bench`: the benchmark suite, each run in a child process of its own (the
 //! hidden `--child` option is that child's side).
 
-use super::Error;
 use super::args::{BackendArg, QualityArg, packet_width, parse_res};
 use super::error::print;
+use super::{Error, outputs};
 use emray::accel::Backend;
 use emray::bench::{self, RunSpec};
 use emray::spd::Database;
@@ -74,6 +74,7 @@ pub fn run(b: Args) -> Result<(), Error> {
     for s in &cfg.scenes {
         Database::parse_spec(s).map_err(Error::usage)?;
     }
+    outputs::prepare(b.csv.iter().chain(&b.json).map(PathBuf::as_path))?;
     let outs = bench::Outputs {
         csv: b.csv.clone(),
         json: b.json.clone(),

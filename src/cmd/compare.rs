@@ -63,6 +63,9 @@ pub fn run(a: Args) -> Result<(), Error> {
             return Err(Error::usage(format!("{name} must be a number ≥ 0")));
         }
     }
+    if let Some(out) = &a.diff {
+        emray::output::prepare(out).map_err(|e| Error::Usage(e.into()))?;
+    }
     let usage = |e: metrics::MetricsError| Error::Usage(e.into());
     let enc: Encoding = a.encoding.into();
     let test = metrics::read_image(&a.test, enc).map_err(usage)?;

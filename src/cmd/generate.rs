@@ -33,6 +33,7 @@ pub fn run(g: Args) -> Result<(), Error> {
     };
     let size = g.size.unwrap_or_else(|| db.default_size());
     db.check_size(size).map_err(Error::usage)?;
+    super::outputs::prepare(g.output.as_deref())?;
     let text = db.generate(size);
     match &g.output {
         None => print(format_args!("{text}"))

@@ -4,8 +4,8 @@
 
 use super::progress::TileBar;
 use anyhow::{Result, bail};
+use emray::output::Format;
 use emray::output::heatmap::{Quantity, write_heatmap};
-use emray::output::{self, Format};
 use emray::render::aov::{AovFilm, AovSet};
 use std::path::{Path, PathBuf};
 
@@ -112,14 +112,6 @@ pub fn write_heatmaps(aov: &AovFilm, files: &[(Quantity, PathBuf)], bar: &TileBa
         };
         write_heatmap(path, values, aov.width, aov.height, *q)?;
         log::info!("wrote {}", path.display());
-    }
-    Ok(())
-}
-
-/// Make sure the heat maps can be written before any render (as the images are).
-pub fn prepare_heatmaps(files: &[(Quantity, PathBuf)]) -> Result<()> {
-    for (_, path) in files {
-        output::prepare(path)?;
     }
     Ok(())
 }

@@ -16,6 +16,7 @@ mod generate;
 mod insight;
 mod interrupt;
 mod merge;
+mod outputs;
 mod progress;
 mod radiosity;
 mod render;

@@ -82,6 +82,8 @@ pub struct BatchDisplay {
     bars: Option<(MultiProgress, ProgressBar)>,
     job_bars: HashMap<usize, ProgressBar>,
     quiet: bool,
+    /// Why the report could not be written, the first time it could not.
+    report_error: Option<String>,
 }
 
 impl BatchDisplay {
@@ -99,7 +101,14 @@ impl BatchDisplay {
             bars,
             job_bars: HashMap::new(),
             quiet,
+            report_error: None,
         }
+    }
+
+    /// Why the report could not be written, if it could not (the command fails with
+    /// it once the batch is done, rather than after each job).
+    pub fn report_error(&self) -> Option<&str> {
+        self.report_error.as_deref()
     }
 
     /// The line of a finished job, or none (a job that went well, when quiet).
@@ -169,6 +178,6 @@ impl Observer for BatchDisplay {
     }
 
     fn report_not_written(&mut self, error: &OutputError) {
-        eprintln!("{}", error_line(error));
+        self.report_error.get_or_insert_with(|| error.to_string());
     }
 }

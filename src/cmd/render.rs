@@ -7,7 +7,7 @@ use super::args::{
 use super::error::{error_line, is_closed_pipe, print};
 use super::insight::{self, HeatmapArg};
 use super::progress::TileBar;
-use super::{Error, append_json_line, init_log, thread_pool};
+use super::{Error, append_json_line, init_log, outputs, thread_pool};
 use anyhow::{Result, anyhow, bail};
 use clap::ValueEnum;
 use emray::Scene;
@@ -210,13 +210,16 @@ type Job = (Option<PathBuf>, PathBuf);
 pub fn run(args: Args) -> Result<(), Error> {
     init_log(args.quiet, args.verbose);
     let jobs = plan(&args).map_err(Error::Usage)?;
-    // An output that cannot be written is found before any render (a missing folder
-    // is created, as `batch` does).
+    // An output that cannot be written is found before any scene is read (a missing
+    // folder is created).
     for (scene, out) in &jobs {
-        emray::output::prepare(out).map_err(Error::failed)?;
-        insight::prepare_heatmaps(&heatmap_files(&args, scene.as_deref()))
-            .map_err(Error::Failed)?;
+        outputs::prepare(
+            written(&args, scene.as_deref(), out)
+                .iter()
+                .map(PathBuf::as_path),
+        )?;
     }
+    outputs::prepare_log(args.stats_json.as_deref())?;
     let pool = thread_pool(args.threads).map_err(Error::Failed)?;
     let mut failed = 0usize;
     for (scene, out) in &jobs {
@@ -235,6 +238,17 @@ pub fn run(args: Args) -> Result<(), Error> {
         )));
     }
     Ok(())
+}
+
+/// Every file the render of `scene` to `out` writes: the image, its ids file, the
+/// heat maps.
+fn written(args: &Args, scene: Option<&Path>, out: &Path) -> Vec<PathBuf> {
+    let mut files = vec![out.to_path_buf()];
+    if args.aov.is_some_and(|s| s.id) {
+        files.push(emray::output::aov::ids_path(out));
+    }
+    files.extend(heatmap_files(args, scene).into_iter().map(|(_, f)| f));
+    files
 }
 
 /// Where scene `scene` goes.

@@ -28,6 +28,8 @@ pub struct Args {
 #[cfg(feature = "quality")]
 pub fn run(a: Args) -> Result<(), Error> {
     use emray::run::{SceneError, load_scene};
+    let files = emray::quality::study::FILES.map(|f| a.out.join(f));
+    super::outputs::prepare(files.iter().map(PathBuf::as_path))?;
     let name = a.scene.display().to_string();
     let scene = match load_scene(&a.scene) {
         Err(SceneError::Spec(e)) => return Err(Error::usage(e)),

@@ -61,10 +61,23 @@ fn new_file_permissions() -> Option<fs::Permissions> {
 /// Create the folder `path` goes in, and the folders above it, if missing: the one
 /// way every command makes its outputs' folders.
 pub fn create_folder(path: &Path) -> Result<(), OutputError> {
-    fs::create_dir_all(folder_of(path)).map_err(|e| OutputError::Write {
+    let folder = folder_of(path);
+    fs::create_dir_all(folder).map_err(|e| OutputError::Write {
         path: path.to_path_buf(),
-        message: e.to_string(),
+        message: match not_a_folder(folder) {
+            Some(f) => format!("{} is not a folder", f.display()),
+            None => e.to_string(),
+        },
     })
+}
+
+/// The nearest of `folder` and the folders above it that exists, if it is not a folder
+/// (a file where a folder should be, which the system reports as "File exists").
+fn not_a_folder(folder: &Path) -> Option<&Path> {
+    folder
+        .ancestors()
+        .find(|a| a.exists())
+        .filter(|a| !a.is_dir())
 }
 
 /// Make sure `path` can be written before any work goes into it: create its folder if
@@ -79,6 +92,23 @@ pub fn prepare(path: &Path) -> Result<(), OutputError> {
         return Err(err("it is a folder".into()));
     }
     temp_beside(path).map_err(|e| err(os_message(&e)))?;
+    Ok(())
+}
+
+/// Make sure `path`, a file that records are appended to (`--stats-json`), can be
+/// written before any work goes into it: as [`prepare`], and if it exists, open it for
+/// appending.
+pub fn prepare_append(path: &Path) -> Result<(), OutputError> {
+    prepare(path)?;
+    if path.exists() {
+        fs::OpenOptions::new()
+            .append(true)
+            .open(path)
+            .map_err(|e| OutputError::Write {
+                path: path.to_path_buf(),
+                message: e.to_string(),
+            })?;
+    }
     Ok(())
 }
 

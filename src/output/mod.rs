@@ -16,7 +16,7 @@ pub mod part;
 mod pending;
 
 pub(crate) use atomic::write_atomic;
-pub use atomic::{create_folder, prepare, remove_stale_temps};
+pub use atomic::{create_folder, prepare, prepare_append, remove_stale_temps};
 pub use pending::abandon_writes;
 
 // The PNG writer's encodings, defined with the colour curves in `render`.

@@ -281,8 +281,11 @@ pub fn raster(rows: &[Row], title: &str) -> Result<image::RgbImage, StudyError> 
     image::RgbImage::from_raw(w, h, buf).ok_or_else(|| StudyError::Plot("bad buffer size".into()))
 }
 
-/// Run the study and write `study.csv`, `study.svg` and `study.png` into `dir`
-/// (created).
+/// The files the study writes into its folder.
+pub const FILES: [&str; 3] = ["study.csv", "study.svg", "study.png"];
+
+/// Run the study and write `study.csv`, `study.svg` and `study.png` ([`FILES`]) into
+/// `dir` (created).
 pub fn write(
     scene: &Scene,
     name: &str,
@@ -294,10 +297,11 @@ pub fn write(
 ) -> Result<Vec<Row>, StudyError> {
     let rows = run(scene, w, h, strata, backends)?;
     let title = format!("{name}, {w}x{h}: error vs time");
-    crate::output::write_text(&dir.join("study.csv"), &csv(&rows))?;
-    crate::output::write_text(&dir.join("study.svg"), &svg(&rows, &title)?)?;
+    let [csv_file, svg_file, png_file] = FILES.map(|f| dir.join(f));
+    crate::output::write_text(&csv_file, &csv(&rows))?;
+    crate::output::write_text(&svg_file, &svg(&rows, &title)?)?;
     let png = raster(&rows, &title)?;
-    crate::output::write_atomic(&dir.join("study.png"), |f| {
+    crate::output::write_atomic(&png_file, |f| {
         let mut f = std::io::BufWriter::new(f);
         png.write_to(&mut f, image::ImageFormat::Png)
             .map_err(|e| e.to_string())?;
