@@ -379,3 +379,106 @@ fn an_unwritable_output_is_refused_before_any_work() {
         }
     }
 }
+
+/// The files in `dir`, sorted.
+fn files(dir: &Path) -> Vec<String> {
+    let mut v: Vec<String> = std::fs::read_dir(dir)
+        .unwrap()
+        .map(|e| e.unwrap().file_name().to_string_lossy().into_owned())
+        .collect();
+    v.sort();
+    v
+}
+
+#[test]
+fn render_and_batch_name_outputs_with_the_same_templates() {
+    let dir = tempfile::tempdir().unwrap();
+    let d = dir.path();
+    std::fs::write(d.join("a.nff"), SCENE).unwrap();
+    std::fs::write(d.join("b.nff"), SCENE).unwrap();
+    let template = "{stem}-{backend}-{spp}-{index}";
+    let o = emray(
+        d,
+        &[
+            "render",
+            "a.nff",
+            "b.nff",
+            "--backend",
+            "bvh",
+            "--spp",
+            "2",
+            "-o",
+            &format!("render/{template}.png"),
+            "--heatmap",
+            "rays",
+            &format!("render/{template}-rays.png"),
+            "-q",
+        ],
+    );
+    assert!(o.status.success(), "{}", stderr(&o));
+    let o = emray(
+        d,
+        &[
+            "batch",
+            "a.nff",
+            "b.nff",
+            "--backend",
+            "bvh",
+            "--spp",
+            "2",
+            "-o",
+            &format!("batch/{template}.png"),
+            "-q",
+        ],
+    );
+    assert!(o.status.success(), "{}", stderr(&o));
+    assert_eq!(
+        files(&d.join("render")),
+        [
+            "a-bvh-2-0-rays.png",
+            "a-bvh-2-0.png",
+            "b-bvh-2-1-rays.png",
+            "b-bvh-2-1.png"
+        ]
+    );
+    assert_eq!(files(&d.join("batch")), ["a-bvh-2-0.png", "b-bvh-2-1.png"]);
+}
+
+#[test]
+fn unknown_placeholders_are_refused_listing_the_known_ones() {
+    let dir = tempfile::tempdir().unwrap();
+    let d = dir.path();
+    std::fs::write(d.join("a.nff"), SCENE).unwrap();
+    let known = "(one of {stem}, {backend}, {index}, {spp})";
+    for (args, wanted) in [
+        (
+            vec!["render", "a.nff", "-o", "{foo}.png"],
+            format!("output template '{{foo}}.png': unknown placeholder '{{foo}}' {known}"),
+        ),
+        (
+            vec!["render", "a.nff", "-o", "{stem.png"],
+            "output template '{stem.png': '{' without '}'".to_string(),
+        ),
+        (
+            vec!["render", "a.nff", "--heatmap", "rays", "{stem}-{what}.png"],
+            format!(
+                "output template '{{stem}}-{{what}}.png': unknown placeholder '{{what}}' {known}"
+            ),
+        ),
+        (
+            vec!["batch", "a.nff", "-o", "{foo}.png"],
+            format!("output template '{{foo}}.png': unknown placeholder '{{foo}}' {known}"),
+        ),
+        (
+            vec!["batch", "a.nff", "--report", "r-{index}.json"],
+            "report name 'r-{index}.json': unknown placeholder '{index}' (one of {shard})"
+                .to_string(),
+        ),
+    ] {
+        let o = emray(d, &args);
+        let e = stderr(&o);
+        assert_eq!(o.status.code(), Some(2), "{args:?}: {e}");
+        assert_eq!(e.trim_end(), format!("emray: error: {wanted}"), "{args:?}");
+    }
+    assert_eq!(files(d), ["a.nff"], "nothing is written");
+}

@@ -11,6 +11,7 @@ use emray::accel::Backend;
 use emray::batch::{self, BatchOptions, BatchReport, Job, JobSettings};
 use emray::output::Encoding;
 use emray::run::RenderRequest;
+use emray::run::template;
 use std::path::PathBuf;
 
 /// `emray batch`.
@@ -22,8 +23,8 @@ pub struct Args {
     /// A TOML manifest of jobs (README "Batch rendering"), instead of scene arguments.
     #[arg(short, long, value_name = "FILE.toml", conflicts_with = "scenes")]
     pub manifest: Option<PathBuf>,
-    /// Output template: `{stem}`, `{backend}`, `{index}`, `{spp}` [default: `{stem}.png`,
-    /// or the manifest's].
+    /// Output template, as `render -o`: `{stem}`, `{backend}`, `{index}`, `{spp}`
+    /// [default: `{stem}.png`, or the manifest's].
     #[arg(short, long, value_name = "TEMPLATE")]
     pub output: Option<String>,
     /// Ray-query backend (overrides the manifest).
@@ -92,6 +93,7 @@ pub fn run(b: Args) -> Result<(), Error> {
     init_log(b.quiet, 0);
     let jobs = jobs(&b)?;
     batch::check_jobs(&jobs).map_err(|e| Error::Usage(e.into()))?;
+    let report = report_path(&b)?;
     let jobs: Vec<Job> = match b.shard {
         Some((i, n)) => jobs
             .into_iter()
@@ -110,15 +112,11 @@ pub fn run(b: Args) -> Result<(), Error> {
         }
         return Ok(());
     }
-    let shard_index = b.shard.map_or(0, |(i, _)| i);
     let opts = BatchOptions {
         threads: b.threads.map(|t| t as usize),
         jobs: b.jobs as usize,
         skip_existing: b.skip_existing,
-        report: b
-            .report
-            .as_ref()
-            .map(|r| PathBuf::from(r.replace("{shard}", &shard_index.to_string()))),
+        report,
         max_memory: b
             .max_memory
             .unwrap_or_else(emray::run::limits::default_max_memory),
@@ -142,6 +140,18 @@ pub fn run(b: Args) -> Result<(), Error> {
         (false, Some(failed)) => Err(Error::Failed(failed)),
         (false, None) => Ok(()),
     }
+}
+
+/// The `--report` file, its `{shard}` the shard's index (0 without `--shard`); another
+/// placeholder is a usage error.
+fn report_path(b: &Args) -> Result<Option<PathBuf>, Error> {
+    let shard = b.shard.map_or(0, |(i, _)| i).to_string();
+    b.report
+        .as_deref()
+        .map(|r| template::expand("report name", r, &["shard"], |_| shard.clone()))
+        .transpose()
+        .map(|r| r.map(PathBuf::from))
+        .map_err(|e| Error::Usage(e.into()))
 }
 
 /// What went wrong in a batch that ran: failed jobs, a report that could not be

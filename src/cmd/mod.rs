@@ -15,6 +15,7 @@ mod explain;
 mod generate;
 mod insight;
 mod interrupt;
+mod jobs;
 mod merge;
 mod outputs;
 mod progress;
