@@ -2,11 +2,11 @@
 //! resumable jobs, optionally one shard of them; Ctrl-C or SIGTERM stops it after
 //! writing the report of what finished (a second one at once).
 
-use super::args::{BackendArg, EncodingArg, parse_res};
+use super::args::{BackendArg, EncodingArg, LogArgs, parse_res};
 use super::error::print;
 use super::interrupt::stop_flag;
 use super::progress::BatchDisplay;
-use super::{Error, init_log, outputs};
+use super::{Error, outputs};
 use emray::accel::Backend;
 use emray::batch::{self, BatchOptions, BatchReport, Job, JobSettings};
 use emray::output::Encoding;
@@ -68,9 +68,9 @@ pub struct Args {
     /// Refuse jobs estimated to need more memory (e.g. 8G) [default: 3/4 of RAM].
     #[arg(long, value_name = "SIZE", value_parser = emray::run::limits::parse_size)]
     pub max_memory: Option<u64>,
-    /// No progress, only errors.
-    #[arg(short, long)]
-    pub quiet: bool,
+    /// `-q` and `-v`.
+    #[command(flatten)]
+    pub log: LogArgs,
 }
 
 impl Args {
@@ -90,7 +90,6 @@ impl Args {
 
 /// Plan the jobs, keep this shard's, and list or run them.
 pub fn run(b: Args) -> Result<(), Error> {
-    init_log(b.quiet, 0);
     let jobs = jobs(&b)?;
     batch::check_jobs(&jobs).map_err(|e| Error::Usage(e.into()))?;
     let report = report_path(&b)?;
@@ -125,9 +124,9 @@ pub fn run(b: Args) -> Result<(), Error> {
     let images = jobs.iter().map(|j| j.output.as_path());
     outputs::prepare(opts.report.as_deref().into_iter().chain(images))?;
     let cancel = stop_flag();
-    let mut display = BatchDisplay::new(jobs.len(), b.quiet);
+    let mut display = BatchDisplay::new(jobs.len(), b.log.quiet);
     let report = batch::run(jobs, &opts, &cancel, &mut display);
-    if report.interrupted && !b.quiet {
+    if report.interrupted && !b.log.quiet {
         eprintln!(
             "emray: interrupted: {} of {} jobs finished",
             report.ok + report.failed + report.skipped,

@@ -1,7 +1,7 @@
 //! `emray bench`: the benchmark suite, each run in a child process of its own (the
 //! hidden `--child` option is that child's side).
 
-use super::args::{BackendArg, QualityArg, packet_width, parse_res};
+use super::args::{BackendArg, LogArgs, QualityArg, packet_width, parse_res};
 use super::error::print;
 use super::{Error, outputs};
 use emray::accel::Backend;
@@ -63,6 +63,9 @@ pub struct Args {
     /// Run one measurement in this process (used by the suite itself).
     #[arg(long, hide = true, value_name = "JSON")]
     pub child: Option<String>,
+    /// `-q` and `-v`.
+    #[command(flatten)]
+    pub log: LogArgs,
 }
 
 /// Run the suite and print its markdown report (or, as a child, one run's JSON).
@@ -82,7 +85,12 @@ pub fn run(b: Args) -> Result<(), Error> {
     };
     let exe = std::env::current_exe()
         .map_err(|e| Error::failed(format!("cannot find the emray executable: {e}")))?;
-    let mut log = |line: &str| eprintln!("{line}");
+    let quiet = b.log.quiet;
+    let mut log = |line: &str| {
+        if !quiet {
+            eprintln!("{line}");
+        }
+    };
     let md = bench::bench(&cfg, &outs, &exe, &mut log)?;
     print(format_args!("{md}"))?;
     Ok(())

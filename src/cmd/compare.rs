@@ -3,7 +3,7 @@
 //! `quality` feature (FLIP).
 
 use super::Error;
-use super::args::EncodingArg;
+use super::args::{EncodingArg, LogArgs};
 use super::error::print;
 use std::path::PathBuf;
 
@@ -31,6 +31,9 @@ pub struct Args {
     /// Print one JSON object instead of the table.
     #[arg(long)]
     pub json: bool,
+    /// `-q` and `-v`.
+    #[command(flatten)]
+    pub log: LogArgs,
 }
 
 /// The table `emray compare` prints.

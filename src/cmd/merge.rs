@@ -1,7 +1,7 @@
 //! `emray merge`: stitch the parts rendered with `render --tile` or `--crop` into the
 //! whole image, with the output variables they were rendered with (`--aov`).
 
-use super::args::EncodingArg;
+use super::args::{EncodingArg, LogArgs};
 use super::{Error, outputs};
 use emray::output::aov::{ids_path, write_ids};
 use emray::output::channels::write_exr_channels;
@@ -20,12 +20,14 @@ pub struct Args {
     /// PNG value encoding.
     #[arg(long, value_enum, default_value_t = EncodingArg::Srgb)]
     pub encoding: EncodingArg,
+    /// `-q` and `-v`.
+    #[command(flatten)]
+    pub log: LogArgs,
 }
 
 /// Check that the parts make one image, and write it: every channel of the parts to
 /// an EXR (with the `.ids.json` of an `id` channel), the colour alone to a PNG.
 pub fn run(m: Args) -> Result<(), Error> {
-    super::init_log(false, 0);
     let format = Format::from_path(&m.output)?;
     // The ids file of parts with an `id` channel goes beside an EXR.
     let ids = (format == Format::Exr).then(|| ids_path(&m.output));

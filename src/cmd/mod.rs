@@ -26,6 +26,8 @@ mod study;
 
 pub use error::Error;
 
+use args::LogArgs;
+
 use anyhow::Context;
 use clap::{Parser, Subcommand};
 use std::io::Write;
@@ -74,6 +76,11 @@ pub enum Command {
 /// Run the command line's command (a bare `emray` renders the default scene), Ctrl-C
 /// and SIGTERM caught for it ([`interrupt`]).
 pub fn run(cli: Cli) -> Result<(), Error> {
+    init_log(
+        cli.command
+            .as_ref()
+            .map_or_else(LogArgs::default, Command::log),
+    );
     interrupt::install();
     match cli.command {
         None => render::run(render::Args::default_scene()),
@@ -90,10 +97,28 @@ pub fn run(cli: Cli) -> Result<(), Error> {
     }
 }
 
-/// Log to standard error: errors only when `quiet`, else warnings and more with each
+impl Command {
+    /// The command's `-q` and `-v`.
+    fn log(&self) -> LogArgs {
+        match self {
+            Command::Render(a) => a.log,
+            Command::Gen(a) => a.log,
+            Command::Batch(a) => a.log,
+            Command::Merge(a) => a.log,
+            Command::Bench(a) => a.log,
+            Command::Compare(a) => a.log,
+            Command::Stress(a) => a.log,
+            Command::Study(a) => a.log,
+            Command::Radiosity(a) => a.log,
+            Command::Explain(a) => a.log,
+        }
+    }
+}
+
+/// Log to standard error: errors only with `-q`, else warnings and more with each
 /// `-v` (`RUST_LOG` wins).
-fn init_log(quiet: bool, verbose: u8) {
-    let level = match (quiet, verbose) {
+fn init_log(log: LogArgs) {
+    let level = match (log.quiet, log.verbose) {
         (true, _) => "error",
         (false, 0) => "warn",
         (false, 1) => "info",

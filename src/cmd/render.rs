@@ -2,13 +2,13 @@
 //! PNG or EXR, whole or one part of an image for `emray merge`.
 
 use super::args::{
-    BackendArg, EncodingArg, QualityArg, RadiositySolveArgs, packet_width, parse_res,
+    BackendArg, EncodingArg, LogArgs, QualityArg, RadiositySolveArgs, packet_width, parse_res,
 };
 use super::error::{error_line, is_closed_pipe, print};
 use super::insight;
 use super::jobs::{self, Job};
 use super::progress::TileBar;
-use super::{Error, append_json_line, init_log, outputs, thread_pool};
+use super::{Error, append_json_line, outputs, thread_pool};
 use anyhow::{Result, anyhow, bail};
 use clap::ValueEnum;
 use emray::Scene;
@@ -131,12 +131,9 @@ pub struct Args {
     /// replacing the scene's own.
     #[arg(long, value_name = "FILE|DIR")]
     pub envmap: Option<PathBuf>,
-    /// No progress bar and no messages but errors.
-    #[arg(short, long)]
-    pub quiet: bool,
-    /// More log output (repeat for more).
-    #[arg(short, long, action = clap::ArgAction::Count)]
-    pub verbose: u8,
+    /// `-q` and `-v`.
+    #[command(flatten)]
+    pub log: LogArgs,
     /// Global illumination: `radiosity` solves the diffuse interreflection first and
     /// takes the diffuse term of polygons and meshes from it (two-pass).
     #[arg(long, value_enum)]
@@ -194,8 +191,7 @@ impl Args {
             crop: None,
             max_memory: None,
             envmap: None,
-            quiet: false,
-            verbose: 0,
+            log: LogArgs::default(),
             gi: None,
             radiosity: RadiositySolveArgs::default(),
             area_samples: 16,
@@ -207,7 +203,6 @@ impl Args {
 
 /// Render every scene; with several, a failing one is reported and the others go on.
 pub fn run(args: Args) -> Result<(), Error> {
-    init_log(args.quiet, args.verbose);
     let jobs = plan(&args).map_err(Error::Usage)?;
     // An output that cannot be written is found before any scene is read (a missing
     // folder is created).
@@ -370,7 +365,7 @@ fn render_one(args: &Args, job: &Job) -> Result<()> {
     };
     limits::check_with(Path::new(&name), &scene, &settings, extra, max_memory)?;
     let options = backend_options(args);
-    let bar = TileBar::new(&name, args.quiet);
+    let bar = TileBar::new(&name, args.log.quiet);
     let (film, aov, report) = trace(args, &name, &scene, &settings, options, load_ms, &bar)?;
     bar.writing(out);
     let part = settings.region.map(|region| part::PartInfo {
@@ -399,7 +394,7 @@ fn render_one(args: &Args, job: &Job) -> Result<()> {
             report.summary(),
             out.display()
         ))?;
-    } else if !args.quiet {
+    } else if !args.log.quiet {
         log::info!("wrote {}", out.display());
     }
     if let Some(path) = &args.stats_json {

@@ -2,7 +2,7 @@
 //! reference, to CSV, SVG and PNG. Needs the `quality` feature (FLIP, plots).
 
 use super::Error;
-use super::args::parse_res;
+use super::args::{LogArgs, parse_res};
 use super::error::print;
 use std::path::PathBuf;
 
@@ -22,6 +22,9 @@ pub struct Args {
     /// Reference samples per pixel side (N×N).
     #[arg(long, default_value_t = 16, value_parser = clap::value_parser!(u32).range(1..=64))]
     pub reference_strata: u32,
+    /// `-q` and `-v`.
+    #[command(flatten)]
+    pub log: LogArgs,
 }
 
 /// Run the study and print its CSV; a bad `spd:` spec is a usage error.
