@@ -11,6 +11,7 @@ mod compare;
 #[cfg(test)]
 mod docs_commands;
 mod error;
+mod eta;
 mod explain;
 mod generate;
 mod insight;
