@@ -96,6 +96,14 @@ impl Tiles {
     }
 }
 
+/// A bar is cleared when dropped, so that a failure's message is not printed beside
+/// it.
+impl Drop for Tiles {
+    fn drop(&mut self) {
+        self.bar.finish_and_clear();
+    }
+}
+
 /// The tiles of one render, and the files it writes after them (writing a large EXR
 /// takes seconds).
 pub struct TileBar(Option<Tiles>);

@@ -333,26 +333,31 @@ fn backend_options(args: &Args) -> BackendOptions {
     }
 }
 
-/// The scene's name and the scene, with `--envmap` in place of its own.
-fn load_scene(args: &Args, path: Option<&Path>) -> Result<(String, Scene)> {
-    let (name, mut scene) = match path {
-        Some(p) => (p.display().to_string(), run::load_scene(p)?),
-        None => (
-            "default".into(),
-            load::nff::parse_str(DEFAULT_SCENE, Path::new("<default scene>"))?,
-        ),
+/// The scene's name: its path, or `default`.
+fn scene_name(path: Option<&Path>) -> String {
+    path.map_or_else(|| "default".into(), |p| p.display().to_string())
+}
+
+/// The scene, with `--envmap` in place of its own.
+fn load_scene(args: &Args, path: Option<&Path>) -> Result<Scene> {
+    let mut scene = match path {
+        Some(p) => run::load_scene(p)?,
+        None => load::nff::parse_str(DEFAULT_SCENE, Path::new("<default scene>"))?,
     };
     if let Some(env) = &args.envmap {
         scene.environment = Some(Environment::load(env).map_err(anyhow::Error::msg)?);
     }
-    Ok((name, scene))
+    Ok(scene)
 }
 
 /// Load, render and write one scene.
 fn render_one(args: &Args, job: &Job) -> Result<()> {
     let out = job.out.as_path();
+    let name = scene_name(job.scene.as_deref());
+    // Cleared when dropped, on an error too.
+    let bar = TileBar::new(&name, args.log.quiet);
     let t0 = Instant::now();
-    let (name, scene) = load_scene(args, job.scene.as_deref())?;
+    let scene = load_scene(args, job.scene.as_deref())?;
     let load_ms = t0.elapsed().as_secs_f64() * 1e3;
     let settings = request(args)
         .settings(&scene)
@@ -365,7 +370,6 @@ fn render_one(args: &Args, job: &Job) -> Result<()> {
     };
     limits::check_with(Path::new(&name), &scene, &settings, extra, max_memory)?;
     let options = backend_options(args);
-    let bar = TileBar::new(&name, args.log.quiet);
     let (film, aov, report) = trace(args, &name, &scene, &settings, options, load_ms, &bar)?;
     bar.writing(out);
     let part = settings.region.map(|region| part::PartInfo {
