@@ -1,6 +1,9 @@
-//! The files every command writes, through the binary: the permissions they get.
+//! The files every command writes, through the binary: the permissions they get, the
+//! folders made for them, the check made before any work that each can be written, no
+//! temporary file left by a signal, and their names from the shared templates.
 
 use std::path::Path;
+#[cfg(unix)]
 use std::process::{Command, Output};
 
 mod common;
@@ -211,6 +214,7 @@ fn every_command_creates_a_missing_output_folder() {
 }
 
 /// The temporary files in `dir` (`.NAME.XXXXXXXX.tmp`), with their sizes.
+#[cfg(unix)]
 fn temporary_files(dir: &Path) -> Vec<(String, u64)> {
     std::fs::read_dir(dir)
         .unwrap()
