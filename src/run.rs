@@ -1,12 +1,14 @@
 //! One render from start to end, with the phases timed separately (the SPD rule:
 //! preprocessing apart from ray tracing): load ([`load_scene`]), resolve the settings
 //! ([`RenderRequest::settings`]), check the memory it needs ([`limits`]), build the
-//! backend and render ([`render_scene`], [`render_two_pass`], [`render_reference`]).
+//! backend and render ([`render_scene`], [`render_two_pass`], [`render_reference`]);
+//! the output file names of every render, from templates ([`template`]).
 
 mod aov;
 mod explain;
 pub mod limits;
 mod request;
+pub mod template;
 
 pub use aov::{AovRunError, render_aov};
 pub use explain::{ExplainRunError, explain_pixel};

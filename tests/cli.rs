@@ -226,8 +226,8 @@ fn input_errors_exit_1_with_one_line_and_write_nothing() {
             "emray: error: nope.toml: cannot read",
         ),
         (
-            vec!["gen", "tetra", "-o", "nodir/t.nff"],
-            "emray: error: nodir/t.nff: cannot write",
+            vec!["gen", "tetra", "-o", "a.nff/t.nff"],
+            "emray: error: a.nff/t.nff: cannot write",
         ),
     ] {
         let o = emray(dir.path(), &args);
@@ -387,4 +387,87 @@ fn a_closed_standard_output_ends_quietly() {
     let o = child.wait_with_output().unwrap();
     assert_eq!(o.status.code(), Some(0), "{}", stderr(&o));
     assert_eq!(stderr(&o), "", "nothing printed on a closed pipe");
+}
+
+/// The options `--help` lists under the heading `heading` (up to the next heading).
+fn options_under(help: &str, heading: &str) -> Vec<String> {
+    let mut out = Vec::new();
+    let mut inside = false;
+    for line in help.lines() {
+        if !line.starts_with(' ') && line.ends_with(':') {
+            inside = line == format!("{heading}:");
+            continue;
+        }
+        let item = line.trim_start();
+        if inside && item.starts_with('-') {
+            let long = item.split([' ', ',', '=']).find(|w| w.starts_with("--"));
+            out.extend(long.map(String::from));
+        }
+    }
+    out
+}
+
+#[test]
+fn help_lists_the_radiosity_options_alone_under_radiosity() {
+    let dir = tempfile::tempdir().unwrap();
+    let radiosity = [
+        "--patch-size",
+        "--ff-samples",
+        "--vis-samples",
+        "--solver",
+        "--form-factors",
+        "--hemicube-res",
+        "--subdiv-threshold",
+        "--min-patch-size",
+        "--subdiv-passes",
+        "--epsilon",
+        "--max-iterations",
+    ];
+    for command in ["render", "explain", "radiosity"] {
+        let o = emray(dir.path(), &[command, "--help"]);
+        let help = String::from_utf8(o.stdout).unwrap();
+        assert_eq!(
+            options_under(&help, "Radiosity"),
+            radiosity,
+            "emray {command} --help:\n{help}"
+        );
+        let options = options_under(&help, "Options");
+        for other in ["--aov", "--heatmap", "--area-samples", "--embree-quality"] {
+            if help.contains(&format!("{other} ")) {
+                assert!(options.iter().any(|o| o == other), "{command}: {other}");
+            }
+        }
+    }
+}
+
+#[test]
+fn every_command_takes_quiet_and_verbose() {
+    let dir = tempfile::tempdir().unwrap();
+    let commands = [
+        "render",
+        "gen",
+        "batch",
+        "merge",
+        "bench",
+        "compare",
+        "stress",
+        "study",
+        "radiosity",
+        "explain",
+    ];
+    for command in commands {
+        let o = emray(dir.path(), &[command, "--help"]);
+        let help = String::from_utf8(o.stdout).unwrap();
+        for option in ["-q, --quiet", "-v, --verbose"] {
+            assert!(help.contains(option), "emray {command} --help: {option}");
+        }
+    }
+    // Taken, not refused as a usage error: the scene is what is missing.
+    let o = emray(dir.path(), &["radiosity", "-q", "-vv", "nope.toml"]);
+    assert_eq!(o.status.code(), Some(1), "{}", stderr(&o));
+    assert!(
+        stderr(&o).contains("nope.toml: cannot read"),
+        "{}",
+        stderr(&o)
+    );
 }

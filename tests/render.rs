@@ -255,3 +255,32 @@ fn area_light_noise_is_the_same_on_every_backend() {
         }
     }
 }
+
+/// A progress bar starts at 0 of the render's tile count: the callback is told the
+/// count before any tile is done, then once per tile, for uniform and adaptive
+/// sampling.
+#[test]
+fn progress_hears_the_tile_count_before_the_first_tile() {
+    use emray::render::Aa;
+    use std::sync::Mutex;
+    let s = scene(&format!("{VIEW}b 0 0 0\nf 1 1 1 1 0 0 0 1\ns 0 0 0 2\n"));
+    let uniform = RenderSettings::for_scene(&s);
+    let adaptive = RenderSettings {
+        aa: Aa::Adaptive {
+            threshold: 0.1,
+            depth: 1,
+        },
+        ..uniform.clone()
+    };
+    for settings in [uniform, adaptive] {
+        let calls = Mutex::new(Vec::new());
+        let progress = |done: usize, total: usize| calls.lock().unwrap().push((done, total));
+        render_scene("test", &s, Backend::Bvh, &settings, 0.0, Some(&progress)).unwrap();
+        let calls = calls.into_inner().unwrap();
+        let total = calls[0].1;
+        assert!(total > 1, "{calls:?}");
+        assert_eq!(calls[0], (0, total), "{:?}", settings.aa);
+        assert_eq!(calls.len(), total + 1);
+        assert!(calls.iter().all(|&(d, t)| t == total && d <= total));
+    }
+}

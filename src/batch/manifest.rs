@@ -21,7 +21,7 @@
 //! (`srgb`/`linear`). A job's own key wins over the default; settings given on the
 //! command line win over both.
 
-use super::{Job, JobSettings, expand_template};
+use super::{Job, JobSettings, job_output};
 use crate::accel::Backend;
 use crate::load::LoadError;
 use crate::output::Encoding;
@@ -195,7 +195,7 @@ pub fn load(path: &Path, cli: &Overrides) -> Result<Vec<Job>, LoadError> {
             .or_else(|| k.output.clone())
             .or_else(|| d.output.clone())
             .unwrap_or_else(|| "{stem}.png".into());
-        let out = expand_template(&template, &scene, &settings, i)
+        let out = job_output(&template, &scene, &settings, i)
             .map_err(|e| whole(format!("job {i}: {e}")))?;
         let output = if cli.output.is_some() {
             PathBuf::from(&out)

@@ -16,6 +16,7 @@ pub use runner::{BatchOptions, BatchReport, Cancel, JobRecord, JobStatus, Observ
 
 use crate::accel::Backend;
 use crate::output::{Encoding, OutputError};
+use crate::run::template::{OutputName, TemplateError};
 use crate::run::{IndexOfError, RenderRequest, parse_index_of};
 use crate::spd::Database;
 use std::path::{Path, PathBuf};
@@ -54,23 +55,9 @@ pub struct Job {
 /// Why a batch cannot be put together: found before any job runs.
 #[derive(Debug, thiserror::Error)]
 pub enum BatchError {
-    /// An output template with a `{` and no `}` after it.
-    #[error("output template '{template}': '{{' without '}}'")]
-    UnclosedPlaceholder {
-        /// The template.
-        template: String,
-    },
-    /// An output template with a `{key}` not in [`TEMPLATE_KEYS`].
-    #[error(
-        "output template '{template}': unknown placeholder '{{{key}}}' (one of {})",
-        placeholder_list()
-    )]
-    UnknownPlaceholder {
-        /// The template.
-        template: String,
-        /// The unknown key.
-        key: String,
-    },
+    /// An output template that cannot be expanded.
+    #[error(transparent)]
+    Template(#[from] TemplateError),
     /// A scene argument that is not a valid glob.
     #[error("bad glob '{pattern}': {message}")]
     BadGlob {
@@ -114,64 +101,21 @@ pub enum BatchError {
     },
 }
 
-/// `{stem}, {backend}, {index}, {spp}`: the placeholders, for messages.
-fn placeholder_list() -> String {
-    TEMPLATE_KEYS
-        .iter()
-        .map(|k| format!("{{{k}}}"))
-        .collect::<Vec<_>>()
-        .join(", ")
-}
-
-/// The file-name stem of a scene: the file's, or `NAME_sN` for a generated one.
-pub fn scene_stem(scene: &Path) -> String {
-    if let Ok(Some((db, size))) = Database::parse_spec(&scene.to_string_lossy()) {
-        return format!("{}_s{size}", db.name());
-    }
-    scene
-        .file_stem()
-        .map(|s| s.to_string_lossy().into_owned())
-        .unwrap_or_else(|| "emray".into())
-}
-
-/// The placeholders an output template may use.
-pub const TEMPLATE_KEYS: &[&str] = &["stem", "backend", "index", "spp"];
-
-/// Expand an output template: `{stem}` (scene file stem), `{backend}`, `{index}` (the
-/// job's position in the batch, from 0) and `{spp}`. An unknown `{key}` is an error.
-pub fn expand_template(
+/// The output file of the job `index` rendering `scene` with `settings`, from
+/// `template` (the placeholders of [`OutputName`]).
+pub fn job_output(
     template: &str,
     scene: &Path,
     settings: &JobSettings,
     index: usize,
-) -> Result<String, BatchError> {
-    let mut out = String::with_capacity(template.len() + 16);
-    let mut rest = template;
-    while let Some(open) = rest.find('{') {
-        out.push_str(&rest[..open]);
-        let after = &rest[open + 1..];
-        let close = after
-            .find('}')
-            .ok_or_else(|| BatchError::UnclosedPlaceholder {
-                template: template.to_string(),
-            })?;
-        let key = &after[..close];
-        match key {
-            "stem" => out.push_str(&scene_stem(scene)),
-            "backend" => out.push_str(settings.backend().name()),
-            "index" => out.push_str(&index.to_string()),
-            "spp" => out.push_str(&settings.render.spp.unwrap_or(1).to_string()),
-            _ => {
-                return Err(BatchError::UnknownPlaceholder {
-                    template: template.to_string(),
-                    key: key.to_string(),
-                });
-            }
-        }
-        rest = &after[close + 1..];
+) -> Result<String, TemplateError> {
+    OutputName {
+        scene,
+        backend: settings.backend(),
+        index,
+        spp: settings.render.spp,
     }
-    out.push_str(rest);
-    Ok(out)
+    .expand(template)
 }
 
 /// The 64-bit FNV-1a hash of `bytes`: fixed by its definition, the same on every
@@ -231,7 +175,7 @@ pub fn jobs_from_scenes(
         .iter()
         .enumerate()
         .map(|(i, s)| {
-            let out = expand_template(template, s, settings, i)?;
+            let out = job_output(template, s, settings, i)?;
             Ok(Job {
                 name: out.clone(),
                 scene: s.clone(),
@@ -280,7 +224,7 @@ mod tests {
     }
 
     #[test]
-    fn templates_expand_and_refuse_unknown_keys() {
+    fn jobs_name_their_outputs_with_their_settings() {
         let s = JobSettings {
             backend: Some(Backend::Bvh),
             render: RenderRequest {
@@ -291,27 +235,14 @@ mod tests {
         };
         let p = Path::new("dir/balls.nff");
         assert_eq!(
-            expand_template("out/{stem}-{backend}-{spp}-{index}.exr", p, &s, 3).unwrap(),
+            job_output("out/{stem}-{backend}-{spp}-{index}.exr", p, &s, 3).unwrap(),
             "out/balls-bvh-4-3.exr"
         );
-        assert_eq!(
-            expand_template("{stem}.png", Path::new("spd:gears?size=2"), &s, 0).unwrap(),
-            "gears_s2.png"
+        let e = jobs_from_scenes(&[p.to_path_buf()], "{colour}.png", &s).unwrap_err();
+        assert!(
+            e.to_string().contains("unknown placeholder '{colour}'"),
+            "{e}"
         );
-        assert_eq!(
-            expand_template("{colour}.png", p, &s, 0)
-                .unwrap_err()
-                .to_string(),
-            "output template '{colour}.png': unknown placeholder '{colour}' (one of {stem}, \
-             {backend}, {index}, {spp})"
-        );
-        assert_eq!(
-            expand_template("{stem.png", p, &s, 0)
-                .unwrap_err()
-                .to_string(),
-            "output template '{stem.png': '{' without '}'"
-        );
-        assert!(expand_template("{stem.png", p, &s, 0).is_err());
     }
 
     #[test]

@@ -142,6 +142,11 @@ pub trait Observer {
         let _ = (index, done, total);
     }
 
+    /// Job `index` is rendered and its image is being written.
+    fn writing(&mut self, index: usize, job: &Job) {
+        let _ = (index, job);
+    }
+
     /// A job finished (rendered, failed or skipped): `done` of `total` jobs are, and
     /// about `eta_s` seconds of rendering are left.
     fn finished(&mut self, record: &JobRecord, done: usize, total: usize, eta_s: Option<f64>) {
@@ -180,6 +185,7 @@ struct Shared {
 enum Msg {
     Started(usize),
     Progress(usize, usize, usize),
+    Writing(usize),
     Finished(Box<JobRecord>),
 }
 
@@ -288,6 +294,7 @@ fn run_job(
     }
     let result = result.map(|r| {
         r.and_then(|(film, report)| {
+            let _ = tx.send(Msg::Writing(i));
             crate::output::write_image(&job.output, &film, job.settings.encoding)
                 .map(|()| report)
                 .map_err(|e| e.to_string())
@@ -409,6 +416,7 @@ fn collect(
                 observer.started(i, &shared.jobs[i]);
             }
             Ok(Msg::Progress(i, d, t)) => observer.progress(i, d, t),
+            Ok(Msg::Writing(i)) => observer.writing(i, &shared.jobs[i]),
             Ok(Msg::Finished(r)) => {
                 done += 1;
                 if r.status != JobStatus::Skipped {

@@ -1,6 +1,6 @@
-//! Argument types and parsers that several commands share: backends, Embree build
-//! qualities, PNG encodings, image sizes, packet widths, and the radiosity options of
-//! `emray radiosity` and `emray render --gi radiosity`.
+//! Argument types and parsers that several commands share: `-q` and `-v`, backends,
+//! Embree build qualities, PNG encodings, image sizes, packet widths, and the radiosity
+//! options of `emray radiosity` and `emray render --gi radiosity`.
 
 use clap::{Args, ValueEnum};
 use emray::accel::{Backend, EmbreeQuality};
@@ -24,43 +24,59 @@ pub enum FormFactorArg {
     Hemicube,
 }
 
+/// `-q` and `-v`, which every command takes.
+#[derive(Args, Debug, Clone, Copy, Default, PartialEq, Eq)]
+pub struct LogArgs {
+    /// No progress bars and no messages but errors.
+    #[arg(short, long)]
+    pub quiet: bool,
+    /// More log output (repeat for more).
+    #[arg(short, long, action = clap::ArgAction::Count)]
+    pub verbose: u8,
+}
+
+/// The help heading of the radiosity options.
+const RADIOSITY: &str = "Radiosity";
+
 /// The radiosity options `emray radiosity` and `emray render --gi radiosity` share.
+/// Each option sets its own heading: a heading set for the struct
+/// (`next_help_heading`) would also head the options that follow it where it is
+/// flattened.
 #[derive(Args, Debug, Clone, PartialEq)]
-#[command(next_help_heading = "Radiosity")]
 pub struct RadiositySolveArgs {
     /// Longest element edge, in scene units [default: 1/12 of the scene's diagonal].
-    #[arg(long, value_name = "SIZE")]
+    #[arg(long, help_heading = RADIOSITY, value_name = "SIZE")]
     pub patch_size: Option<f32>,
     /// Form-factor sample points per shooting element: 1, 4, 16 or 64.
-    #[arg(long, default_value_t = 4, value_parser = parse_power_of_four)]
+    #[arg(long, help_heading = RADIOSITY, default_value_t = 4, value_parser = parse_power_of_four)]
     pub ff_samples: u32,
     /// Visibility rays per pair of elements: 1, 4, 16 or 64.
-    #[arg(long, default_value_t = 1, value_parser = parse_power_of_four)]
+    #[arg(long, help_heading = RADIOSITY, default_value_t = 1, value_parser = parse_power_of_four)]
     pub vis_samples: u32,
     /// Solver.
-    #[arg(long, value_enum, default_value_t = SolverArg::Progressive)]
+    #[arg(long, help_heading = RADIOSITY, value_enum, default_value_t = SolverArg::Progressive)]
     pub solver: SolverArg,
     /// Form-factor method.
-    #[arg(long, value_enum, default_value_t = FormFactorArg::Raycast)]
+    #[arg(long, help_heading = RADIOSITY, value_enum, default_value_t = FormFactorArg::Raycast)]
     pub form_factors: FormFactorArg,
     /// Hemicube resolution: pixels across the top face (even).
-    #[arg(long, default_value_t = 128, value_parser = clap::value_parser!(u32).range(2..=4096))]
+    #[arg(long, help_heading = RADIOSITY, default_value_t = 128, value_parser = clap::value_parser!(u32).range(2..=4096))]
     pub hemicube_res: u32,
     /// Adaptive subdivision: split elements whose radiosity differs from a neighbour's
     /// by more than this fraction of the largest reflected radiosity, then solve again.
-    #[arg(long, value_name = "FRACTION")]
+    #[arg(long, help_heading = RADIOSITY, value_name = "FRACTION")]
     pub subdiv_threshold: Option<f32>,
     /// Smallest element edge adaptive subdivision makes [default: patch size / 8].
-    #[arg(long, value_name = "SIZE")]
+    #[arg(long, help_heading = RADIOSITY, value_name = "SIZE")]
     pub min_patch_size: Option<f32>,
     /// Most rounds of adaptive subdivision.
-    #[arg(long, default_value_t = 3)]
+    #[arg(long, help_heading = RADIOSITY, default_value_t = 3)]
     pub subdiv_passes: u32,
     /// Stop when the unshot power is below this fraction of the emitted power.
-    #[arg(long, default_value_t = 1e-3)]
+    #[arg(long, help_heading = RADIOSITY, default_value_t = 1e-3)]
     pub epsilon: f64,
     /// Most shots (progressive) or sweeps (Gauss–Seidel).
-    #[arg(long, default_value_t = 1_000_000)]
+    #[arg(long, help_heading = RADIOSITY, default_value_t = 1_000_000)]
     pub max_iterations: usize,
 }
 

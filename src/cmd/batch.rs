@@ -1,16 +1,17 @@
 //! `emray batch`: many scenes (arguments, globs or a manifest) rendered as isolated,
-//! resumable jobs, optionally one shard of them; Ctrl-C stops it after writing the
-//! report of what finished.
+//! resumable jobs, optionally one shard of them; Ctrl-C or SIGTERM stops it after
+//! writing the report of what finished (a second one at once).
 
-use super::args::{BackendArg, EncodingArg, parse_res};
+use super::args::{BackendArg, EncodingArg, LogArgs, parse_res};
 use super::error::print;
-use super::interrupt::cancel_on_ctrl_c;
+use super::interrupt::stop_flag;
 use super::progress::BatchDisplay;
-use super::{Error, init_log};
+use super::{Error, outputs};
 use emray::accel::Backend;
-use emray::batch::{self, BatchOptions, Job, JobSettings};
+use emray::batch::{self, BatchOptions, BatchReport, Job, JobSettings};
 use emray::output::Encoding;
 use emray::run::RenderRequest;
+use emray::run::template;
 use std::path::PathBuf;
 
 /// `emray batch`.
@@ -22,8 +23,8 @@ pub struct Args {
     /// A TOML manifest of jobs (README "Batch rendering"), instead of scene arguments.
     #[arg(short, long, value_name = "FILE.toml", conflicts_with = "scenes")]
     pub manifest: Option<PathBuf>,
-    /// Output template: `{stem}`, `{backend}`, `{index}`, `{spp}` [default: `{stem}.png`,
-    /// or the manifest's].
+    /// Output template, as `render -o`: `{stem}`, `{backend}`, `{index}`, `{spp}`
+    /// [default: `{stem}.png`, or the manifest's].
     #[arg(short, long, value_name = "TEMPLATE")]
     pub output: Option<String>,
     /// Ray-query backend (overrides the manifest).
@@ -67,9 +68,9 @@ pub struct Args {
     /// Refuse jobs estimated to need more memory (e.g. 8G) [default: 3/4 of RAM].
     #[arg(long, value_name = "SIZE", value_parser = emray::run::limits::parse_size)]
     pub max_memory: Option<u64>,
-    /// No progress, only errors.
-    #[arg(short, long)]
-    pub quiet: bool,
+    /// `-q` and `-v`.
+    #[command(flatten)]
+    pub log: LogArgs,
 }
 
 impl Args {
@@ -89,9 +90,9 @@ impl Args {
 
 /// Plan the jobs, keep this shard's, and list or run them.
 pub fn run(b: Args) -> Result<(), Error> {
-    init_log(b.quiet, 0);
     let jobs = jobs(&b)?;
     batch::check_jobs(&jobs).map_err(|e| Error::Usage(e.into()))?;
+    let report = report_path(&b)?;
     let jobs: Vec<Job> = match b.shard {
         Some((i, n)) => jobs
             .into_iter()
@@ -110,36 +111,56 @@ pub fn run(b: Args) -> Result<(), Error> {
         }
         return Ok(());
     }
-    let shard_index = b.shard.map_or(0, |(i, _)| i);
     let opts = BatchOptions {
         threads: b.threads.map(|t| t as usize),
         jobs: b.jobs as usize,
         skip_existing: b.skip_existing,
-        report: b
-            .report
-            .as_ref()
-            .map(|r| PathBuf::from(r.replace("{shard}", &shard_index.to_string()))),
+        report,
         max_memory: b
             .max_memory
             .unwrap_or_else(emray::run::limits::default_max_memory),
         shard: b.shard,
     };
-    let cancel = cancel_on_ctrl_c();
-    let mut display = BatchDisplay::new(jobs.len(), b.quiet);
+    let images = jobs.iter().map(|j| j.output.as_path());
+    outputs::prepare(opts.report.as_deref().into_iter().chain(images))?;
+    let cancel = stop_flag();
+    let mut display = BatchDisplay::new(jobs.len(), b.log.quiet);
     let report = batch::run(jobs, &opts, &cancel, &mut display);
-    if report.interrupted && !b.quiet {
+    if report.interrupted && !b.log.quiet {
         eprintln!(
             "emray: interrupted: {} of {} jobs finished",
             report.ok + report.failed + report.skipped,
             report.total
         );
     }
-    let failed = (report.failed > 0)
-        .then(|| anyhow::anyhow!("{} of {} jobs failed", report.failed, report.total));
+    let failed = failure(&report, display.report_error());
     match (report.interrupted, failed) {
         (true, failed) => Err(Error::Interrupted(failed)),
         (false, Some(failed)) => Err(Error::Failed(failed)),
         (false, None) => Ok(()),
+    }
+}
+
+/// The `--report` file, its `{shard}` the shard's index (0 without `--shard`); another
+/// placeholder is a usage error.
+fn report_path(b: &Args) -> Result<Option<PathBuf>, Error> {
+    let shard = b.shard.map_or(0, |(i, _)| i).to_string();
+    b.report
+        .as_deref()
+        .map(|r| template::expand("report name", r, &["shard"], |_| shard.clone()))
+        .transpose()
+        .map(|r| r.map(PathBuf::from))
+        .map_err(|e| Error::Usage(e.into()))
+}
+
+/// What went wrong in a batch that ran: failed jobs, a report that could not be
+/// written.
+fn failure(report: &BatchReport, report_error: Option<&str>) -> Option<anyhow::Error> {
+    let jobs =
+        (report.failed > 0).then(|| format!("{} of {} jobs failed", report.failed, report.total));
+    match (jobs, report_error) {
+        (Some(jobs), Some(r)) => Some(anyhow::anyhow!("{jobs}; {r}")),
+        (jobs, r) => jobs.as_deref().or(r).map(|e| anyhow::anyhow!("{e}")),
     }
 }
 

@@ -1,9 +1,9 @@
 //! `emray bench`: the benchmark suite, each run in a child process of its own (the
 //! hidden `--child` option is that child's side).
 
-use super::Error;
-use super::args::{BackendArg, QualityArg, packet_width, parse_res};
+use super::args::{BackendArg, LogArgs, QualityArg, packet_width, parse_res};
 use super::error::print;
+use super::{Error, outputs};
 use emray::accel::Backend;
 use emray::bench::{self, RunSpec};
 use emray::spd::Database;
@@ -63,6 +63,9 @@ pub struct Args {
     /// Run one measurement in this process (used by the suite itself).
     #[arg(long, hide = true, value_name = "JSON")]
     pub child: Option<String>,
+    /// `-q` and `-v`.
+    #[command(flatten)]
+    pub log: LogArgs,
 }
 
 /// Run the suite and print its markdown report (or, as a child, one run's JSON).
@@ -74,6 +77,7 @@ pub fn run(b: Args) -> Result<(), Error> {
     for s in &cfg.scenes {
         Database::parse_spec(s).map_err(Error::usage)?;
     }
+    outputs::prepare(b.csv.iter().chain(&b.json).map(PathBuf::as_path))?;
     let outs = bench::Outputs {
         csv: b.csv.clone(),
         json: b.json.clone(),
@@ -81,7 +85,12 @@ pub fn run(b: Args) -> Result<(), Error> {
     };
     let exe = std::env::current_exe()
         .map_err(|e| Error::failed(format!("cannot find the emray executable: {e}")))?;
-    let mut log = |line: &str| eprintln!("{line}");
+    let quiet = b.log.quiet;
+    let mut log = |line: &str| {
+        if !quiet {
+            eprintln!("{line}");
+        }
+    };
     let md = bench::bench(&cfg, &outs, &exe, &mut log)?;
     print(format_args!("{md}"))?;
     Ok(())

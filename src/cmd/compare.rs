@@ -3,7 +3,7 @@
 //! `quality` feature (FLIP).
 
 use super::Error;
-use super::args::EncodingArg;
+use super::args::{EncodingArg, LogArgs};
 use super::error::print;
 use std::path::PathBuf;
 
@@ -31,6 +31,9 @@ pub struct Args {
     /// Print one JSON object instead of the table.
     #[arg(long)]
     pub json: bool,
+    /// `-q` and `-v`.
+    #[command(flatten)]
+    pub log: LogArgs,
 }
 
 /// The table `emray compare` prints.
@@ -62,6 +65,9 @@ pub fn run(a: Args) -> Result<(), Error> {
         if v.is_some_and(|v| v.is_nan() || v < 0.0) {
             return Err(Error::usage(format!("{name} must be a number ≥ 0")));
         }
+    }
+    if let Some(out) = &a.diff {
+        emray::output::prepare(out).map_err(|e| Error::Usage(e.into()))?;
     }
     let usage = |e: metrics::MetricsError| Error::Usage(e.into());
     let enc: Encoding = a.encoding.into();

@@ -7,7 +7,7 @@
 //! | 1 | [`Error::Failed`]: an input, render or output error; `batch`: a job failed |
 //! | 1 | [`Error::CheckFailed`]: `compare` over a threshold, `stress` outside a bound |
 //! | 2 | [`Error::Usage`]: bad arguments, found before any work (clap's own errors too); `compare`: an unreadable image |
-//! | 130 | [`Error::Interrupted`]: Ctrl-C stopped a `batch` |
+//! | 130 | [`Error::Interrupted`]: Ctrl-C or SIGTERM stopped the command (`interrupt.rs`) |
 //!
 //! A command whose standard output is closed early (`emray gen teapot | head`) stops
 //! quietly with status 0, as other command-line tools do.
@@ -25,8 +25,8 @@ pub enum Error {
     /// A check the command makes did not pass and says so itself (`compare`'s
     /// thresholds, `stress`'s bounds): exit 1, nothing more printed.
     CheckFailed,
-    /// Ctrl-C stopped a batch, with the error of the jobs that failed before if any:
-    /// exit 130.
+    /// Ctrl-C or SIGTERM stopped the command (a batch, with the error of the jobs that
+    /// failed before if any): exit 130.
     Interrupted(Option<anyhow::Error>),
 }
 

@@ -2,10 +2,10 @@
 //! the camera, samples and settings of `emray render`, as indented text or as JSON
 //! (docs/explain.md).
 
-use super::args::{BackendArg, QualityArg, RadiositySolveArgs, packet_width, parse_res};
+use super::Error;
+use super::args::{BackendArg, LogArgs, QualityArg, RadiositySolveArgs, packet_width, parse_res};
 use super::error::print;
 use super::render::GiArg;
-use super::{Error, init_log};
 use anyhow::anyhow;
 use emray::accel::{Backend, BackendOptions};
 use emray::render::explain::{ExplainError, Explanation, text};
@@ -73,12 +73,9 @@ pub struct Args {
     /// Eye rays per Embree packet, as `emray render --packet-width`.
     #[arg(long, value_name = "N", default_value_t = 8, value_parser = packet_width)]
     pub packet_width: u32,
-    /// No messages but errors.
-    #[arg(short, long)]
-    pub quiet: bool,
-    /// More log output (repeat for more).
-    #[arg(short, long, action = clap::ArgAction::Count)]
-    pub verbose: u8,
+    /// `-q` and `-v`.
+    #[command(flatten)]
+    pub log: LogArgs,
 }
 
 /// The JSON `--json` prints: the explanation with the scene and backend it is of.
@@ -92,7 +89,6 @@ struct Output<'a> {
 
 /// Explain the pixel and print the tree.
 pub fn run(a: Args) -> Result<(), Error> {
-    init_log(a.quiet, a.verbose);
     if let Some(b) = a.bailout {
         if !b.is_finite() || b < 0.0 {
             return Err(Error::usage(format!(

@@ -2,6 +2,7 @@
 //! called `gen`, a reserved word since edition 2024).
 
 use super::Error;
+use super::args::LogArgs;
 use super::error::print;
 use anyhow::Context;
 use emray::spd::Database;
@@ -19,6 +20,9 @@ pub struct Args {
     /// Output file (default: standard output).
     #[arg(short, long, value_name = "FILE.nff")]
     pub output: Option<std::path::PathBuf>,
+    /// `-q` and `-v`.
+    #[command(flatten)]
+    pub log: LogArgs,
 }
 
 /// Generate the database at its size, to the file or to standard output.
@@ -33,6 +37,7 @@ pub fn run(g: Args) -> Result<(), Error> {
     };
     let size = g.size.unwrap_or_else(|| db.default_size());
     db.check_size(size).map_err(Error::usage)?;
+    super::outputs::prepare(g.output.as_deref())?;
     let text = db.generate(size);
     match &g.output {
         None => print(format_args!("{text}"))

@@ -2,9 +2,10 @@
 //! in the EXR beside the colour) and `--heatmap` (a false-colour PNG of a per-pixel
 //! cost): parsing, the checks made before any render, and writing what they ask for.
 
+use super::progress::TileBar;
 use anyhow::{Result, bail};
+use emray::output::Format;
 use emray::output::heatmap::{Quantity, write_heatmap};
-use emray::output::{self, Format};
 use emray::render::aov::{AovFilm, AovSet};
 use std::path::{Path, PathBuf};
 
@@ -26,8 +27,7 @@ pub fn parse_aov(s: &str) -> Result<AovSet, String> {
     Ok(set)
 }
 
-/// One `--heatmap WHAT FILE`: the quantity and the file (a template with `{stem}`
-/// when several scenes render).
+/// One `--heatmap WHAT FILE`: the quantity and the file (a template, as `-o`).
 #[derive(Clone, Debug, PartialEq)]
 pub struct HeatmapArg {
     /// What it shows.
@@ -37,8 +37,8 @@ pub struct HeatmapArg {
 }
 
 /// The `--heatmap` pairs (`WHAT FILE` each), checked: a known quantity and a `.png`
-/// file, with `{stem}` when `scenes` scenes render (more than one).
-pub fn heatmaps(values: &[String], scenes: usize) -> Result<Vec<HeatmapArg>> {
+/// file.
+pub fn heatmaps(values: &[String]) -> Result<Vec<HeatmapArg>> {
     let mut out = Vec::new();
     for pair in values.chunks(2) {
         let [what, file] = pair else {
@@ -52,12 +52,6 @@ pub fn heatmaps(values: &[String], scenes: usize) -> Result<Vec<HeatmapArg>> {
         };
         if Format::from_path(Path::new(file))? != Format::Png {
             bail!("--heatmap {what} {file}: a heat map is a PNG (name it FILE.png)");
-        }
-        if scenes > 1 && !file.contains("{stem}") {
-            bail!(
-                "{scenes} scenes but one heat map file '{file}': use a template such as \
-                 '{{stem}}-{what}.png'"
-            );
         }
         out.push(HeatmapArg {
             quantity,
@@ -93,16 +87,10 @@ pub fn gathered(set: AovSet, maps: &[HeatmapArg]) -> AovSet {
     g
 }
 
-/// The heat map files of one scene whose stem is `stem`.
-pub fn heatmap_files(maps: &[HeatmapArg], stem: &str) -> Vec<(Quantity, PathBuf)> {
-    maps.iter()
-        .map(|m| (m.quantity, PathBuf::from(m.file.replace("{stem}", stem))))
-        .collect()
-}
-
-/// Write the heat maps `files` of a render's variables `aov`.
-pub fn write_heatmaps(aov: &AovFilm, files: &[(Quantity, PathBuf)]) -> Result<()> {
+/// Write the heat maps `files` of a render's variables `aov`, saying so on `bar`.
+pub fn write_heatmaps(aov: &AovFilm, files: &[(Quantity, PathBuf)], bar: &TileBar) -> Result<()> {
     for (q, path) in files {
+        bar.writing(path);
         let values = match q {
             Quantity::Rays => &aov.rays,
             Quantity::Time => &aov.time,
@@ -110,14 +98,6 @@ pub fn write_heatmaps(aov: &AovFilm, files: &[(Quantity, PathBuf)]) -> Result<()
         };
         write_heatmap(path, values, aov.width, aov.height, *q)?;
         log::info!("wrote {}", path.display());
-    }
-    Ok(())
-}
-
-/// Make sure the heat maps can be written before any render (as the images are).
-pub fn prepare_heatmaps(files: &[(Quantity, PathBuf)]) -> Result<()> {
-    for (_, path) in files {
-        output::prepare(path)?;
     }
     Ok(())
 }
@@ -139,14 +119,11 @@ mod tests {
     #[test]
     fn heatmaps_are_checked() {
         let v = |s: &[&str]| s.iter().map(|x| x.to_string()).collect::<Vec<_>>();
-        let h = heatmaps(&v(&["rays", "r.png", "time", "t.png"]), 1).unwrap();
+        let h = heatmaps(&v(&["rays", "r.png", "time", "t.png"])).unwrap();
         assert_eq!(h.len(), 2);
         assert_eq!(h[1].quantity, Quantity::Time);
-        assert!(heatmaps(&v(&["colour", "r.png"]), 1).is_err());
-        assert!(heatmaps(&v(&["rays", "r.exr"]), 1).is_err());
-        assert!(heatmaps(&v(&["rays", "r.png"]), 2).is_err());
-        assert!(heatmaps(&v(&["rays", "{stem}-r.png"]), 2).is_ok());
-        let files = heatmap_files(&h, "balls");
-        assert_eq!(files[0].1, PathBuf::from("r.png"));
+        assert!(heatmaps(&v(&["colour", "r.png"])).is_err());
+        assert!(heatmaps(&v(&["rays", "r.exr"])).is_err());
+        assert!(heatmaps(&v(&["rays", "{stem}-r.png"])).is_ok());
     }
 }

@@ -1,9 +1,9 @@
 //! `emray merge`: stitch the parts rendered with `render --tile` or `--crop` into the
 //! whole image, with the output variables they were rendered with (`--aov`).
 
-use super::Error;
-use super::args::EncodingArg;
-use emray::output::aov::write_ids;
+use super::args::{EncodingArg, LogArgs};
+use super::{Error, outputs};
+use emray::output::aov::{ids_path, write_ids};
 use emray::output::channels::write_exr_channels;
 use emray::output::{self, Format};
 use std::path::PathBuf;
@@ -20,13 +20,18 @@ pub struct Args {
     /// PNG value encoding.
     #[arg(long, value_enum, default_value_t = EncodingArg::Srgb)]
     pub encoding: EncodingArg,
+    /// `-q` and `-v`.
+    #[command(flatten)]
+    pub log: LogArgs,
 }
 
 /// Check that the parts make one image, and write it: every channel of the parts to
 /// an EXR (with the `.ids.json` of an `id` channel), the colour alone to a PNG.
 pub fn run(m: Args) -> Result<(), Error> {
-    super::init_log(false, 0);
     let format = Format::from_path(&m.output)?;
+    // The ids file of parts with an `id` channel goes beside an EXR.
+    let ids = (format == Format::Exr).then(|| ids_path(&m.output));
+    outputs::prepare([m.output.as_path()].into_iter().chain(ids.as_deref()))?;
     let merged = emray::batch::merge::merge(&m.parts)?;
     if merged.channels.is_empty() || format == Format::Png {
         if !merged.channels.is_empty() {

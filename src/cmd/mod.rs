@@ -1,8 +1,8 @@
 //! The commands of the `emray` binary, one module each with its own arguments and a
 //! `run(args) -> Result<(), Error>`; [`args`] holds the argument types several share,
 //! [`error`] how a failure becomes a message and an exit status, [`progress`] and
-//! [`interrupt`] the terminal's progress bars and the Ctrl-C handler (neither of which
-//! the library has).
+//! [`interrupt`] the terminal's progress bars and the handler of Ctrl-C and SIGTERM
+//! (neither of which the library has).
 
 mod args;
 mod batch;
@@ -11,11 +11,14 @@ mod compare;
 #[cfg(test)]
 mod docs_commands;
 mod error;
+mod eta;
 mod explain;
 mod generate;
 mod insight;
 mod interrupt;
+mod jobs;
 mod merge;
+mod outputs;
 mod progress;
 mod radiosity;
 mod render;
@@ -23,6 +26,8 @@ mod stress;
 mod study;
 
 pub use error::Error;
+
+use args::LogArgs;
 
 use anyhow::Context;
 use clap::{Parser, Subcommand};
@@ -69,8 +74,15 @@ pub enum Command {
     Explain(explain::Args),
 }
 
-/// Run the command line's command (a bare `emray` renders the default scene).
+/// Run the command line's command (a bare `emray` renders the default scene), Ctrl-C
+/// and SIGTERM caught for it ([`interrupt`]).
 pub fn run(cli: Cli) -> Result<(), Error> {
+    init_log(
+        cli.command
+            .as_ref()
+            .map_or_else(LogArgs::default, Command::log),
+    );
+    interrupt::install();
     match cli.command {
         None => render::run(render::Args::default_scene()),
         Some(Command::Render(a)) => render::run(a),
@@ -86,10 +98,28 @@ pub fn run(cli: Cli) -> Result<(), Error> {
     }
 }
 
-/// Log to standard error: errors only when `quiet`, else warnings and more with each
+impl Command {
+    /// The command's `-q` and `-v`.
+    fn log(&self) -> LogArgs {
+        match self {
+            Command::Render(a) => a.log,
+            Command::Gen(a) => a.log,
+            Command::Batch(a) => a.log,
+            Command::Merge(a) => a.log,
+            Command::Bench(a) => a.log,
+            Command::Compare(a) => a.log,
+            Command::Stress(a) => a.log,
+            Command::Study(a) => a.log,
+            Command::Radiosity(a) => a.log,
+            Command::Explain(a) => a.log,
+        }
+    }
+}
+
+/// Log to standard error: errors only with `-q`, else warnings and more with each
 /// `-v` (`RUST_LOG` wins).
-fn init_log(quiet: bool, verbose: u8) {
-    let level = match (quiet, verbose) {
+fn init_log(log: LogArgs) {
+    let level = match (log.quiet, log.verbose) {
         (true, _) => "error",
         (false, 0) => "warn",
         (false, 1) => "info",
@@ -110,9 +140,11 @@ fn thread_pool(threads: Option<u32>) -> anyhow::Result<rayon::ThreadPool> {
     builder.build().context("cannot start the worker threads")
 }
 
-/// Append `value` as one JSON line to `path` (the `--stats-json` log: one record per run).
+/// Append `value` as one JSON line to `path` (the `--stats-json` log: one record per
+/// run), creating its folder if missing.
 fn append_json_line(path: &Path, value: &impl serde::Serialize) -> anyhow::Result<()> {
     let line = serde_json::to_string(value).expect("report serialises");
+    emray::output::create_folder(path)?;
     let mut f = std::fs::OpenOptions::new()
         .create(true)
         .append(true)

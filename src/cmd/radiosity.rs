@@ -1,9 +1,9 @@
 //! `emray radiosity`: solve a scene's diffuse interreflection and render a view of
 //! the solution.
 
-use super::args::{BackendArg, RadiositySolveArgs, parse_res};
+use super::args::{BackendArg, LogArgs, RadiositySolveArgs, parse_res};
 use super::error::print;
-use super::{Error, append_json_line, init_log, thread_pool};
+use super::{Error, append_json_line, outputs, thread_pool};
 use anyhow::{Context, Result};
 use emray::accel::Backend;
 use emray::output::{self, Encoding, Format};
@@ -43,16 +43,20 @@ pub struct Args {
     /// Append the statistics (with the residual curve) as one JSON object to FILE.
     #[arg(long, value_name = "FILE")]
     pub stats_json: Option<PathBuf>,
+    /// `-q` and `-v`.
+    #[command(flatten)]
+    pub log: LogArgs,
 }
 
 /// Solve, render the view, write the image (and the PLY and statistics asked for).
 pub fn run(a: Args) -> Result<(), Error> {
-    init_log(false, 0);
+    Format::from_path(&a.output)?;
+    outputs::prepare([a.output.as_path()].into_iter().chain(a.ply.as_deref()))?;
+    outputs::prepare_log(a.stats_json.as_deref())?;
     solve_and_write(&a).map_err(Error::Failed)
 }
 
 fn solve_and_write(a: &Args) -> Result<()> {
-    Format::from_path(&a.output)?;
     let pool = thread_pool(a.threads)?;
     let scene = emray::load::load_path(&a.scene)?;
     let settings = a.solve.settings();

@@ -2,12 +2,13 @@
 //! PNG or EXR, whole or one part of an image for `emray merge`.
 
 use super::args::{
-    BackendArg, EncodingArg, QualityArg, RadiositySolveArgs, packet_width, parse_res,
+    BackendArg, EncodingArg, LogArgs, QualityArg, RadiositySolveArgs, packet_width, parse_res,
 };
 use super::error::{error_line, is_closed_pipe, print};
-use super::insight::{self, HeatmapArg};
+use super::insight;
+use super::jobs::{self, Job};
 use super::progress::TileBar;
-use super::{Error, append_json_line, init_log, thread_pool};
+use super::{Error, append_json_line, outputs, thread_pool};
 use anyhow::{Result, anyhow, bail};
 use clap::ValueEnum;
 use emray::Scene;
@@ -19,7 +20,6 @@ use emray::render::{Aa, Film, RenderSettings};
 use emray::run::{self, Part, RenderRequest, Report, limits};
 use emray::scene::Environment;
 use emray::spd::Database;
-use std::collections::HashMap;
 use std::path::{Path, PathBuf};
 use std::time::Instant;
 
@@ -41,8 +41,10 @@ pub struct Args {
     /// Scene files: NFF, TOML (`.toml`), OBJ (`.obj`), or `spd:NAME[?size=N]`.
     #[arg(required = true, value_name = "SCENE")]
     pub scenes: Vec<PathBuf>,
-    /// Output file (.png or .exr), or a template with `{stem}` for several scenes.
-    /// Default: `{stem}.png` in the current directory.
+    /// Output file (.png or .exr), a template: `{stem}` (the scene file's stem),
+    /// `{backend}`, `{index}` (the scene's position, from 0), `{spp}` (as `--spp`, 1
+    /// without); several scenes need one. Default: `{stem}.png` in the current
+    /// directory.
     #[arg(short, long, value_name = "OUT")]
     pub output: Option<String>,
     /// Ray-query backend.
@@ -129,12 +131,9 @@ pub struct Args {
     /// replacing the scene's own.
     #[arg(long, value_name = "FILE|DIR")]
     pub envmap: Option<PathBuf>,
-    /// No progress bar and no messages but errors.
-    #[arg(short, long)]
-    pub quiet: bool,
-    /// More log output (repeat for more).
-    #[arg(short, long, action = clap::ArgAction::Count)]
-    pub verbose: u8,
+    /// `-q` and `-v`.
+    #[command(flatten)]
+    pub log: LogArgs,
     /// Global illumination: `radiosity` solves the diffuse interreflection first and
     /// takes the diffuse term of polygons and meshes from it (two-pass).
     #[arg(long, value_enum)]
@@ -152,7 +151,7 @@ pub struct Args {
     #[arg(long, value_name = "LIST", value_parser = insight::parse_aov)]
     pub aov: Option<AovSet>,
     /// A heat map of a per-pixel cost: rays (cast), time (spent) or depth (of the
-    /// deepest ray), to a PNG with a colour bar; may be repeated.
+    /// deepest ray), to a PNG with a colour bar (a template, as `-o`); may be repeated.
     #[arg(long, num_args = 2, value_names = ["WHAT", "FILE.png"], action = clap::ArgAction::Append)]
     pub heatmap: Vec<String>,
 }
@@ -192,8 +191,7 @@ impl Args {
             crop: None,
             max_memory: None,
             envmap: None,
-            quiet: false,
-            verbose: 0,
+            log: LogArgs::default(),
             gi: None,
             radiosity: RadiositySolveArgs::default(),
             area_samples: 16,
@@ -203,24 +201,19 @@ impl Args {
     }
 }
 
-/// One render: the scene (`None` = the built-in default) and its output file.
-type Job = (Option<PathBuf>, PathBuf);
-
 /// Render every scene; with several, a failing one is reported and the others go on.
 pub fn run(args: Args) -> Result<(), Error> {
-    init_log(args.quiet, args.verbose);
     let jobs = plan(&args).map_err(Error::Usage)?;
-    // An output that cannot be written is found before any render (a missing folder
-    // is created, as `batch` does).
-    for (scene, out) in &jobs {
-        emray::output::prepare(out).map_err(Error::failed)?;
-        insight::prepare_heatmaps(&heatmap_files(&args, scene.as_deref()))
-            .map_err(Error::Failed)?;
+    // An output that cannot be written is found before any scene is read (a missing
+    // folder is created).
+    for job in &jobs {
+        outputs::prepare(job.files(&args).iter().map(PathBuf::as_path))?;
     }
+    outputs::prepare_log(args.stats_json.as_deref())?;
     let pool = thread_pool(args.threads).map_err(Error::Failed)?;
     let mut failed = 0usize;
-    for (scene, out) in &jobs {
-        if let Err(e) = pool.install(|| render_one(&args, scene.as_deref(), out)) {
+    for job in &jobs {
+        if let Err(e) = pool.install(|| render_one(&args, job)) {
             if jobs.len() == 1 || is_closed_pipe(&e) {
                 return Err(Error::Failed(e));
             }
@@ -237,67 +230,23 @@ pub fn run(args: Args) -> Result<(), Error> {
     Ok(())
 }
 
-/// Where scene `scene` goes.
-fn output_for(args: &Args, scene: &Path) -> PathBuf {
-    let stem = emray::batch::scene_stem(scene);
-    PathBuf::from(match &args.output {
-        Some(t) if t.contains("{stem}") => t.replace("{stem}", &stem),
-        Some(t) => t.clone(),
-        None => format!("{stem}.png"),
-    })
-}
-
 /// The jobs, or a usage error found before any work is done.
 fn plan(args: &Args) -> Result<Vec<Job>> {
     check_options(args)?;
-    if args.scenes.len() > 1 {
-        if let Some(o) = &args.output {
-            if !o.contains("{stem}") {
-                bail!(
-                    "{} scenes but one output file '{o}': use a template such as '{{stem}}.png'",
-                    args.scenes.len()
-                );
-            }
-        }
-    }
-    let jobs: Vec<Job> = if args.scenes.is_empty() {
-        vec![(None, output_for(args, Path::new("emray")))]
-    } else {
-        args.scenes
-            .iter()
-            .map(|s| (Some(s.clone()), output_for(args, s)))
-            .collect()
-    };
+    let maps = insight::heatmaps(&args.heatmap)?;
+    let jobs = jobs::plan(args, &maps, backend_options(args).backend)?;
     if args.tile.is_some() || args.crop.is_some() {
         check_part(args, &jobs)?;
     }
-    insight::heatmaps(&args.heatmap, jobs.len())?;
-    for (scene, out) in &jobs {
-        Format::from_path(out)?;
-        insight::check_aov_output(&args.aov.unwrap_or_default(), out)?;
-        if let Some(s) = scene {
+    for job in &jobs {
+        Format::from_path(&job.out)?;
+        insight::check_aov_output(&args.aov.unwrap_or_default(), &job.out)?;
+        if let Some(s) = &job.scene {
             Database::parse_spec(&s.to_string_lossy()).map_err(anyhow::Error::msg)?;
         }
     }
-    check_outputs(&jobs)?;
+    jobs::check_distinct(args, &jobs)?;
     Ok(jobs)
-}
-
-/// Refuse, before any render, two scenes that would write the same file.
-fn check_outputs(jobs: &[Job]) -> Result<()> {
-    let mut seen: HashMap<&Path, &Path> = HashMap::new();
-    for (scene, out) in jobs {
-        let scene = scene.as_deref().unwrap_or(Path::new("the default scene"));
-        if let Some(first) = seen.insert(out, scene) {
-            bail!(
-                "{} and {} would both write {}: use an output template that tells them apart",
-                first.display(),
-                scene.display(),
-                out.display()
-            );
-        }
-    }
-    Ok(())
 }
 
 /// Options that cannot go together, and numbers out of range.
@@ -341,10 +290,10 @@ fn check_part(args: &Args, jobs: &[Job]) -> Result<()> {
     if jobs.len() != 1 {
         bail!("--tile and --crop render one scene");
     }
-    if !matches!(Format::from_path(&jobs[0].1), Ok(Format::Exr)) {
+    if !matches!(Format::from_path(&jobs[0].out), Ok(Format::Exr)) {
         bail!(
             "--tile and --crop write an EXR part (for emray merge), not '{}'",
-            jobs[0].1.display()
+            jobs[0].out.display()
         );
     }
     Ok(())
@@ -384,25 +333,31 @@ fn backend_options(args: &Args) -> BackendOptions {
     }
 }
 
-/// The scene's name and the scene, with `--envmap` in place of its own.
-fn load_scene(args: &Args, path: Option<&Path>) -> Result<(String, Scene)> {
-    let (name, mut scene) = match path {
-        Some(p) => (p.display().to_string(), run::load_scene(p)?),
-        None => (
-            "default".into(),
-            load::nff::parse_str(DEFAULT_SCENE, Path::new("<default scene>"))?,
-        ),
+/// The scene's name: its path, or `default`.
+fn scene_name(path: Option<&Path>) -> String {
+    path.map_or_else(|| "default".into(), |p| p.display().to_string())
+}
+
+/// The scene, with `--envmap` in place of its own.
+fn load_scene(args: &Args, path: Option<&Path>) -> Result<Scene> {
+    let mut scene = match path {
+        Some(p) => run::load_scene(p)?,
+        None => load::nff::parse_str(DEFAULT_SCENE, Path::new("<default scene>"))?,
     };
     if let Some(env) = &args.envmap {
         scene.environment = Some(Environment::load(env).map_err(anyhow::Error::msg)?);
     }
-    Ok((name, scene))
+    Ok(scene)
 }
 
 /// Load, render and write one scene.
-fn render_one(args: &Args, scene_path: Option<&Path>, out: &Path) -> Result<()> {
+fn render_one(args: &Args, job: &Job) -> Result<()> {
+    let out = job.out.as_path();
+    let name = scene_name(job.scene.as_deref());
+    // Cleared when dropped, on an error too.
+    let bar = TileBar::new(&name, args.log.quiet);
     let t0 = Instant::now();
-    let (name, scene) = load_scene(args, scene_path)?;
+    let scene = load_scene(args, job.scene.as_deref())?;
     let load_ms = t0.elapsed().as_secs_f64() * 1e3;
     let settings = request(args)
         .settings(&scene)
@@ -415,9 +370,8 @@ fn render_one(args: &Args, scene_path: Option<&Path>, out: &Path) -> Result<()> 
     };
     limits::check_with(Path::new(&name), &scene, &settings, extra, max_memory)?;
     let options = backend_options(args);
-    let bar = TileBar::new(&name, args.quiet);
     let (film, aov, report) = trace(args, &name, &scene, &settings, options, load_ms, &bar)?;
-    bar.finish();
+    bar.writing(out);
     let part = settings.region.map(|region| part::PartInfo {
         full: (settings.width, settings.height),
         region,
@@ -435,31 +389,22 @@ fn render_one(args: &Args, scene_path: Option<&Path>, out: &Path) -> Result<()> 
         (_, None) => output::write_image(out, &film, args.encoding.into())?,
     }
     if let Some(aov) = &aov {
-        insight::write_heatmaps(aov, &heatmap_files(args, scene_path))?;
+        insight::write_heatmaps(aov, &job.heatmaps, &bar)?;
     }
+    bar.finish();
     if args.stats {
         print(format_args!(
             "{}\noutput     {}\n",
             report.summary(),
             out.display()
         ))?;
-    } else if !args.quiet {
+    } else if !args.log.quiet {
         log::info!("wrote {}", out.display());
     }
     if let Some(path) = &args.stats_json {
         append_json_line(path, &report)?;
     }
     Ok(())
-}
-
-/// The heat map files of the scene `scene` (`None`: the default scene).
-fn heatmap_files(
-    args: &Args,
-    scene: Option<&Path>,
-) -> Vec<(emray::output::heatmap::Quantity, PathBuf)> {
-    let maps: Vec<HeatmapArg> = insight::heatmaps(&args.heatmap, 1).unwrap_or_default();
-    let stem = emray::batch::scene_stem(scene.unwrap_or(Path::new("emray")));
-    insight::heatmap_files(&maps, &stem)
 }
 
 /// Build the backend and render: the f64 reference, two-pass, or Whitted alone; with
@@ -482,7 +427,7 @@ fn trace(
     }
     let radiosity = args.gi.map(|GiArg::Radiosity| args.radiosity.settings());
     if insight_wanted(args) {
-        let maps = insight::heatmaps(&args.heatmap, 1)?;
+        let maps = insight::heatmaps(&args.heatmap)?;
         let set = insight::gathered(args.aov.unwrap_or_default(), &maps);
         let (film, mut aov, report) = run::render_aov(
             name,

@@ -2,6 +2,7 @@
 //! and whether the bounds of `tests/stability.rs` hold.
 
 use super::Error;
+use super::args::LogArgs;
 use super::error::print;
 use emray::Backend;
 use emray::accel::bvh::Bvh;
@@ -17,6 +18,9 @@ pub struct Args {
     /// each.
     #[arg(long, default_value_t = 4000)]
     pub triangles: u32,
+    /// `-q` and `-v`.
+    #[command(flatten)]
+    pub log: LogArgs,
 }
 
 /// The verdicts so far: each printed as `ok` or `FAIL` with what was measured.

@@ -2,7 +2,7 @@
 //! reference, to CSV, SVG and PNG. Needs the `quality` feature (FLIP, plots).
 
 use super::Error;
-use super::args::parse_res;
+use super::args::{LogArgs, parse_res};
 use super::error::print;
 use std::path::PathBuf;
 
@@ -22,12 +22,17 @@ pub struct Args {
     /// Reference samples per pixel side (N×N).
     #[arg(long, default_value_t = 16, value_parser = clap::value_parser!(u32).range(1..=64))]
     pub reference_strata: u32,
+    /// `-q` and `-v`.
+    #[command(flatten)]
+    pub log: LogArgs,
 }
 
 /// Run the study and print its CSV; a bad `spd:` spec is a usage error.
 #[cfg(feature = "quality")]
 pub fn run(a: Args) -> Result<(), Error> {
     use emray::run::{SceneError, load_scene};
+    let files = emray::quality::study::FILES.map(|f| a.out.join(f));
+    super::outputs::prepare(files.iter().map(PathBuf::as_path))?;
     let name = a.scene.display().to_string();
     let scene = match load_scene(&a.scene) {
         Err(SceneError::Spec(e)) => return Err(Error::usage(e)),

@@ -1,21 +1,28 @@
 //! Image output: PNG (sRGB-encoded by default) and OpenEXR (linear f32), chosen by the
 //! file extension, always written to a temporary file beside the target and renamed,
-//! so a failed or interrupted write never leaves a truncated image. Besides the colour:
-//! the output variables' EXR channels ([`aov`], [`channels`]) and the cost heat maps
-//! ([`heatmap`]), drawn with the colour maps of [`colormap`].
+//! so a failed or interrupted write never leaves a truncated image, and
+//! [`abandon_writes`] removes the temporary files of the writes in progress for a
+//! process about to end. Besides the colour: the output variables' EXR channels
+//! ([`aov`], [`channels`]) and the cost heat maps ([`heatmap`]), drawn with the colour
+//! maps of [`colormap`].
 
 pub mod aov;
+mod atomic;
 pub mod channels;
 pub mod colormap;
 mod font;
 pub mod heatmap;
 pub mod part;
+mod pending;
+
+pub(crate) use atomic::write_atomic;
+pub use atomic::{create_folder, prepare, prepare_append, remove_stale_temps};
+pub use pending::abandon_writes;
 
 // The PNG writer's encodings, defined with the colour curves in `render`.
 use crate::render::Film;
 pub use crate::render::color::Encoding;
 use crate::render::color::to_rgb8;
-use std::fs;
 use std::io::{BufWriter, Write};
 use std::path::{Path, PathBuf};
 
@@ -95,112 +102,11 @@ pub fn write_png_rgb8(path: &Path, width: u32, height: u32, rgb: &[u8]) -> Resul
     })
 }
 
-/// The folder `path` goes in (`.` for a bare file name).
-fn folder_of(path: &Path) -> &Path {
-    match path.parent() {
-        Some(d) if !d.as_os_str().is_empty() => d,
-        _ => Path::new("."),
-    }
-}
-
-/// A new temporary file beside `path`, named `.NAME.XXXXXXXX.tmp`; deleted when dropped
-/// unless persisted.
-fn temp_beside(path: &Path) -> std::io::Result<tempfile::NamedTempFile> {
-    let name = path
-        .file_name()
-        .map(|n| n.to_string_lossy().into_owned())
-        .unwrap_or_default();
-    tempfile::Builder::new()
-        .prefix(&format!(".{name}."))
-        .suffix(TEMP_SUFFIX)
-        .rand_bytes(TEMP_RAND)
-        .tempfile_in(folder_of(path))
-}
-
-/// Make sure `path` can be written before any work goes into it: create its folder if
-/// missing, and create (then remove) a temporary file there, as the final write will.
-pub fn prepare(path: &Path) -> Result<(), OutputError> {
-    let err = |message: String| OutputError::Write {
-        path: path.to_path_buf(),
-        message,
-    };
-    std::fs::create_dir_all(folder_of(path)).map_err(|e| err(e.to_string()))?;
-    if path.is_dir() {
-        return Err(err("it is a folder".into()));
-    }
-    temp_beside(path).map_err(|e| err(os_message(&e)))?;
-    Ok(())
-}
-
-/// What an I/O error says, without the temporary file's name that `tempfile` appends
-/// ("... at path \"dir/.x.png.AbCd1234.tmp\""): the message names the target instead.
-fn os_message(e: &std::io::Error) -> String {
-    let text = e.to_string();
-    match text.rfind(" at path \"") {
-        Some(at) => text[..at].to_string(),
-        None => text,
-    }
-}
-
-/// Write `path` through a temporary file beside it (`.NAME.XXXXXX.tmp`, so that the
-/// rename is atomic) that `write` fills, then a rename; on failure the temporary file is
-/// removed and the target left as it was.
-pub(crate) fn write_atomic(
-    path: &Path,
-    write: impl FnOnce(fs::File) -> Result<(), String>,
-) -> Result<(), OutputError> {
-    let err = |message: String| OutputError::Write {
-        path: path.to_path_buf(),
-        message,
-    };
-    // Dropping an unpersisted temporary file deletes it.
-    let tmp = temp_beside(path).map_err(|e| err(os_message(&e)))?;
-    let file = tmp.reopen().map_err(|e| err(e.to_string()))?;
-    write(file).map_err(err)?;
-    tmp.persist(path).map_err(|e| err(e.error.to_string()))?;
-    Ok(())
-}
-
-/// Temporary files end in this.
-const TEMP_SUFFIX: &str = ".tmp";
-/// Random characters in a temporary file's name.
-const TEMP_RAND: usize = 8;
-
 /// Write a text file through a temporary file and a rename.
 pub fn write_text(path: &Path, text: &str) -> Result<(), OutputError> {
     write_atomic(path, |mut f| {
         f.write_all(text.as_bytes()).map_err(|e| e.to_string())
     })
-}
-
-/// Remove temporary files that an earlier, killed process left for `path` (their
-/// names are `.NAME.XXXXXXXX.tmp`, see [`write_atomic`]; older versions put their
-/// process id there); returns how many went.
-pub fn remove_stale_temps(path: &Path) -> usize {
-    let (Some(dir), Some(name)) = (path.parent(), path.file_name()) else {
-        return 0;
-    };
-    let dir = if dir.as_os_str().is_empty() {
-        Path::new(".")
-    } else {
-        dir
-    };
-    let prefix = format!(".{}.", name.to_string_lossy());
-    let Ok(entries) = fs::read_dir(dir) else {
-        return 0;
-    };
-    let mut removed = 0;
-    for e in entries.flatten() {
-        let n = e.file_name().to_string_lossy().into_owned();
-        let stale = n
-            .strip_prefix(&prefix)
-            .and_then(|rest| rest.strip_suffix(TEMP_SUFFIX))
-            .is_some_and(|r| !r.is_empty() && r.bytes().all(|b| b.is_ascii_alphanumeric()));
-        if stale && fs::remove_file(e.path()).is_ok() {
-            removed += 1;
-        }
-    }
-    removed
 }
 
 /// Whether `path` holds a whole image that decodes (what a resumed batch trusts).

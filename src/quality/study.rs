@@ -11,7 +11,7 @@ use crate::render::{Aa, RenderSettings};
 use crate::run::{render_reference, render_scene};
 use crate::scene::Scene;
 use std::fmt::Write as _;
-use std::path::{Path, PathBuf};
+use std::path::Path;
 
 /// Why the study could not be run or written.
 #[derive(Debug, thiserror::Error)]
@@ -22,14 +22,6 @@ pub enum StudyError {
     /// A backend could not be built.
     #[error(transparent)]
     Accel(#[from] AccelError),
-    /// The output directory could not be created.
-    #[error("{}: cannot create: {message}", dir.display())]
-    CreateDir {
-        /// The directory.
-        dir: PathBuf,
-        /// Why.
-        message: String,
-    },
     /// The plot could not be drawn.
     #[error("plotting: {0}")]
     Plot(String),
@@ -289,8 +281,11 @@ pub fn raster(rows: &[Row], title: &str) -> Result<image::RgbImage, StudyError> 
     image::RgbImage::from_raw(w, h, buf).ok_or_else(|| StudyError::Plot("bad buffer size".into()))
 }
 
-/// Run the study and write `study.csv`, `study.svg` and `study.png` into `dir`
-/// (created).
+/// The files the study writes into its folder.
+pub const FILES: [&str; 3] = ["study.csv", "study.svg", "study.png"];
+
+/// Run the study and write `study.csv`, `study.svg` and `study.png` ([`FILES`]) into
+/// `dir` (created).
 pub fn write(
     scene: &Scene,
     name: &str,
@@ -301,15 +296,12 @@ pub fn write(
     backends: &[Backend],
 ) -> Result<Vec<Row>, StudyError> {
     let rows = run(scene, w, h, strata, backends)?;
-    std::fs::create_dir_all(dir).map_err(|e| StudyError::CreateDir {
-        dir: dir.to_path_buf(),
-        message: e.to_string(),
-    })?;
     let title = format!("{name}, {w}x{h}: error vs time");
-    crate::output::write_text(&dir.join("study.csv"), &csv(&rows))?;
-    crate::output::write_text(&dir.join("study.svg"), &svg(&rows, &title)?)?;
+    let [csv_file, svg_file, png_file] = FILES.map(|f| dir.join(f));
+    crate::output::write_text(&csv_file, &csv(&rows))?;
+    crate::output::write_text(&svg_file, &svg(&rows, &title)?)?;
     let png = raster(&rows, &title)?;
-    crate::output::write_atomic(&dir.join("study.png"), |f| {
+    crate::output::write_atomic(&png_file, |f| {
         let mut f = std::io::BufWriter::new(f);
         png.write_to(&mut f, image::ImageFormat::Png)
             .map_err(|e| e.to_string())?;

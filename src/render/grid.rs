@@ -207,6 +207,10 @@ where
     let total = tiles.len();
     let mut film = Film::new(gw, gh);
     let rows = tile_rows(&mut film.pixels, gw, ts);
+    // The count first, so that a progress bar starts at 0 of it.
+    if let Some(p) = progress {
+        p(0, total);
+    }
     // One task per tile: rayon otherwise splits the list only as far as it sees
     // threads steal, and a run of costly tiles (glass, mirrors) left in one thread's
     // last piece keeps it busy while the other waits with nothing to take.

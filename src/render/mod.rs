@@ -195,7 +195,8 @@ impl RenderStats {
     }
 }
 
-/// Called as tiles complete: `(done, total)`.
+/// Told `(0, total)` before the first tile, then `(done, total)` as tiles complete
+/// (from the worker threads, in any order).
 pub type Progress<'a> = &'a (dyn Fn(usize, usize) + Sync);
 
 /// Render `scene` through `accel` on the current rayon pool.
