@@ -98,8 +98,59 @@ fn corpus() -> Vec<(&'static str, Option<Vec<u8>>)> {
                 "children = [{ type = \"include\", file = \"nowhere.obj\" }, ",
             )),
         ),
+        ("packed.nff.gz", Some(GZIP.to_vec())),
+        ("utf16.toml", Some(utf16(&nested_csg(0)))),
         ("directory.nff", None),
     ]
+}
+
+/// The first bytes of a gzip file.
+const GZIP: &[u8] = b"\x1F\x8B\x08\x00\x00\x00\x00\x00\x00\x03";
+
+/// `text` as UTF-16 with its byte-order mark (little-endian, as Windows writes it).
+fn utf16(text: &str) -> Vec<u8> {
+    std::iter::once(0xFEFF_u16)
+        .chain(text.encode_utf16())
+        .flat_map(u16::to_le_bytes)
+        .collect()
+}
+
+/// Compressed files (whatever their name) and UTF-16 text are refused in one line that
+/// says what they are, for every format.
+#[test]
+fn compressed_and_utf16_inputs_say_what_they_are() {
+    let dir = tempfile::tempdir().unwrap();
+    let d = dir.path();
+    let cases: [(&str, Vec<u8>, &str); 5] = [
+        (
+            "a.nff.gz",
+            GZIP.to_vec(),
+            "is gzip-compressed: decompress it first (gunzip a.nff.gz)",
+        ),
+        (
+            "b.obj",
+            GZIP.to_vec(),
+            "is gzip-compressed: decompress it first (mv b.obj b.obj.gz && gunzip b.obj.gz)",
+        ),
+        ("c.toml", GZIP.to_vec(), "is gzip-compressed"),
+        ("d.nff", utf16(CAMERA), "is UTF-16 text: save it as UTF-8"),
+        (
+            "e.toml",
+            utf16(&nested_csg(0)),
+            "is UTF-16 text: save it as UTF-8",
+        ),
+    ];
+    for (name, bytes, message) in &cases {
+        std::fs::write(d.join(name), bytes).unwrap();
+        let o = emray(d, &["render", "-q", name, "-o", "out.png"]);
+        let err = String::from_utf8_lossy(&o.stderr);
+        assert_eq!(o.status.code(), Some(1), "{name}: {err}");
+        assert_eq!(err.lines().count(), 1, "{name}: {err}");
+        assert!(
+            err.starts_with(&format!("emray: error: {name}: the file ")) && err.contains(message),
+            "{name}: {err}"
+        );
+    }
 }
 
 #[test]

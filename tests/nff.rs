@@ -513,6 +513,62 @@ fn bytes_that_are_not_utf8_in_comments_are_harmless() {
     assert_eq!(load_path(&path).unwrap().geometry.spheres().len(), 1);
 }
 
+/// A UTF-8 byte-order mark at the start is skipped: the file reads as it does without
+/// one, and positions on the first line count from the character after it.
+#[test]
+fn a_byte_order_mark_is_skipped() {
+    let dir = tempfile::tempdir().unwrap();
+    let plain = dir.path().join("plain.nff");
+    let bom = dir.path().join("bom.nff");
+    let src = format!("b 0 0 1\n{V}s 0 0 0 1\n");
+    std::fs::write(&plain, &src).unwrap();
+    std::fs::write(&bom, [b"\xEF\xBB\xBF", src.as_bytes()].concat()).unwrap();
+    assert_eq!(load_path(&bom).unwrap(), load_path(&plain).unwrap());
+    std::fs::write(&bom, b"\xEF\xBB\xBFx").unwrap();
+    let e = load_path(&bom).unwrap_err();
+    assert_eq!(
+        (e.line, e.col, e.message.as_str()),
+        (1, 1, "unknown entity 'x'")
+    );
+}
+
+/// A gzip-compressed file (by its first bytes, whatever its name) and UTF-16 text are
+/// refused with a message that says what they are.
+#[test]
+fn compressed_and_utf16_files_are_refused_by_name() {
+    let dir = tempfile::tempdir().unwrap();
+    let gzip = b"\x1F\x8B\x08\x00\x00\x00\x00\x00\x00\x03\x4B\x04\x00";
+    for name in ["scene.nff.gz", "scene.nff"] {
+        let path = dir.path().join(name);
+        std::fs::write(&path, gzip).unwrap();
+        let e = load_path(&path).unwrap_err();
+        let shown = path.display().to_string();
+        assert_eq!((e.line, e.col), (0, 0), "{e}");
+        assert!(
+            e.to_string().starts_with(&format!(
+                "{shown}: the file is gzip-compressed: decompress it first ("
+            )),
+            "{e}"
+        );
+        assert!(e.message.contains(&format!("gunzip {shown}")), "{e}");
+    }
+    let path = dir.path().join("utf16.nff");
+    let utf16: Vec<u8> = [0xFEFF_u16]
+        .into_iter()
+        .chain(format!("{V}s 0 0 0 1\n").encode_utf16())
+        .flat_map(u16::to_le_bytes)
+        .collect();
+    std::fs::write(&path, utf16).unwrap();
+    let e = load_path(&path).unwrap_err();
+    assert_eq!(
+        e.to_string(),
+        format!(
+            "{}: the file is UTF-16 text: save it as UTF-8",
+            path.display()
+        )
+    );
+}
+
 // ---------------------------------------------------------------------------------
 // Errors: each with its own message and position (line 8 is the first after `V`).
 

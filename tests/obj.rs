@@ -781,6 +781,55 @@ fn crlf_line_endings_and_latin1_comments() {
     assert!(data.warnings.is_empty(), "{:?}", data.warnings);
 }
 
+/// A UTF-8 byte-order mark before the first statement of an OBJ or MTL file is
+/// skipped: the first vertex and the first material are kept, and the indices do not
+/// shift.
+#[test]
+fn byte_order_marks_are_skipped_in_obj_and_mtl_files() {
+    let bom = "\u{feff}";
+    let obj =
+        format!("{bom}v 0 0 0\nv 1 0 0\nv 0 1 0\nv 5 5 5\nmtllib lib.mtl\nusemtl red\nf 1 2 3\n");
+    let mtl = format!("{bom}newmtl red\nKd 1 0 0\n");
+    let (_dir, _path, r) = load_text(&obj, &[("lib.mtl", &mtl)]);
+    let data = r.unwrap();
+    assert!(data.warnings.is_empty(), "{:?}", data.warnings);
+    assert_eq!(data.geometry.triangles.len(), 1);
+    assert_eq!(
+        data.geometry.triangles.items[0].p,
+        [Vec3::ZERO, Vec3::X, Vec3::Y]
+    );
+    let m = data.geometry.triangles.material[0] as usize;
+    assert_eq!(data.materials[m].color, Vec3::X);
+}
+
+/// A gzip-compressed OBJ file is refused, naming the file; a compressed material
+/// library is a warning that says so.
+#[test]
+fn compressed_obj_and_mtl_files_are_named_as_such() {
+    let gzip = b"\x1F\x8B\x08\x00\x00\x00\x00\x00";
+    let obj = "mtllib lib.mtl\nusemtl red\nv 0 0 0\nv 1 0 0\nv 0 1 0\nf 1 2 3\n";
+    let dir = dir_with(&[("model.obj", obj)]);
+    std::fs::write(dir.path().join("lib.mtl"), gzip).unwrap();
+    let data = ok(&dir.path().join("model.obj"));
+    assert!(
+        data.warnings
+            .iter()
+            .any(|w| w.contains("lib.mtl") && w.contains("gzip-compressed")),
+        "{:?}",
+        data.warnings
+    );
+    let path = dir.path().join("model.obj");
+    std::fs::write(&path, gzip).unwrap();
+    let e = load_geometry(&path).unwrap_err();
+    assert!(
+        e.to_string().starts_with(&format!(
+            "{}: the file is gzip-compressed: decompress it first",
+            path.display()
+        )),
+        "{e}"
+    );
+}
+
 /// Positions are read in double precision and a model rendered alone is re-centred on
 /// the centre of its bounds: the same model a million units away loads into the same
 /// single-precision triangles, where single precision alone would have kept about a

@@ -101,6 +101,8 @@ fn nff_regressions_load_or_fail_cleanly_and_render_without_nan() {
     // Loads, and renders with its overflowing radiance clamped instead of NaN.
     assert!(!refused.iter().any(|(n, _)| n == "overflowing-colour.nff"));
     assert!(!refused.iter().any(|(n, _)| n == "huge-up.nff"));
+    // A byte-order mark before the first entity is skipped.
+    assert!(!refused.iter().any(|(n, _)| n == "bom.nff"), "{refused:?}");
 }
 
 #[test]
@@ -111,6 +113,7 @@ fn toml_regressions_load_or_fail_cleanly_and_render_without_nan() {
     let e = refusal(&refused, "far-scaled-instance.toml");
     assert!(e.contains(":18:8: this instance reaches from"), "{e}");
     assert!(!refused.iter().any(|(n, _)| n == "overflowing-light.toml"));
+    assert!(!refused.iter().any(|(n, _)| n == "bom.toml"), "{refused:?}");
 }
 
 #[test]
@@ -122,6 +125,11 @@ fn obj_regressions_load_or_fail_cleanly_and_render_without_nan() {
     assert!(e.contains(":3:9: vertex y / w = 1e30 lies outside"), "{e}");
     // An unusable `Ni` on a transparent MTL material is 1, with a warning.
     assert!(!refused.iter().any(|(n, _)| n == "glass-ni-tiny.obj"));
+    // A byte-order mark before the first vertex is skipped: the vertex is kept, so the
+    // face is the triangle at the origin.
+    let dir = Path::new(env!("CARGO_MANIFEST_DIR")).join("tests/regressions/obj");
+    let data = emray::load::obj::load_geometry(&dir.join("bom.obj")).unwrap();
+    assert!(data.bounds.max.max_element() <= 1.0, "{:?}", data.bounds);
 }
 
 /// The overflowing scenes really overflow: their renders report saturated rays (and

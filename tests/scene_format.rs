@@ -1647,6 +1647,50 @@ fn include_errors_name_the_right_file_and_line() {
     assert_eq!(e.line, marked_line(&format!("{CAMERA}{body}")), "{e}");
 }
 
+/// A UTF-8 byte-order mark is skipped in a scene file (columns on its first line count
+/// from the character after it) and in the NFF and OBJ files it includes; a
+/// gzip-compressed include is refused, naming it and where it was included from.
+#[test]
+fn byte_order_marks_are_skipped_in_scenes_and_includes() {
+    let dir = temp_dir();
+    let bom = "\u{feff}";
+    let p = write(dir.path(), "first.toml", &format!("{bom}radius = 1\n"));
+    let e = scene_toml::load(&p).unwrap_err();
+    assert_eq!((e.line, e.col), (1, 1), "{e}");
+    write(dir.path(), "part.nff", &format!("{bom}{TABLE_NFF}"));
+    write(
+        dir.path(),
+        "part.obj",
+        &format!("{bom}v 0 0 0\nv 1 0 0\nv 0 1 0\nv 9 9 9\nf 1 2 3\n"),
+    );
+    let body = "[[objects]]\ntype = \"include\"\nfile = \"part.nff\"\n\
+                [[objects]]\ntype = \"include\"\nfile = \"part.obj\"\n";
+    let main = write(dir.path(), "scene.toml", &format!("{bom}{CAMERA}{body}"));
+    let s = scene_toml::load(&main).unwrap_or_else(|e| panic!("{e}"));
+    assert_eq!(s.geometry.spheres().len(), 1);
+    // The polygon of the NFF file and the OBJ face, whose first vertex is kept.
+    assert_eq!(s.geometry.triangles.len(), 2);
+    let corners = s.geometry.triangles.items[1].p;
+    assert!(
+        corners
+            .iter()
+            .all(|&c| (c.as_dvec3() + s.origin).max_element() < 2.0),
+        "{corners:?}: a corner at 9 9 9 means the first vertex was lost"
+    );
+
+    std::fs::write(dir.path().join("packed.nff"), b"\x1F\x8B\x08\x00").unwrap();
+    let body = "[[objects]]\ntype = \"include\"\nfile = \"packed.nff\" # HERE\n";
+    let main = write(dir.path(), "packed.toml", &format!("{CAMERA}{body}"));
+    let e = scene_toml::load(&main).unwrap_err();
+    assert_eq!(e.path, dir.path().join("packed.nff"), "{e}");
+    assert!(e.message.contains("gzip-compressed"), "{e}");
+    assert!(
+        e.message
+            .contains(&format!("included from {}", main.display())),
+        "{e}"
+    );
+}
+
 #[test]
 fn settings_come_back_from_files() {
     let dir = temp_dir();

@@ -495,7 +495,7 @@ impl PeerFiles {
                 Some((db, size)) => db.generate(size),
                 // Tachyon reads NFF only.
                 None if name.ends_with(".nff") => {
-                    std::fs::read_to_string(name).map_err(|e| BenchError::io(name, "read", e))?
+                    crate::load::text::read_lossy(Path::new(name)).map_err(SceneError::Load)?
                 }
                 None => continue,
             };

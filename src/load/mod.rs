@@ -2,6 +2,7 @@
 
 pub mod nff;
 pub mod obj;
+pub(crate) mod text;
 pub mod toml;
 
 use std::fmt;

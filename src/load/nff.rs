@@ -17,7 +17,7 @@
 //! degenerate polygons are dropped with one warning per file and counted in
 //! [`LoadStats::degenerate_dropped`](crate::scene::LoadStats).
 
-use super::LoadError;
+use super::{LoadError, text};
 use crate::geometry::Kind;
 use crate::geometry::polygon::Triangulator;
 use crate::geometry::{Cone, Sphere, Triangle};
@@ -34,17 +34,12 @@ pub const MAX_PIXELS: u64 = 1 << 28;
 /// Read and parse the NFF file at `path`.
 ///
 /// # Errors
-/// `path: cannot read: …` when the file cannot be read, otherwise whatever
-/// [`parse_str`] reports. Bytes that are not UTF-8 (in comments, say) are replaced,
-/// which leaves line and column numbers intact.
+/// `path: cannot read: …` when the file cannot be read, `path: …` when it is not text
+/// (gzip-compressed, UTF-16), otherwise whatever [`parse_str`] reports. A leading
+/// UTF-8 byte-order mark is skipped, and bytes that are not UTF-8 (in comments, say)
+/// are replaced, which leaves line and column numbers intact (see [`super::text`]).
 pub fn load(path: &Path) -> Result<Scene, LoadError> {
-    let bytes = std::fs::read(path).map_err(|e| LoadError {
-        path: path.to_path_buf(),
-        line: 0,
-        col: 0,
-        message: format!("cannot read: {e}"),
-    })?;
-    parse_str(&String::from_utf8_lossy(&bytes), path)
+    parse_str(&text::read_lossy(path)?, path)
 }
 
 /// Parse NFF text; `path` only labels the errors.

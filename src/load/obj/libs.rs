@@ -7,6 +7,7 @@
 use super::mtl::{self, MtlMaterial};
 use super::parse::MtlLib;
 use super::texmap::TexStmt;
+use crate::load::text;
 use std::path::Path;
 
 /// What the libraries give, in the order read.
@@ -75,7 +76,17 @@ impl Libraries {
                 return;
             }
         };
-        let lib = mtl::parse(&String::from_utf8_lossy(&bytes), &full);
+        let text = match text::lossy(&bytes, &full) {
+            Ok(text) => text,
+            Err(e) => {
+                self.warnings.push(format!(
+                    "{at}: cannot read material library '{name}': {e}; faces using its \
+                     materials get the default grey material"
+                ));
+                return;
+            }
+        };
+        let lib = mtl::parse(&text, &full);
         self.warnings.extend(lib.warnings);
         self.read_at
             .extend(std::iter::repeat_n(line, lib.materials.len()));

@@ -26,7 +26,8 @@
 //!
 //! # Errors
 //!
-//! A file that cannot be read is an error naming it. A malformed file is an error
+//! A file that cannot be read is an error naming it, and so is a gzip-compressed file or
+//! UTF-16 text; a UTF-8 byte-order mark at the start is skipped. A malformed file is an error
 //! `path:line:col: message` at the first problem found: a coordinate that is not a
 //! number, too few or too many numbers in a `v`, `vt` or `vn`, a non-finite coordinate
 //! or normal that a face uses (`nan`, `inf`, or a number too large for `f32`; unused
@@ -58,7 +59,8 @@
 //! wins). Problems with materials never stop the load; each becomes a warning naming
 //! the file, and the faces concerned get [`DEFAULT_MATERIAL`], a mid-grey diffuse:
 //!
-//! - a library that cannot be read (its faces' materials are then missing);
+//! - a library that cannot be read, or is gzip-compressed or UTF-16 text (its faces'
+//!   materials are then missing);
 //! - a `usemtl` naming a material no library defines (one warning per name);
 //! - a malformed MTL statement (`path:line:col`): it is ignored, and a `newmtl` without
 //!   a name drops the statements up to the next `newmtl`. A colour given as one number
@@ -168,7 +170,7 @@ pub use framing::{
     AUTO_RESOLUTION, frame,
 };
 
-use super::LoadError;
+use super::{LoadError, text};
 use crate::math::{Aabb, DVec3, Vec3};
 use crate::scene::{Environment, Geometry, LoadStats, Material, Scene, Texture};
 use build::Builder;
@@ -263,10 +265,11 @@ pub fn load(path: &Path) -> Result<Scene, LoadError> {
 /// Read the OBJ file at `path` and the material libraries it names.
 ///
 /// # Errors
-/// `path: cannot read: …` when the file cannot be read, `path:line:col: …` at the
-/// first malformed statement (see the module documentation). Bytes that are not UTF-8
-/// are replaced, which leaves line numbers intact. Problems with material libraries are
-/// warnings, not errors.
+/// `path: cannot read: …` when the file cannot be read, `path: …` when it is not text
+/// (gzip-compressed, UTF-16), `path:line:col: …` at the first malformed statement (see
+/// the module documentation). A leading UTF-8 byte-order mark is skipped, and bytes
+/// that are not UTF-8 are replaced, which leaves line numbers intact (see
+/// [`super::text`]). Problems with material libraries are warnings, not errors.
 pub fn load_geometry(path: &Path) -> Result<ObjData, LoadError> {
     load_geometry_at(path, Origin::At(DVec3::ZERO))
 }
@@ -277,8 +280,7 @@ pub fn load_geometry(path: &Path) -> Result<ObjData, LoadError> {
 /// As [`load_geometry`].
 pub fn load_geometry_at(path: &Path, origin: Origin) -> Result<ObjData, LoadError> {
     let t0 = Instant::now();
-    let bytes = std::fs::read(path).map_err(|e| whole_file(path, format!("cannot read: {e}")))?;
-    let text = String::from_utf8_lossy(&bytes);
+    let text = text::read_lossy(path)?;
     let t_read = t0.elapsed();
     let mut obj = parse::parse(&text).map_err(|e| e.at(path))?;
     let t_parse = t0.elapsed();

@@ -110,14 +110,10 @@ pub(crate) fn parse_toml_file<T: serde::de::DeserializeOwned>(path: &Path) -> Re
     })
 }
 
-/// The file's bytes as text (invalid UTF-8 is an error: TOML requires UTF-8).
+/// The file's bytes as text (see [`super::text`]; invalid UTF-8 is an error: TOML
+/// requires UTF-8).
 pub(crate) fn read_text(path: &Path) -> Result<String, LoadError> {
-    let bytes = std::fs::read(path).map_err(|e| LoadError {
-        path: path.to_path_buf(),
-        line: 0,
-        col: 0,
-        message: format!("cannot read: {e}"),
-    })?;
+    let bytes = super::text::read_body(path)?;
     String::from_utf8(bytes).map_err(|e| {
         let off = e.utf8_error().valid_up_to();
         let src = String::from_utf8_lossy(e.as_bytes()).into_owned();

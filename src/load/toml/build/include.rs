@@ -15,7 +15,7 @@ use super::types::Ty;
 use super::{Builder, LOG_TARGET, R, f32v};
 use crate::geometry::Kind;
 use crate::geometry::{QuadUv, Triangle};
-use crate::load::{LoadError, nff, obj};
+use crate::load::{LoadError, nff, obj, text};
 use crate::math::Vec3;
 use crate::scene::{Geometry, Light, LoadStats, Material, SceneSources, Spot};
 use glam::{DAffine3, DMat3, DVec3};
@@ -213,8 +213,8 @@ impl Builder<'_, '_> {
     fn read_nff(&self, file: &Spanned<String>, path: &Path) -> R<Read> {
         let bytes = std::fs::read(path).map_err(|e| self.unreadable(file, path, e))?;
         let from = self.included_from(file);
-        let scene = nff::parse_str(&String::from_utf8_lossy(&bytes), path)
-            .map_err(|e| located(e, &from))?;
+        let text = text::lossy(&bytes, path).map_err(|e| located(e, &from))?;
+        let scene = nff::parse_str(&text, path).map_err(|e| located(e, &from))?;
         Ok(Read {
             geometry: scene.geometry,
             origin: scene.origin,
