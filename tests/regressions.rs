@@ -114,6 +114,8 @@ fn toml_regressions_load_or_fail_cleanly_and_render_without_nan() {
     assert!(e.contains(":18:8: this instance reaches from"), "{e}");
     assert!(!refused.iter().any(|(n, _)| n == "overflowing-light.toml"));
     assert!(!refused.iter().any(|(n, _)| n == "bom.toml"), "{refused:?}");
+    let e = refusal(&refused, "empty-patches.toml");
+    assert!(e.contains(":10:11: `patches` is empty"), "{e}");
 }
 
 #[test]

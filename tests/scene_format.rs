@@ -1908,6 +1908,100 @@ fn error_bad_sizes() {
     );
 }
 
+/// An empty list that leaves an object meaningless is an error at the list, naming
+/// its key: with it, a bezier once panicked (its default tolerance came from the
+/// bounds of no control points) or drew nothing, and a mesh or group drew nothing
+/// without a word.
+#[test]
+fn error_empty_lists() {
+    let patch = "[[0, 0, 0], [1, 0, 0], [2, 0, 0], [3, 0, 0], [0, 1, 0], [1, 1, 1], [2, 1, 1], \
+                 [3, 1, 0], [0, 2, 0], [1, 2, 1], [2, 2, 1], [3, 2, 0], [0, 3, 0], [1, 3, 0], \
+                 [2, 3, 0], [3, 3, 0]]";
+    let cases: &[(&str, &[&str])] = &[
+        (
+            "[[objects]]\ntype = \"bezier\"\npatches = [] # HERE\n",
+            &["`patches` is empty", "a bezier needs at least one patch"],
+        ),
+        (
+            "[[objects]]\ntype = \"bezier\"\ntolerance = 0.1\npatches = [] # HERE\n",
+            &["`patches` is empty"],
+        ),
+        (
+            "[[objects]]\ntype = \"mesh\"\nvertices = [] # HERE\nfaces = []\n",
+            &["`vertices` is empty", "a mesh needs at least one vertex"],
+        ),
+        (
+            "[[objects]]\ntype = \"mesh\"\nvertices = [[0, 0, 0], [1, 0, 0], [0, 1, 0]]\nfaces = [] # HERE\n",
+            &["`faces` is empty", "a mesh needs at least one face"],
+        ),
+        (
+            "[[objects]]\ntype = \"group\"\nchildren = [] # HERE\n",
+            &["`children` is empty", "a group needs at least one child"],
+        ),
+        (
+            "[[objects]]\ntype = \"group\"\nchildren = [\n  { type = \"group\", children = [] }, # HERE\n]\n",
+            &["`children` is empty"],
+        ),
+        (
+            "[define.d]\ntype = \"group\"\nchildren = [] # HERE\n[[objects]]\ntype = \"instance\"\nof = \"d\"\n",
+            &["`children` is empty"],
+        ),
+        (
+            "[define.unused]\ntype = \"mesh\"\nvertices = [] # HERE\nfaces = [[0, 1, 2]]\n",
+            &["`vertices` is empty"],
+        ),
+        (
+            "[[objects]]\ntype = \"polygon\"\nvertices = [] # HERE\n",
+            &["`vertices` is empty", "a polygon needs at least 3 vertices"],
+        ),
+        (
+            "[[objects]]\ntype = \"triangle\"\nvertices = [] # HERE\n",
+            &["`vertices` is empty", "a triangle needs exactly 3 vertices"],
+        ),
+        (
+            "[[objects]]\ntype = \"polyhedron\"\nplanes = [] # HERE\n",
+            &["`planes` is empty", "at least 4"],
+        ),
+        (
+            "[[objects]]\ntype = \"union\"\nchildren = [] # HERE\n",
+            &["`children` is empty", "a union needs at least 2 children"],
+        ),
+    ];
+    for (body, words) in cases {
+        error_at(body, words);
+    }
+    // A bezier with patches still builds.
+    let s = build(&format!(
+        "[[objects]]\ntype = \"bezier\"\npatches = [{patch}]\n"
+    ));
+    assert!(s.geometry.triangles.len() > 1);
+}
+
+/// A bezier whose control points overflow under its transforms is refused at its
+/// `type` (its default tolerance, relative to their extent, was once infinite and
+/// panicked), as is every other object that leaves the traceable range.
+#[test]
+fn error_bezier_overflowing_under_transforms() {
+    let points: Vec<String> = (0..16)
+        .map(|i| format!("[{}e8, {}, 0]", i % 4, i / 4))
+        .collect();
+    let mut node = format!(
+        "{{ type = \"bezier\", patches = [[{}]] }}",
+        points.join(", ")
+    );
+    for _ in 0..25 {
+        node = format!(
+            "{{ type = \"group\", transform = [{{ scale = 1e12 }}], children = [{node}] }}"
+        );
+    }
+    let e = parse(&format!(
+        "{CAMERA}[[objects]]\ntype = \"group\"\nchildren = [{node}]\n"
+    ))
+    .unwrap_err();
+    assert!(e.message.contains("this bezier"), "{e}");
+    assert_eq!(e.line, 6, "{e}");
+}
+
 #[test]
 fn error_bad_transforms() {
     error_at(
@@ -1970,10 +2064,8 @@ fn error_toml_syntax() {
 #[test]
 fn valid_but_surprising_inputs() {
     // Integers and floats are both numbers; a define used by nothing is still checked
-    // (and fine); an empty group is fine.
-    let s = build(
-        "[define.unused]\ntype = \"sphere\"\ncenter = [0, 0, 0]\nradius = 1\n[[objects]]\ntype = \"group\"\nchildren = []\n",
-    );
+    // (and fine).
+    let s = build("[define.unused]\ntype = \"sphere\"\ncenter = [0, 0, 0]\nradius = 1\n");
     assert_eq!(s.prim_count_with_instances(), 0);
     error_at(
         "[define.unused]\ntype = \"sphere\"\ncenter = [0, 0, 0]\nradius = 0 # HERE\n",

@@ -4,9 +4,10 @@
 
 use super::super::format::{ObjectDef, Spanned};
 use super::objects::Sink;
+use super::types::Ty;
 use super::{Builder, R, did_you_mean, v3};
 use crate::geometry::bezier::{BezierPatch, teapot_patches, tessellate};
-use glam::{DAffine3, DVec3};
+use glam::DAffine3;
 
 /// A bezier's default tessellation tolerance, relative to the diagonal of its control
 /// points' bounding box.
@@ -23,9 +24,19 @@ impl Builder<'_, '_> {
         let o = node.get_ref();
         let mut patches = self.patches(node)?;
         transform_patches(&mut patches, x);
+        // Points that overflowed would make the tolerance and the tessellation
+        // meaningless; what they would have built lies outside the traceable range.
+        if !all_finite(&patches) {
+            return Err(self.err(
+                o.ty.span(),
+                "this bezier's control points are not finite under its transforms (they \
+                 overflow)",
+            ));
+        }
         let tolerance = match &o.tolerance {
             Some(t) => self.positive(t, "bezier `tolerance`")?,
-            None => default_tolerance(&patches),
+            None => default_tolerance(&patches)
+                .ok_or_else(|| self.err(node.span(), "a bezier needs at least one patch"))?,
         };
         let mesh = tessellate(&patches, tolerance);
         let g = Self::geometry(&mut self.geometry, sink);
@@ -40,8 +51,8 @@ impl Builder<'_, '_> {
     fn patches(&self, node: &Spanned<ObjectDef>) -> R<Vec<BezierPatch>> {
         let o = node.get_ref();
         match (&o.patches, &o.builtin) {
-            (Some(p), None) => Ok(p
-                .get_ref()
+            (Some(p), None) => Ok(self
+                .non_empty(p, "patches", Ty::Bezier, "at least one patch")?
                 .iter()
                 .map(|q| {
                     let q = q.get_ref();
@@ -87,16 +98,24 @@ fn transform_patches(patches: &mut [BezierPatch], x: &DAffine3) {
     }
 }
 
-/// The default tolerance: relative to the size of the control points' bounding box.
-fn default_tolerance(patches: &[BezierPatch]) -> f64 {
-    let (lo, hi) = patches.iter().flat_map(|p| p.p.iter().flatten()).fold(
-        (DVec3::splat(f64::INFINITY), DVec3::splat(f64::NEG_INFINITY)),
-        |(lo, hi), &c| (lo.min(c), hi.max(c)),
-    );
+/// Whether every control point of `patches` is finite.
+fn all_finite(patches: &[BezierPatch]) -> bool {
+    patches
+        .iter()
+        .all(|p| p.p.iter().flatten().all(|c| c.is_finite()))
+}
+
+/// The default tolerance, relative to the diagonal of the control points' bounding box
+/// (1 when the points coincide), always positive and finite; `None` without control
+/// points, which have no extent to be relative to.
+fn default_tolerance(patches: &[BezierPatch]) -> Option<f64> {
+    let mut points = patches.iter().flat_map(|p| p.p.iter().flatten().copied());
+    let first = points.next()?;
+    let (lo, hi) = points.fold((first, first), |(lo, hi), c| (lo.min(c), hi.max(c)));
     let size = (hi - lo).length();
-    if size > 0.0 {
-        size * BEZIER_RELATIVE_TOLERANCE
+    Some(if size > 0.0 {
+        (size * BEZIER_RELATIVE_TOLERANCE).min(f64::MAX)
     } else {
         1.0
-    }
+    })
 }

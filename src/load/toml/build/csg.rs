@@ -50,6 +50,7 @@ impl<'a> Builder<'a, '_> {
     ) -> R<CsgTree> {
         let ty = Ty::Csg(op);
         let children = self.need(&node.get_ref().children, "children", node, ty)?;
+        self.non_empty(children, "children", ty, "at least 2 children")?;
         let (first, rest) = match children.get_ref().split_first() {
             Some((first, rest)) if !rest.is_empty() => (first, rest),
             _ => {

@@ -33,6 +33,7 @@ impl Builder<'_, '_> {
         } else {
             (n >= 3, "at least 3 vertices")
         };
+        self.non_empty(vertices, "vertices", ty, what)?;
         if !enough {
             return Err(self.err(
                 vertices.span(),
@@ -51,9 +52,10 @@ impl Builder<'_, '_> {
         material: u32,
         sink: &mut Sink,
     ) -> R<()> {
-        let (_, v) = self.vertices(node, Ty::Mesh)?;
+        let (vertices, v) = self.vertices(node, Ty::Mesh)?;
+        self.non_empty(vertices, "vertices", Ty::Mesh, "at least one vertex")?;
         let faces = self.need(&node.get_ref().faces, "faces", node, Ty::Mesh)?;
-        for f in faces.get_ref() {
+        for f in self.non_empty(faces, "faces", Ty::Mesh, "at least one face")? {
             let idx = f.get_ref();
             if idx.len() < 3 {
                 return Err(self.err(

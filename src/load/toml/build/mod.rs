@@ -152,9 +152,10 @@ fn f32v(v: DVec3) -> Vec3 {
     v.as_vec3()
 }
 
-/// "a sphere", "an include".
+/// "a sphere", "an include", "a union".
 fn article(name: &str) -> String {
-    let vowel = name.starts_with(['a', 'e', 'i', 'o', 'u']);
+    // A "u" that sounds "you" takes "a".
+    let vowel = name.starts_with(['a', 'e', 'i', 'o', 'u']) && !name.starts_with("uni");
     format!("{} {name}", if vowel { "an" } else { "a" })
 }
 

@@ -158,7 +158,7 @@ impl<'a> Builder<'a, '_> {
     /// `group`: its children, each placed in turn.
     fn group(&mut self, node: &'a Spanned<ObjectDef>, inner: Ctx, sink: &mut Sink) -> R<()> {
         let children = self.need(&node.get_ref().children, "children", node, Ty::Group)?;
-        for c in children.get_ref() {
+        for c in self.non_empty(children, "children", Ty::Group, "at least one child")? {
             self.walk(c, inner, sink)?;
         }
         Ok(())

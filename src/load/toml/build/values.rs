@@ -1,9 +1,10 @@
 //! The checks of single values that every part of a scene shares: numbers that must be
-//! positive or not negative, colours and sizes, directions that must not be zero. Each
-//! error is at the value's span and names it.
+//! positive or not negative, colours and sizes, directions that must not be zero, lists
+//! that must not be empty. Each error is at the value's span and names it.
 
 use super::super::format::{Real, Spanned, V3};
-use super::{Builder, DisplayPrefix, R, f32v, v3};
+use super::types::Ty;
+use super::{Builder, DisplayPrefix, R, article, f32v, v3};
 use crate::math::Vec3;
 use glam::DVec3;
 
@@ -68,6 +69,26 @@ impl Builder<'_, '_> {
                 format!("{what} must have positive components, found {x}"),
             ))
         }
+    }
+
+    /// The list `list`, the value of the key `key` of an object of type `ty`, unless it
+    /// is empty: such an object would be nothing. `needs` says what it needs (`at
+    /// least one patch`).
+    pub(super) fn non_empty<'v, T>(
+        &self,
+        list: &'v Spanned<Vec<T>>,
+        key: &str,
+        ty: Ty,
+        needs: &str,
+    ) -> R<&'v [T]> {
+        let items = list.get_ref();
+        if items.is_empty() {
+            return Err(self.err(
+                list.span(),
+                format!("`{key}` is empty: {} needs {needs}", article(ty.name())),
+            ));
+        }
+        Ok(items)
     }
 
     /// A non-zero vector, normalised.

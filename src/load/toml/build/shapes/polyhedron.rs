@@ -80,7 +80,7 @@ fn from_planes(
         ));
     }
     let mut list = Vec::with_capacity(planes.get_ref().len());
-    for p in planes.get_ref() {
+    for p in b.non_empty(planes, "planes", ty, "at least 4 planes")? {
         let [pa, pb, pc, d] = p.get_ref().map(|x| x.0);
         let n = DVec3::new(pa, pb, pc);
         if n == DVec3::ZERO {
