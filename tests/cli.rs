@@ -471,3 +471,36 @@ fn every_command_takes_quiet_and_verbose() {
         stderr(&o)
     );
 }
+
+/// A scene with no objects renders the background, with a warning naming the file; a
+/// scene with one does not warn.
+#[test]
+fn a_scene_without_objects_is_warned_about() {
+    let dir = tempfile::tempdir().unwrap();
+    let view = SCENE.split("b 0.1").next().unwrap();
+    std::fs::write(dir.path().join("empty.nff"), format!("{view}l 3 3 10\n")).unwrap();
+    std::fs::write(
+        dir.path().join("empty.toml"),
+        "[camera]\nfrom = [0, 0, 5]\nat = [0, 0, 0]\nresolution = [8, 8]\n\
+         [[lights]]\nposition = [0, 5, 5]\n",
+    )
+    .unwrap();
+    std::fs::write(dir.path().join("full.nff"), SCENE).unwrap();
+    for name in ["empty.nff", "empty.toml"] {
+        let o = emray(dir.path(), &["render", name, "-o", "out.png"]);
+        let err = stderr(&o);
+        assert!(o.status.success(), "{name}: {err}");
+        assert!(
+            err.contains(&format!(
+                "{name}: scene has no objects: the image will be the background only"
+            )),
+            "{name}: {err}"
+        );
+    }
+    let o = emray(dir.path(), &["render", "full.nff", "-o", "out.png"]);
+    assert!(
+        o.status.success() && stderr(&o).is_empty(),
+        "{}",
+        stderr(&o)
+    );
+}

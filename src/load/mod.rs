@@ -41,6 +41,17 @@ impl fmt::Display for LoadError {
 
 impl std::error::Error for LoadError {}
 
+/// Warn when `scene`, read from the file at `path`, has no object at all: it renders,
+/// but its image is the background alone, which is seldom what was meant.
+pub(crate) fn warn_if_empty(scene: &crate::scene::Scene, path: &Path) {
+    if scene.prim_count_with_instances() == 0 {
+        log::warn!(
+            "{}: scene has no objects: the image will be the background only",
+            path.display()
+        );
+    }
+}
+
 /// Load a scene file, choosing the format by extension (any case): `.toml` is the
 /// scene format ([`toml`]), `.obj` a Wavefront OBJ model framed by an automatic camera
 /// and light ([`obj::load`]); anything else is read as NFF (`.nff`, and the classic

@@ -31,7 +31,7 @@ pub const MAX_RESOLUTION_SIDE: u64 = 65_536;
 /// Largest accepted pixel count (2²⁸).
 pub const MAX_PIXELS: u64 = 1 << 28;
 
-/// Read and parse the NFF file at `path`.
+/// Read and parse the NFF file at `path`; a scene without objects is a warning.
 ///
 /// # Errors
 /// `path: cannot read: …` when the file cannot be read, `path: …` when it is not text
@@ -39,7 +39,9 @@ pub const MAX_PIXELS: u64 = 1 << 28;
 /// UTF-8 byte-order mark is skipped, and bytes that are not UTF-8 (in comments, say)
 /// are replaced, which leaves line and column numbers intact (see [`super::text`]).
 pub fn load(path: &Path) -> Result<Scene, LoadError> {
-    parse_str(&text::read_lossy(path)?, path)
+    let scene = parse_str(&text::read_lossy(path)?, path)?;
+    super::warn_if_empty(&scene, path);
+    Ok(scene)
 }
 
 /// Parse NFF text; `path` only labels the errors.

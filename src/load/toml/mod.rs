@@ -28,7 +28,7 @@ pub const MAX_SIDE: u32 = 16_384;
 /// scene itself. The command line overrides them.
 pub type SceneSettings = crate::scene::RenderHints;
 
-/// Read and build the scene file at `path`.
+/// Read and build the scene file at `path`; a scene without objects is a warning.
 ///
 /// # Errors
 /// `path: cannot read: …` when the file cannot be read, else whatever [`parse_str`]
@@ -44,7 +44,9 @@ pub fn load(path: &Path) -> Result<Scene, LoadError> {
 /// As [`load`].
 pub fn load_with_settings(path: &Path) -> Result<(Scene, SceneSettings), LoadError> {
     let text = read_text(path)?;
-    parse_str_with_settings(&text, path)
+    let (scene, settings) = parse_str_with_settings(&text, path)?;
+    super::warn_if_empty(&scene, path);
+    Ok((scene, settings))
 }
 
 /// Build a scene from TOML text. `path` labels the errors, and included files are found
