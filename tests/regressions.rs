@@ -116,6 +116,8 @@ fn toml_regressions_load_or_fail_cleanly_and_render_without_nan() {
     assert!(!refused.iter().any(|(n, _)| n == "bom.toml"), "{refused:?}");
     let e = refusal(&refused, "empty-patches.toml");
     assert!(e.contains(":10:11: `patches` is empty"), "{e}");
+    let e = refusal(&refused, "spindle-csg.toml");
+    assert!(e.contains(":12:12: a spindle torus"), "{e}");
 }
 
 #[test]

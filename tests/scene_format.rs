@@ -2052,6 +2052,55 @@ fn error_csg_of_open_surfaces() {
     );
 }
 
+/// A spindle torus (minor radius above the major one) intersects itself: what is
+/// inside it is not clear, so it is refused as a CSG operand, directly or through an
+/// instance, at its `type`.
+#[test]
+fn error_spindle_torus_in_csg() {
+    let torus = "type = \"torus\", center = [0, 0, 0], axis = [0, 1, 0], major_radius = 1";
+    error_at(
+        &format!(
+            "[[objects]]\ntype = \"union\"\nchildren = [\n  {{ type = \"sphere\", center = [0, 0, 0], radius = 1 }},\n  {{ {torus}, minor_radius = 2 }}, # HERE\n]\n"
+        ),
+        &[
+            "a spindle torus (minor radius 2 > major radius 1)",
+            "cannot be a CSG operand",
+        ],
+    );
+    error_at(
+        "[define.lemon]\ntype = \"torus\" # HERE\ncenter = [0, 0, 0]\naxis = [0, 1, 0]\nmajor_radius = 1\nminor_radius = 1.5\n\
+         [[objects]]\ntype = \"difference\"\nchildren = [\n  { type = \"sphere\", center = [0, 0, 0], radius = 3 },\n  { type = \"instance\", of = \"lemon\" },\n]\n",
+        &["spindle torus", "CSG operand"],
+    );
+    // A horn torus (equal radii) and a ring torus are operands as before.
+    let s = build(&format!(
+        "[[objects]]\ntype = \"union\"\nchildren = [\n  {{ type = \"sphere\", center = [0, 0, 0], radius = 1 }},\n  {{ {torus}, minor_radius = 1 }},\n  {{ {torus}, minor_radius = 0.5 }},\n]\n"
+    ));
+    assert_eq!(s.geometry.count(Kind::Csg), 1);
+}
+
+/// Outside CSG a spindle torus is drawn (its outer surface), with a warning at its
+/// `type`.
+#[test]
+fn spindle_torus_warns() {
+    let dir = tempfile::tempdir().unwrap();
+    std::fs::write(
+        dir.path().join("s.toml"),
+        "[camera]\nfrom = [0, 0, 9]\nat = [0, 0, 0]\nresolution = [8, 8]\n\
+         [[objects]]\ntype = \"torus\"\ncenter = [0, 0, 0]\naxis = [0, 1, 0]\nmajor_radius = 1\nminor_radius = 2\n\
+         [[objects]]\ntype = \"torus\"\ncenter = [0, 3, 0]\naxis = [0, 1, 0]\nmajor_radius = 1\nminor_radius = 1\n",
+    )
+    .unwrap();
+    let out = common::emray(dir.path(), &["render", "s.toml", "-o", "s.png"]);
+    let err = common::stderr(&out);
+    assert!(out.status.success(), "{err}");
+    assert_eq!(err.matches("spindle").count(), 1, "{err}");
+    assert!(
+        err.contains("s.toml:6:8: a spindle torus (minor radius 2 > major radius 1)"),
+        "{err}"
+    );
+}
+
 #[test]
 fn error_toml_syntax() {
     error_at(

@@ -101,6 +101,7 @@ impl<'a> Builder<'a, '_> {
             Ty::Analytic(t) => {
                 let (at, rest) = split_translation(&rel);
                 let shape = self.analytic(node, t, at)?;
+                self.refuse_spindle(node)?;
                 self.csg_leaf(node, shape, rest, material)
             }
             Ty::Group => Err(self.err(

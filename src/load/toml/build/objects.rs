@@ -150,6 +150,7 @@ impl<'a> Builder<'a, '_> {
                 let m = self.material_or_fallback(inner.material, sink);
                 let (at, rest) = split_translation(&x);
                 let shape = self.analytic(node, t, at)?;
+                self.warn_spindle(node);
                 self.place_shape(shape, &rest, m, node.get_ref().ty.span(), sink)
             }
         }
