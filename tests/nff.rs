@@ -455,6 +455,8 @@ fn second_viewpoint_warns() {
         "{}",
         w[0]
     );
+    // The first eye as the file gives it, in its coordinates and in NFF's terms.
+    assert!(w[0].ends_with("(from 0 0 -10)"), "{}", w[0]);
 }
 
 #[test]

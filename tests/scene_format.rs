@@ -2101,6 +2101,36 @@ fn spindle_torus_warns() {
     );
 }
 
+/// Messages show numbers as the file writes them, never in Rust's terms (`Vec3(1.0,
+/// 0.0, 0.0)`, `0.0`, `` ` as i128 ``).
+#[test]
+fn messages_show_plain_numbers() {
+    let rust_terms = ["Vec3", "i128", "0.0", "`"];
+    let plain = |e: LoadError| {
+        for w in rust_terms {
+            assert!(!e.message.contains(w), "`{w}` in: {e}");
+        }
+        e
+    };
+    let e = plain(error_at(
+        "[[objects]]\ntype = \"sphere\"\ncenter = [0, 0, 0]\nradius = 99999999999999999999 # HERE\n",
+        &["number too large: 99999999999999999999"],
+    ));
+    assert!(e.message.contains("99999999999999999999.0"), "{e}");
+    plain(error_at(
+        "[render]\nspp = 99999999999999999999 # HERE\n",
+        &["number too large: 99999999999999999999", "whole number"],
+    ));
+    plain(error_at(
+        "[[objects]]\ntype = \"obox\"\ncenter = [0, 0, 0]\nsize = [1, 1, 1]\naxes = [[1, 0, 0], [1, 0, 0], [0, 0.5, 1]] # HERE\n",
+        &["axes (1, 0, 0), (1, 0, 0), (0, 0.5, 1) are not orthonormal"],
+    ));
+    plain(error_at(
+        "[[objects]]\ntype = \"sphere\"\ncenter = [0, 0, 0]\nradius = 1\ntransform = [{ matrix = [[1, 0, 0, 0], [0, 1, 0, 0], [0, 0, 1, 0], [0, 0, 1.5, 1]] }] # HERE\n",
+        &["found [0, 0, 1.5, 1]"],
+    ));
+}
+
 #[test]
 fn error_toml_syntax() {
     error_at(

@@ -79,10 +79,10 @@ pub enum ShapeError {
     #[error("oriented box: rotation {0} is zero")]
     ZeroRotation(Quat),
     /// An oriented box's axes are not finite.
-    #[error("oriented box: axes {0:?} are not finite")]
+    #[error("oriented box: axes {} are not finite", show_axes(.0))]
     AxesNotFinite([Vec3; 3]),
     /// An oriented box's axes are not orthonormal.
-    #[error("oriented box: axes {0:?} are not orthonormal")]
+    #[error("oriented box: axes {} are not orthonormal", show_axes(.0))]
     AxesNotOrthonormal([Vec3; 3]),
     /// An oriented box reaches beyond f32.
     #[error("oriented box: centre {center} and half extents {half_extents} overflow")]
@@ -253,6 +253,14 @@ pub enum ShapeError {
     },
 }
 
+/// Three axes as plain numbers: `(1, 0, 0), (0, 1, 0), (0, 0, 1)`.
+fn show_axes(axes: &[Vec3; 3]) -> String {
+    axes.iter()
+        .map(|a| format!("({}, {}, {})", a.x, a.y, a.z))
+        .collect::<Vec<_>>()
+        .join(", ")
+}
+
 impl ShapeError {
     /// `shape: what value is not finite`.
     pub(super) fn parameter_not_finite(
@@ -336,6 +344,13 @@ mod tests {
         assert_eq!(
             text(OBox::new(z, Vec3::ONE, Quat::from_xyzw(0.0, 0.0, 0.0, 0.0)).unwrap_err()),
             "oriented box: rotation [0, 0, 0, 0] is zero"
+        );
+        assert_eq!(
+            text(
+                OBox::from_axes(z, Vec3::ONE, [Vec3::X, Vec3::X, Vec3::new(0.0, 0.5, 1.0)])
+                    .unwrap_err()
+            ),
+            "oriented box: axes (1, 0, 0), (1, 0, 0), (0, 0.5, 1) are not orthonormal"
         );
         assert_eq!(
             text(CappedCone::cylinder(z, Vec3::Z, -3.0, 1.0).unwrap_err()),

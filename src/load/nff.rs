@@ -449,12 +449,16 @@ impl<'a> Parser<'a, '_> {
 
     fn viewpoint(&mut self, v: &Tok<'a>) -> Result<(), LoadError> {
         if let Some(old) = self.camera {
+            // The first eye in the file's coordinates, as it wrote them.
+            let from = (old.from.as_dvec3() + self.origin).as_vec3();
             log::warn!(
-                "{}:{}:{}: a second viewpoint ('v') replaces the first (from {:?})",
+                "{}:{}:{}: a second viewpoint ('v') replaces the first (from {} {} {})",
                 self.path.display(),
                 v.line,
                 self.lex.col(v.line_start, v.start),
-                old.from
+                range::number(from.x),
+                range::number(from.y),
+                range::number(from.z)
             );
         }
         self.keyword("from")?;

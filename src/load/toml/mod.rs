@@ -200,6 +200,9 @@ fn type_message(msg: &str) -> Option<String> {
         .or_else(|| msg.strip_prefix("invalid value: "))
     {
         let (found, expected) = rest.split_once(", expected ")?;
+        if let Some(digits) = too_large(found) {
+            return Some(too_large_message(digits, expected));
+        }
         (toml_found(found), expected)
     } else {
         let rest = msg.strip_prefix("invalid length ")?;
@@ -211,6 +214,30 @@ fn type_message(msg: &str) -> Option<String> {
         "expected {}, found {found}",
         toml_expected(expected)
     ))
+}
+
+/// The digits of a whole number too large for TOML's 64-bit integers, which the toml
+/// crate reports as found ``integer `N` as i128``.
+fn too_large(found: &str) -> Option<&str> {
+    found
+        .strip_prefix("integer `")?
+        .strip_suffix("` as i128")
+        .filter(|d| !d.is_empty())
+}
+
+/// The message for a whole number too large for TOML where `expected` was wanted: a
+/// number may be written with a decimal point (`1e20`, `100000000000000000000.0`),
+/// which TOML reads as a float.
+fn too_large_message(digits: &str, expected: &str) -> String {
+    let expected = toml_expected(expected);
+    if expected.starts_with("a number") {
+        format!(
+            "number too large: {digits} (TOML whole numbers are 64-bit; write {digits}.0 \
+             to give it as a number)"
+        )
+    } else {
+        format!("number too large: {digits} (expected {expected})")
+    }
 }
 
 /// What serde says it found (`serde::de::Unexpected`), in TOML's terms.
@@ -376,6 +403,15 @@ mod tests {
             (
                 "invalid type: boolean `true`, expected a number",
                 "expected a number, found the boolean true",
+            ),
+            (
+                "invalid type: integer `99999999999999999999` as i128, expected a number",
+                "number too large: 99999999999999999999 (TOML whole numbers are 64-bit; \
+                 write 99999999999999999999.0 to give it as a number)",
+            ),
+            (
+                "invalid type: integer `-99999999999999999999` as i128, expected u32",
+                "number too large: -99999999999999999999 (expected a whole number, 0 or more)",
             ),
         ];
         for (serde, toml) in cases {

@@ -38,12 +38,12 @@ impl Builder<'_, '_> {
     pub(super) fn matrix(&self, m: &Spanned<[[Real; 4]; 4]>) -> R<DAffine3> {
         let r = m.get_ref().map(|row| row.map(|x| x.0));
         if r[3] != [0.0, 0.0, 0.0, 1.0] {
+            let [a, b, c, d] = r[3];
             return Err(self.err(
                 m.span(),
                 format!(
                     "the last row of a matrix must be [0, 0, 0, 1] (only affine transforms), \
-                     found {:?}",
-                    r[3]
+                     found [{a}, {b}, {c}, {d}]"
                 ),
             ));
         }
