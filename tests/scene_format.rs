@@ -2307,6 +2307,41 @@ fn colours_above_one_warn() {
     );
 }
 
+/// A define that an instance names anywhere (at the top level, as a CSG operand, inside
+/// another define, even one nothing places) is not warned about; one that no instance
+/// names is, once. Polygons of a define copied into another are counted once.
+#[test]
+fn only_defines_no_instance_names_are_warned_about() {
+    let dir = tempfile::tempdir().unwrap();
+    std::fs::write(
+        dir.path().join("d.toml"),
+        "[camera]\nfrom = [0, 0, 9]\nat = [0, 0, 0]\nresolution = [8, 8]\n\
+         [define.ball]\ntype = \"sphere\"\ncenter = [0, 0, 0]\nradius = 1\n\
+         [define.leaf]\ntype = \"polygon\"\nvertices = [[0, 0, 0], [1, 0, 0], [0, 1, 0]]\n\
+         [define.tree]\ntype = \"group\"\nchildren = [{ type = \"instance\", of = \"leaf\" }]\n\
+         [define.inner]\ntype = \"sphere\"\ncenter = [5, 0, 0]\nradius = 1\n\
+         [define.unplaced]\ntype = \"group\"\nchildren = [{ type = \"instance\", of = \"inner\" }]\n\
+         [define.alone]\ntype = \"sphere\"\ncenter = [0, 0, 0]\nradius = 2\n\
+         [[objects]]\ntype = \"difference\"\nchildren = [\n  { type = \"sphere\", center = [0, 0, 0], radius = 2 },\n  { type = \"instance\", of = \"ball\" },\n]\n\
+         [[objects]]\ntype = \"instance\"\nof = \"tree\"\n",
+    )
+    .unwrap();
+    let out = common::emray(dir.path(), &["render", "d.toml", "-o", "d.png", "--stats"]);
+    let err = common::stderr(&out);
+    assert!(out.status.success(), "{err}");
+    for used in ["ball", "leaf", "tree", "inner"] {
+        assert!(!err.contains(&format!("`{used}`")), "{used}: {err}");
+    }
+    assert_eq!(err.matches("is never instanced").count(), 2, "{err}");
+    assert!(
+        err.contains("define `unplaced` is never instanced"),
+        "{err}"
+    );
+    assert!(err.contains("define `alone` is never instanced"), "{err}");
+    let s = scene_toml::load(&dir.path().join("d.toml")).unwrap();
+    assert_eq!(s.load_stats.polygons, 1);
+}
+
 /// A TOML scene's frame has its origin at the eye, and its points are read in double
 /// precision: the same scene a million units away (its coordinates shifted, not a
 /// transform) builds into the same single-precision numbers, primitives placed in

@@ -1,13 +1,15 @@
 //! Defines and instances: a `[define.NAME]` placed by a top-level `instance` is
 //! compiled once into an object all its instances share; an `instance` inside a define
 //! copies the other define's content in place, which is where cycles are caught. Defines
-//! no instance places are checked all the same.
+//! that nothing expanded are checked all the same, and those that no instance names
+//! anywhere in the file are warned about.
 
-use super::super::format::{ObjectDef, Spanned};
+use super::super::format::{ObjectDef, SceneFile, Spanned};
 use super::objects::{Ctx, Sink};
 use super::types::Ty;
 use super::{Builder, DisplayPrefix, LOG_TARGET, R, did_you_mean};
 use crate::scene::{Geometry, Instance};
+use std::collections::HashSet;
 
 impl<'a> Builder<'a, '_> {
     /// The define named by `of`: its name and content.
@@ -31,6 +33,7 @@ impl<'a> Builder<'a, '_> {
 
     /// Start expanding define `name` (named by `of`), unless that is a cycle.
     pub(super) fn enter_define(&mut self, name: &'a str, of: &Spanned<String>) -> R<()> {
+        self.expanded.insert(name);
         if self.define_stack.contains(&name) {
             let mut chain: Vec<&str> = self.define_stack.clone();
             chain.push(name);
@@ -105,19 +108,24 @@ impl<'a> Builder<'a, '_> {
         Ok(o)
     }
 
-    /// Defines no top-level instance placed, warned about and still checked (in file
-    /// order), so that an error in one does not wait until it is first used.
+    /// Defines that nothing expanded, checked all the same (in file order), so that an
+    /// error in one does not wait until it is first used; those that no instance names
+    /// anywhere are warned about.
     pub(super) fn check_unused_defines(&mut self) -> R<()> {
         let file = self.file;
+        let named = instanced_names(file);
         let mut defines: Vec<_> = file.define.iter().collect();
         defines.sort_by_key(|(_, d)| d.span().start);
         for (name, def) in defines {
-            if !self.compiled.contains_key(name.as_str()) {
+            if !named.contains(name.as_str()) {
                 log::warn!(
                     target: LOG_TARGET,
                     "{}: define `{name}` is never instanced",
                     self.at(def.span()).display_prefix()
                 );
+            }
+            if !self.expanded.contains(name.as_str()) {
+                self.expanded.insert(name);
                 let mut scratch = Geometry::default();
                 self.define_stack.push(name);
                 self.walk(def, Ctx::ROOT, &mut Sink::Object(&mut scratch))?;
@@ -126,4 +134,28 @@ impl<'a> Builder<'a, '_> {
         }
         Ok(())
     }
+}
+
+/// The names of the defines that some `instance` names, anywhere in `file`: among its
+/// objects and inside every define, placed or not, at any depth (CSG operands and
+/// group children alike).
+fn instanced_names(file: &SceneFile) -> HashSet<&str> {
+    let mut names = HashSet::new();
+    let mut todo: Vec<&ObjectDef> = file
+        .objects
+        .iter()
+        .chain(file.define.values())
+        .map(Spanned::get_ref)
+        .collect();
+    while let Some(o) = todo.pop() {
+        if o.ty.get_ref() == Ty::Instance.name() {
+            if let Some(of) = &o.of {
+                names.insert(of.get_ref().as_str());
+            }
+        }
+        if let Some(children) = &o.children {
+            todo.extend(children.get_ref().iter().map(Spanned::get_ref));
+        }
+    }
+    names
 }

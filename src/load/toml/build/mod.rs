@@ -48,7 +48,7 @@ use crate::scene::{
 use glam::DVec3;
 use include::Included;
 use objects::{Ctx, Sink};
-use std::collections::HashMap;
+use std::collections::{HashMap, HashSet};
 use std::ops::Range;
 use std::path::{Path, PathBuf};
 use std::rc::Rc;
@@ -79,6 +79,9 @@ struct Builder<'a, 's> {
     compiled: HashMap<&'a str, Option<u32>>,
     /// Defines being expanded, outermost first, for cycle detection.
     define_stack: Vec<&'a str>,
+    /// Defines expanded at least once (compiled, copied into another define, or taken
+    /// as a CSG operand), and so checked.
+    expanded: HashSet<&'a str>,
     includes: HashMap<PathBuf, Rc<Included>>,
     stats: LoadStats,
     /// Position of the first dropped degenerate polygon.
@@ -182,6 +185,7 @@ impl<'a, 's> Builder<'a, 's> {
             instances: Vec::new(),
             compiled: HashMap::new(),
             define_stack: Vec::new(),
+            expanded: HashSet::new(),
             includes: HashMap::new(),
             stats: LoadStats::default(),
             first_degenerate: None,
