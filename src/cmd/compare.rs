@@ -4,6 +4,7 @@
 
 use super::Error;
 use super::args::{EncodingArg, LogArgs};
+#[cfg(feature = "quality")]
 use super::error::print;
 use std::path::PathBuf;
 

@@ -3,6 +3,7 @@
 
 use super::Error;
 use super::args::{LogArgs, parse_res};
+#[cfg(feature = "quality")]
 use super::error::print;
 use std::path::PathBuf;
 
