@@ -8,9 +8,9 @@ use criterion::{Criterion, Throughput, criterion_group, criterion_main};
 use emray::Scene;
 use emray::accel::bvh::Bvh;
 use emray::accel::{Accel, Hit};
+use emray::job::load_scene;
 use emray::math::Ray;
 use emray::render::{RayGen, RenderSettings};
-use emray::run::load_scene;
 use std::hint::black_box;
 
 const SCENES: [&str; 6] = [

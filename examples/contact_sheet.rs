@@ -21,7 +21,7 @@ fn main() {
         let mut s = RenderSettings::for_scene(&scene);
         s.width = tile;
         s.height = tile;
-        let (film, report) = emray::run::render_scene(
+        let (film, report) = emray::job::render_scene(
             db.name(),
             &scene,
             Backend::default_available(),

@@ -11,13 +11,13 @@ pub mod accel;
 pub mod batch;
 pub mod bench;
 pub mod geometry;
+pub mod job;
 pub mod load;
 pub mod math;
 pub mod output;
 pub mod quality;
 pub mod radiosity;
 pub mod render;
-pub mod run;
 pub mod scene;
 pub mod spd;
 

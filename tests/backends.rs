@@ -207,7 +207,7 @@ fn a_huge_floor_seen_from_close_by_is_whole_on_both_backends() {
         let scene = emray::load::nff::parse_str(&src, std::path::Path::new("floor.nff")).unwrap();
         let settings = emray::RenderSettings::for_scene(&scene);
         let render = |backend| {
-            emray::run::render_scene("floor", &scene, backend, &settings, 0.0, None).unwrap()
+            emray::job::render_scene("floor", &scene, backend, &settings, 0.0, None).unwrap()
         };
         let (bvh, bvh_report) = render(emray::Backend::Bvh);
         let (embree, embree_report) = render(emray::Backend::Embree);

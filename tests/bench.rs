@@ -103,7 +103,7 @@ fn bad_input_is_refused_clearly() {
 #[test]
 fn raw_casting_replays_exactly_the_rays_of_the_render() {
     // A sphereflake without transmitters: every query is a counted ray.
-    let scene = emray::run::load_scene("spd:balls?size=1").unwrap();
+    let scene = emray::job::load_scene("spd:balls?size=1").unwrap();
     let accel = emray::accel::bvh::Bvh::build(&scene);
     let mut s = RenderSettings::for_scene(&scene);
     s.width = 12;

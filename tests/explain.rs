@@ -7,11 +7,11 @@
 
 use emray::Scene;
 use emray::accel::{self, Accel, BackendOptions, WithAccel};
+use emray::job::{RenderRequest, load_scene};
 use emray::math::Rng;
 use emray::radiosity::RadiositySettings;
 use emray::render::explain::{Explanation, RayNode, explain, text};
 use emray::render::{Film, GlobalIllumination, RenderSettings, render_with_gi};
-use emray::run::{RenderRequest, load_scene};
 use std::collections::BTreeSet;
 use std::path::Path;
 

@@ -68,7 +68,7 @@ fn databases_render_on_every_backend() {
         let mut films = Vec::new();
         for &b in &backends {
             let (film, report) =
-                emray::run::render_scene(db.name(), &scene, b, &st, 0.0, None).unwrap();
+                emray::job::render_scene(db.name(), &scene, b, &st, 0.0, None).unwrap();
             assert!(report.rays["eye_hit"] > 0, "{}: nothing visible", db.name());
             films.push(film);
         }

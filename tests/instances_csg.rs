@@ -6,10 +6,10 @@
 use emray::Scene;
 use emray::accel::Backend;
 use emray::geometry::{Csg, CsgOp, CsgTree, Kind, Shape, Solid, Sphere, Triangle};
+use emray::job::render_scene;
 use emray::math::{Ray, Rng, Vec3, Xform};
 use emray::output::differing_pixels;
 use emray::render::{Film, RenderSettings};
-use emray::run::render_scene;
 use emray::scene::{Camera, Geometry, Instance, Light, Material};
 use glam::{Affine3A, Quat};
 use std::sync::Arc;

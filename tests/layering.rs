@@ -24,7 +24,7 @@ const LAYERS: &[(&str, &[&str])] = &[
     ),
     ("output", &["math", "render"]),
     (
-        "run",
+        "job",
         &[
             "math",
             "geometry",
@@ -49,19 +49,19 @@ const LAYERS: &[(&str, &[&str])] = &[
             "render",
             "radiosity",
             "output",
-            "run",
+            "job",
         ],
     ),
     (
         "bench",
         &[
-            "math", "geometry", "scene", "spd", "load", "accel", "render", "output", "run",
+            "math", "geometry", "scene", "spd", "load", "accel", "render", "output", "job",
         ],
     ),
     (
         "quality",
         &[
-            "math", "geometry", "scene", "spd", "load", "accel", "render", "output", "run",
+            "math", "geometry", "scene", "spd", "load", "accel", "render", "output", "job",
         ],
     ),
 ];
@@ -258,7 +258,7 @@ fn the_architecture_doc_lists_the_same_layers() {
         "{ARCHITECTURE}: the layer table's rows"
     );
     // "all of the above" means the modules of the rows above that are not drivers.
-    let stages = ["run", "batch", "bench", "quality"];
+    let stages = ["job", "batch", "bench", "quality"];
     let mut above: Vec<String> = Vec::new();
     for ((module, cell), (want_module, want)) in rows.iter().zip(LAYERS) {
         assert_eq!(

@@ -4,9 +4,9 @@
 //! refraction enters and leaves where it should.
 
 use emray::accel::Backend;
+use emray::job::render_scene;
 use emray::quality::stress::invariance_of;
 use emray::render::{Film, RenderSettings};
-use emray::run::render_scene;
 use glam::DVec3;
 use std::path::Path;
 

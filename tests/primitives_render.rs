@@ -8,10 +8,10 @@ use emray::geometry::{
     AaBox, CappedCone, Cone, Csg, CsgOp, CsgTree, Kind, OBox, Plane, Polyhedron, Quadric, Shape,
     Sphere, Torus,
 };
+use emray::job::render_scene;
 use emray::math::{Aabb, Vec3};
 use emray::output::differing_pixels;
 use emray::render::{Film, RenderSettings};
-use emray::run::render_scene;
 use emray::scene::{Camera, Light, Material};
 use glam::Quat;
 use std::sync::Arc;

@@ -4,13 +4,13 @@
 
 use emray::Scene;
 use emray::accel::Backend;
+use emray::job::{Report, render_scene};
 use emray::load::nff::parse_str;
 #[cfg(feature = "quality")]
 use emray::quality::metrics::compare;
 #[cfg(feature = "quality")]
 use emray::render::Aa;
 use emray::render::{Film, RenderSettings};
-use emray::run::{Report, render_scene};
 use std::path::Path;
 use std::process::Command;
 

@@ -39,7 +39,7 @@ fn renders_without_nan(path: &Path, scene: &Scene) {
     settings.area_samples = settings.area_samples.min(2);
     for backend in backends() {
         let (film, _) =
-            emray::run::render_scene("regression", scene, backend, &settings, 0.0, None)
+            emray::job::render_scene("regression", scene, backend, &settings, 0.0, None)
                 .unwrap_or_else(|e| panic!("{}: {} build: {e}", path.display(), backend.name()));
         for (i, p) in film.pixels.iter().enumerate() {
             assert!(
@@ -154,7 +154,7 @@ fn overflowing_radiance_is_saturated_and_counted() {
         let mut settings = emray::RenderSettings::for_scene(&scene);
         (settings.width, settings.height) = (8, 8);
         let (film, report) =
-            emray::run::render_scene("overflow", &scene, Backend::Bvh, &settings, 0.0, None)
+            emray::job::render_scene("overflow", &scene, Backend::Bvh, &settings, 0.0, None)
                 .unwrap();
         assert!(report.rays["saturated"] > 0, "{}", path.display());
         assert!(film.pixels.iter().all(|p| !p.is_nan()));

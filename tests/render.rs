@@ -3,9 +3,9 @@
 
 use emray::Scene;
 use emray::accel::Backend;
+use emray::job::{Report, render_scene};
 use emray::load::nff::parse_str;
 use emray::render::{Film, RenderSettings};
-use emray::run::{Report, render_scene};
 use std::path::Path;
 
 mod common;

@@ -2,9 +2,9 @@
 //! and the two backends agree on at least 99.9% of the pixels.
 
 use emray::accel::Backend;
+use emray::job::render_scene;
 use emray::output::differing_pixels;
 use emray::render::RenderSettings;
-use emray::run::render_scene;
 use std::path::Path;
 
 fn check(name: &str, w: u32, h: u32) {

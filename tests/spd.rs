@@ -31,8 +31,8 @@ fn spd_scenes_agree_across_backends() {
         s.height = 256;
         let name = path.display().to_string();
         let (a, ra) =
-            emray::run::render_scene(&name, &scene, Backend::Embree, &s, 0.0, None).unwrap();
-        let (b, rb) = emray::run::render_scene(&name, &scene, Backend::Bvh, &s, 0.0, None).unwrap();
+            emray::job::render_scene(&name, &scene, Backend::Embree, &s, 0.0, None).unwrap();
+        let (b, rb) = emray::job::render_scene(&name, &scene, Backend::Bvh, &s, 0.0, None).unwrap();
         let differ = emray::output::differing_pixels(&a, &b);
         let share = 1.0 - differ as f64 / (a.pixels.len() as f64);
         println!(
@@ -62,7 +62,7 @@ fn spd_scenes_render_on_the_bvh() {
         let mut s = RenderSettings::for_scene(&scene);
         s.width = 128;
         s.height = 128;
-        let (f, _) = emray::run::render_scene("spd", &scene, Backend::Bvh, &s, 0.0, None).unwrap();
+        let (f, _) = emray::job::render_scene("spd", &scene, Backend::Bvh, &s, 0.0, None).unwrap();
         assert!(f.pixels.iter().any(|p| p.max_element() > 0.0));
     }
 }

@@ -4,7 +4,7 @@
 //! in the SPD 3.14 README within 2%, on every backend.
 
 use emray::accel::Backend;
-use emray::run::{RenderRequest, load_scene, render_scene};
+use emray::job::{RenderRequest, load_scene, render_scene};
 use std::collections::BTreeMap;
 
 mod common;

@@ -23,9 +23,9 @@
 
 use super::{Job, JobSettings, job_output};
 use crate::accel::Backend;
+use crate::job::RenderRequest;
 use crate::load::LoadError;
 use crate::output::Encoding;
-use crate::run::RenderRequest;
 use serde::Deserialize;
 use std::path::{Path, PathBuf};
 

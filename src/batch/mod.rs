@@ -15,9 +15,9 @@ mod runner;
 pub use runner::{BatchOptions, BatchReport, Cancel, JobRecord, JobStatus, Observer, run};
 
 use crate::accel::Backend;
+use crate::job::template::{OutputName, TemplateError};
+use crate::job::{IndexOfError, RenderRequest, parse_index_of};
 use crate::output::{Encoding, OutputError};
-use crate::run::template::{OutputName, TemplateError};
-use crate::run::{IndexOfError, RenderRequest, parse_index_of};
 use crate::spd::Database;
 use std::path::{Path, PathBuf};
 

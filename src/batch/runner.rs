@@ -2,8 +2,8 @@
 //! clean stop when the [`Cancel`] flag is set.
 
 use super::Job;
+use crate::job::{Report, limits, load_scene};
 use crate::output::OutputError;
-use crate::run::{Report, limits, load_scene};
 use serde::Serialize;
 use std::path::{Path, PathBuf};
 use std::sync::atomic::{AtomicBool, AtomicUsize, Ordering};
@@ -203,7 +203,7 @@ fn render_job(
         .settings(&scene)
         .map_err(|e| format!("{name}: {e}"))?;
     limits::check(&job.scene, &scene, &settings, max_memory).map_err(|e| e.to_string())?;
-    let (film, report) = crate::run::render_scene(
+    let (film, report) = crate::job::render_scene(
         &name,
         &scene,
         job.settings.backend(),

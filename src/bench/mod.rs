@@ -9,9 +9,9 @@ pub mod raw;
 pub mod report;
 
 use crate::accel::{AccelError, Backend, BackendOptions, WithAccel};
+use crate::job::{RenderRequest, SceneError, load_scene};
 use crate::output::OutputError;
 use crate::render::RenderSettings;
-use crate::run::{RenderRequest, SceneError, load_scene};
 use crate::scene::Scene;
 use crate::spd::Database;
 use serde::{Deserialize, Serialize};
@@ -805,7 +805,7 @@ mod tests {
         assert!(r.rays.reflection > 0 && r.rays.shadow > 0);
         assert_eq!(
             r.prims,
-            crate::run::load_scene("spd:balls?size=1")
+            crate::job::load_scene("spd:balls?size=1")
                 .unwrap()
                 .prim_count_with_instances()
         );

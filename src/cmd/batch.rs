@@ -9,9 +9,9 @@ use super::progress::BatchDisplay;
 use super::{Error, outputs};
 use emray::accel::Backend;
 use emray::batch::{self, BatchOptions, BatchReport, Job, JobSettings};
+use emray::job::RenderRequest;
+use emray::job::template;
 use emray::output::Encoding;
-use emray::run::RenderRequest;
-use emray::run::template;
 use std::path::PathBuf;
 
 /// `emray batch`.
@@ -66,7 +66,7 @@ pub struct Args {
     #[arg(long)]
     pub list: bool,
     /// Refuse jobs estimated to need more memory (e.g. 8G) [default: 3/4 of RAM].
-    #[arg(long, value_name = "SIZE", value_parser = emray::run::limits::parse_size)]
+    #[arg(long, value_name = "SIZE", value_parser = emray::job::limits::parse_size)]
     pub max_memory: Option<u64>,
     /// `-q` and `-v`.
     #[command(flatten)]
@@ -118,7 +118,7 @@ pub fn run(b: Args) -> Result<(), Error> {
         report,
         max_memory: b
             .max_memory
-            .unwrap_or_else(emray::run::limits::default_max_memory),
+            .unwrap_or_else(emray::job::limits::default_max_memory),
         shard: b.shard,
     };
     let images = jobs.iter().map(|j| j.output.as_path());

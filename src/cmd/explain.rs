@@ -8,8 +8,8 @@ use super::error::print;
 use super::render::GiArg;
 use anyhow::anyhow;
 use emray::accel::{Backend, BackendOptions};
+use emray::job::{self, ExplainRunError, RenderRequest};
 use emray::render::explain::{ExplainError, Explanation, text};
-use emray::run::{self, ExplainRunError, RenderRequest};
 use emray::scene::Environment;
 use serde::Serialize;
 use std::path::PathBuf;
@@ -97,7 +97,7 @@ pub fn run(a: Args) -> Result<(), Error> {
         }
     }
     let name = a.scene.display().to_string();
-    let mut scene = run::load_scene(&a.scene)?;
+    let mut scene = job::load_scene(&a.scene)?;
     if let Some(env) = &a.envmap {
         scene.environment = Some(Environment::load(env).map_err(Error::failed)?);
     }
@@ -125,7 +125,7 @@ pub fn run(a: Args) -> Result<(), Error> {
         packet_width: a.packet_width,
     };
     let radiosity = a.gi.map(|GiArg::Radiosity| a.radiosity.settings());
-    let explanation = run::explain_pixel(&scene, options, &settings, radiosity.as_ref(), a.x, a.y)
+    let explanation = job::explain_pixel(&scene, options, &settings, radiosity.as_ref(), a.x, a.y)
         .map_err(|e| match e {
             ExplainRunError::Explain(e @ ExplainError::Outside { .. }) => {
                 Error::Usage(anyhow!("{name}: {e}"))

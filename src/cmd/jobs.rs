@@ -1,14 +1,14 @@
 //! The jobs of `emray render`: each scene with the files its render writes, named by
 //! the output templates (`-o`, `--heatmap`; the template language of `emray batch`,
-//! [`emray::run::template`]), and the check, made before any work, that no two of them
+//! [`emray::job::template`]), and the check, made before any work, that no two of them
 //! are one file.
 
 use super::insight::HeatmapArg;
 use super::render::Args;
 use anyhow::{Result, bail};
 use emray::accel::Backend;
+use emray::job::template::{OUTPUT_KEYS, OutputName, has_placeholder};
 use emray::output::heatmap::Quantity;
-use emray::run::template::{OUTPUT_KEYS, OutputName, has_placeholder};
 use std::collections::HashMap;
 use std::path::{Path, PathBuf};
 

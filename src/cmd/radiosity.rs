@@ -6,8 +6,8 @@ use super::error::print;
 use super::{Error, append_json_line, outputs, thread_pool};
 use anyhow::{Context, Result};
 use emray::accel::Backend;
+use emray::job::RenderRequest;
 use emray::output::{self, Encoding, Format};
-use emray::run::RenderRequest;
 use std::path::PathBuf;
 
 /// `emray radiosity`.

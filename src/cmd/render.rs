@@ -13,11 +13,11 @@ use anyhow::{Result, anyhow, bail};
 use clap::ValueEnum;
 use emray::Scene;
 use emray::accel::{Backend, BackendOptions};
+use emray::job::{self, Part, RenderRequest, Report, limits};
 use emray::load;
 use emray::output::{self, Format, part};
 use emray::render::aov::{AovFilm, AovSet};
 use emray::render::{Aa, Film, RenderSettings};
-use emray::run::{self, Part, RenderRequest, Report, limits};
 use emray::scene::Environment;
 use emray::spd::Database;
 use std::path::{Path, PathBuf};
@@ -118,13 +118,13 @@ pub struct Args {
     pub encoding: EncodingArg,
     /// Render only band I of N horizontal bands (I counts from 0: 0 ≤ I < N), to an EXR
     /// part for `emray merge`.
-    #[arg(long, value_name = "I/N", value_parser = emray::run::parse_tile, conflicts_with = "crop")]
+    #[arg(long, value_name = "I/N", value_parser = emray::job::parse_tile, conflicts_with = "crop")]
     pub tile: Option<(u32, u32)>,
     /// Render only columns x0..x1 and rows y0..y1 (half-open), to an EXR part.
-    #[arg(long, value_name = "x0,x1,y0,y1", value_parser = emray::run::parse_crop)]
+    #[arg(long, value_name = "x0,x1,y0,y1", value_parser = emray::job::parse_crop)]
     pub crop: Option<emray::Region>,
     /// Refuse a render estimated to need more memory (e.g. 8G) [default: 3/4 of RAM].
-    #[arg(long, value_name = "SIZE", value_parser = emray::run::limits::parse_size)]
+    #[arg(long, value_name = "SIZE", value_parser = emray::job::limits::parse_size)]
     pub max_memory: Option<u64>,
     /// Environment map for rays that leave the scene (PNG/JPEG: 2:1 latitude-longitude
     /// or a 4:3 cube cross, or a directory of six cube faces px, nx, py, ny, pz, nz),
@@ -341,7 +341,7 @@ fn scene_name(path: Option<&Path>) -> String {
 /// The scene, with `--envmap` in place of its own.
 fn load_scene(args: &Args, path: Option<&Path>) -> Result<Scene> {
     let mut scene = match path {
-        Some(p) => run::load_scene(p)?,
+        Some(p) => job::load_scene(p)?,
         None => load::nff::parse_str(DEFAULT_SCENE, Path::new("<default scene>"))?,
     };
     if let Some(env) = &args.envmap {
@@ -421,7 +421,7 @@ fn trace(
     let progress = |done: usize, total: usize| bar.set(done, total);
     if args.reference {
         let strata = (args.spp.unwrap_or(256) as f64).sqrt().floor() as u32;
-        let (film, report) = run::render_reference(name, scene, settings, strata, load_ms)
+        let (film, report) = job::render_reference(name, scene, settings, strata, load_ms)
             .map_err(|why| anyhow!("{name}: {why}"))?;
         return Ok((film, None, report));
     }
@@ -429,7 +429,7 @@ fn trace(
     if insight_wanted(args) {
         let maps = insight::heatmaps(&args.heatmap)?;
         let set = insight::gathered(args.aov.unwrap_or_default(), &maps);
-        let (film, mut aov, report) = run::render_aov(
+        let (film, mut aov, report) = job::render_aov(
             name,
             scene,
             options,
@@ -445,7 +445,7 @@ fn trace(
         return Ok((film, Some(aov), report));
     }
     let (film, report) = match &radiosity {
-        Some(rad) => run::render_two_pass(
+        Some(rad) => job::render_two_pass(
             name,
             scene,
             options,
@@ -454,7 +454,7 @@ fn trace(
             load_ms,
             Some(&progress),
         )?,
-        None => run::render_scene(name, scene, options, settings, load_ms, Some(&progress))?,
+        None => job::render_scene(name, scene, options, settings, load_ms, Some(&progress))?,
     };
     Ok((film, None, report))
 }

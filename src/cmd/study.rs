@@ -31,7 +31,7 @@ pub struct Args {
 /// Run the study and print its CSV; a bad `spd:` spec is a usage error.
 #[cfg(feature = "quality")]
 pub fn run(a: Args) -> Result<(), Error> {
-    use emray::run::{SceneError, load_scene};
+    use emray::job::{SceneError, load_scene};
     let files = emray::quality::study::FILES.map(|f| a.out.join(f));
     super::outputs::prepare(files.iter().map(PathBuf::as_path))?;
     let name = a.scene.display().to_string();

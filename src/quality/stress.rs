@@ -4,10 +4,10 @@
 use crate::accel::Accel;
 use crate::accel::Backend;
 use crate::geometry::reference as r64;
+use crate::job::render_scene;
 use crate::load::nff::{parse_str, parse_str_at};
 use crate::math::{DRay, DVec3, Ray, Rng, Vec3, next_float_down, offset_ray_origin};
 use crate::render::{Film, RayGen, RenderSettings};
-use crate::run::render_scene;
 use crate::scene::Scene;
 use std::path::Path;
 

@@ -5,10 +5,10 @@
 
 use super::metrics::{Metrics, compare};
 use crate::accel::{AccelError, Backend};
+use crate::job::{render_reference, render_scene};
 use crate::output::OutputError;
 use crate::render::reference::Unsupported;
 use crate::render::{Aa, RenderSettings};
-use crate::run::{render_reference, render_scene};
 use crate::scene::Scene;
 use std::fmt::Write as _;
 use std::path::Path;

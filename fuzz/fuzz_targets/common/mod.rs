@@ -20,7 +20,7 @@ pub fn render_has_no_nan(scene: &emray::Scene) {
     settings.area_samples = settings.area_samples.min(2);
     for &backend in BACKENDS {
         if let Ok((film, _)) =
-            emray::run::render_scene("fuzz", scene, backend, &settings, 0.0, None)
+            emray::job::render_scene("fuzz", scene, backend, &settings, 0.0, None)
         {
             for (i, p) in film.pixels.iter().enumerate() {
                 assert!(
