@@ -36,7 +36,7 @@ fn renders_without_nan(path: &Path, scene: &Scene) {
     settings.height = 5;
     settings.max_depth = settings.max_depth.min(6);
     settings.spp = 1;
-    settings.area_samples = settings.area_samples.min(2);
+    settings.area_strata = settings.area_strata.min(2);
     for backend in backends() {
         let (film, _) =
             emray::job::render_scene("regression", scene, backend, &settings, 0.0, None)

@@ -4,7 +4,7 @@
 //! in the SPD 3.14 README within 2%, on every backend.
 
 use emray::accel::Backend;
-use emray::job::{RenderRequest, load_scene, render_scene};
+use emray::job::{RenderOptions, load_scene, render_scene};
 use std::collections::BTreeMap;
 
 mod common;
@@ -27,11 +27,11 @@ const TOLERANCE: f64 = 0.02;
 fn spd_counts(db: &str, backend: Backend) -> BTreeMap<&'static str, u64> {
     let name = format!("spd:{db}");
     let scene = load_scene(&name).unwrap_or_else(|e| panic!("{name}: {e}"));
-    let request = RenderRequest {
-        spd: true,
-        ..RenderRequest::default()
+    let request = RenderOptions {
+        spd: Some(true),
+        ..RenderOptions::default()
     };
-    let settings = request.settings(&scene).expect("SPD settings");
+    let settings = request.resolve(&scene).expect("SPD settings").settings;
     let (_, report) = render_scene(&name, &scene, backend, &settings, 0.0, None)
         .unwrap_or_else(|e| panic!("{name}: {e}"));
     report.rays

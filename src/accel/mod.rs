@@ -96,7 +96,9 @@ pub trait Accel: Sync {
 }
 
 /// Which backend to build.
-#[derive(Clone, Copy, Debug, PartialEq, Eq, Hash)]
+#[derive(Clone, Copy, Debug, PartialEq, Eq, Hash, serde::Serialize, serde::Deserialize)]
+#[serde(rename_all = "lowercase")]
+#[cfg_attr(feature = "cli", derive(clap::ValueEnum))]
 pub enum Backend {
     /// Intel Embree.
     Embree,
@@ -219,6 +221,7 @@ pub fn build<W: WithAccel>(
     Clone, Copy, Debug, Default, PartialEq, Eq, Hash, serde::Serialize, serde::Deserialize,
 )]
 #[serde(rename_all = "lowercase")]
+#[cfg_attr(feature = "cli", derive(clap::ValueEnum))]
 pub enum EmbreeQuality {
     /// `RTC_BUILD_QUALITY_LOW`: a Morton-code build, fastest to build.
     Low,

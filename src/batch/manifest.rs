@@ -14,205 +14,212 @@
 //! scene = "spd:gears?size=2"
 //! output = "out/gears-hq.exr"
 //! spp = 16
+//! radiosity = { patch_size = 0.5 }
 //! ```
 //!
-//! Keys of a job (and defaults): `scene` (job only), `name` (job only), `output`,
-//! `backend` (`embree`/`bvh`), `res` (`"WxH"`), `spp`, `max_depth`, `spd`, `encoding`
-//! (`srgb`/`linear`). A job's own key wins over the default; settings given on the
-//! command line win over both.
+//! A job's keys are `scene` and `name` (a job's own), `output`, and every key of the
+//! render options ([`RenderOptions`], the command line's long options with `_` for
+//! `-`: `backend`, `res`, `spp`, `max_depth`, `spd`, `encoding`, `aov`, `heatmap`, ...,
+//! and the table `radiosity`). A job's own key wins over the default; options given on
+//! the command line win over both. Unknown keys and bad values are errors at their
+//! `file:line:col`. Relative paths (scenes, outputs, heat maps, environment maps) are
+//! relative to the manifest's folder.
 
-use super::{Job, JobSettings, job_output};
-use crate::accel::Backend;
-use crate::job::RenderRequest;
+use crate::job::template::{OutputName, TemplateError};
+use crate::job::{Job, Outputs, RenderOptions, SceneSource, Task};
 use crate::load::LoadError;
-use crate::output::Encoding;
+use crate::load::toml::{Source, read_text, serde_message};
 use serde::Deserialize;
 use std::path::{Path, PathBuf};
+use toml::Spanned;
+use toml::de::{DeTable, DeValue};
 
-/// Largest image side a manifest may ask for.
-pub const MAX_SIDE: u32 = 65536;
+/// The keys of a job that are not render options.
+const JOB_KEYS: [&str; 3] = ["scene", "name", "output"];
 
-#[derive(Clone, Copy, Debug, Deserialize, PartialEq, Eq)]
-#[serde(rename_all = "lowercase")]
-enum BackendName {
-    Embree,
-    Bvh,
-}
-
-#[derive(Clone, Copy, Debug, Deserialize, PartialEq, Eq)]
-#[serde(rename_all = "lowercase")]
-enum EncodingName {
-    Srgb,
-    Linear,
-}
-
-/// `"WxH"`, checked when read.
-#[derive(Clone, Copy, Debug, Deserialize, PartialEq, Eq)]
-#[serde(try_from = "String")]
-struct Res(u32, u32);
-
-impl TryFrom<String> for Res {
-    type Error = String;
-    fn try_from(s: String) -> Result<Self, String> {
-        let bad = || format!("res '{s}' is not WxH with sides 1..={MAX_SIDE} (e.g. \"640x480\")");
-        let (w, h) = s.split_once(['x', 'X']).ok_or_else(bad)?;
-        let (w, h): (u32, u32) = (
-            w.trim().parse().map_err(|_| bad())?,
-            h.trim().parse().map_err(|_| bad())?,
-        );
-        if w == 0 || h == 0 || w > MAX_SIDE || h > MAX_SIDE {
-            return Err(bad());
-        }
-        Ok(Res(w, h))
-    }
-}
-
-/// The settings keys, shared by the defaults and the jobs (serde cannot refuse unknown
-/// keys through `flatten`, so each table lists them).
-#[derive(Clone, Debug, Default)]
-struct Keys {
-    output: Option<String>,
-    backend: Option<BackendName>,
-    res: Option<Res>,
-    spp: Option<u32>,
-    max_depth: Option<u32>,
-    spd: Option<bool>,
-    encoding: Option<EncodingName>,
-}
-
-macro_rules! table {
-    ($(#[$m:meta])* $name:ident { $($extra:ident : $t:ty),* }) => {
-        $(#[$m])*
-        #[derive(Debug, Deserialize)]
-        #[serde(deny_unknown_fields)]
-        struct $name {
-            $($extra: $t,)*
-            output: Option<String>,
-            backend: Option<BackendName>,
-            res: Option<Res>,
-            spp: Option<u32>,
-            max_depth: Option<u32>,
-            spd: Option<bool>,
-            encoding: Option<EncodingName>,
-        }
-
-        impl $name {
-            fn keys(&self) -> Keys {
-                Keys {
-                    output: self.output.clone(),
-                    backend: self.backend,
-                    res: self.res,
-                    spp: self.spp,
-                    max_depth: self.max_depth,
-                    spd: self.spd,
-                    encoding: self.encoding,
-                }
-            }
-        }
-    };
-}
-
-table!(
-    /// One `[[job]]`.
-    JobEntry { scene: String, name: Option<String> }
-);
-table!(
-    /// The whole file: the defaults and the jobs.
-    File { job: Option<Vec<JobEntry>> }
-);
-
-/// Command-line settings that override every job's.
+/// What the command line gives every job: its output template and options, which win
+/// over the manifest's.
 #[derive(Clone, Debug, Default)]
 pub struct Overrides {
     /// Output template.
     pub output: Option<String>,
-    /// Backend.
-    pub backend: Option<Backend>,
-    /// Image size.
-    pub res: Option<(u32, u32)>,
-    /// Samples per pixel.
-    pub spp: Option<u32>,
-    /// Maximum depth.
-    pub max_depth: Option<u32>,
-    /// SPD mode (only `true` overrides).
-    pub spd: bool,
-    /// PNG encoding.
-    pub encoding: Option<Encoding>,
+    /// Render options.
+    pub options: RenderOptions,
 }
+
+/// A table of the manifest, each key and value with its place in the file.
+type Table<'t> = DeTable<'t>;
 
 /// Read the jobs of the manifest at `path`. Errors are `path:line:col: message`.
 pub fn load(path: &Path, cli: &Overrides) -> Result<Vec<Job>, LoadError> {
-    let file: File = crate::load::toml::parse_toml_file(path)?;
-    let whole = |message: String| LoadError {
-        path: path.to_path_buf(),
-        line: 0,
-        col: 0,
-        message,
-    };
-    let entries = file.job.as_deref().unwrap_or_default();
-    if entries.is_empty() {
-        return Err(whole("no [[job]] in the manifest".into()));
+    let text = read_text(path)?;
+    let source = Source::new(path, &text);
+    let doc = DeTable::parse(&text)
+        .map_err(|e| source.err(e.span().unwrap_or(0..0), serde_message(e.message())))?;
+    let (defaults, jobs) = split(&source, doc.into_inner())?;
+    if jobs.is_empty() {
+        return Err(source.err(0..0, "no [[job]] in the manifest"));
     }
     let base = path.parent().unwrap_or(Path::new(""));
-    let d = &file.keys();
-    let mut jobs = Vec::with_capacity(entries.len());
-    for (i, j) in entries.iter().enumerate() {
-        let k = &j.keys();
-        for (what, v) in [
-            ("spp", k.spp.or(d.spp)),
-            ("max_depth", k.max_depth.or(d.max_depth)),
-        ] {
-            let max = if what == "spp" { 65536 } else { 64 };
-            if v.is_some_and(|v| v == 0 || v > max) {
-                return Err(whole(format!("job {i}: {what} must be in 1..={max}")));
+    jobs.into_iter()
+        .enumerate()
+        .map(|(index, job)| {
+            let entry = Entry::read(&source, &defaults, job)?;
+            let span = entry.span.clone();
+            entry
+                .job(base, index, cli)
+                .map_err(|e| source.err(span, e.to_string()))
+        })
+        .collect()
+}
+
+/// The defaults (every top-level key but `job`) and the `[[job]]` tables.
+fn split<'t>(
+    source: &Source,
+    doc: Table<'t>,
+) -> Result<(Table<'t>, Vec<Spanned<Table<'t>>>), LoadError> {
+    let mut defaults = Table::new();
+    let mut jobs = Vec::new();
+    for (key, value) in doc {
+        let span = value.span();
+        match (key.get_ref().as_ref(), value.into_inner()) {
+            ("job", DeValue::Array(array)) => {
+                for item in array {
+                    let span = item.span();
+                    match item.into_inner() {
+                        DeValue::Table(t) => jobs.push(Spanned::new(span, t)),
+                        _ => return Err(source.err(span, "each job is a table: use [[job]]")),
+                    }
+                }
+            }
+            ("job", _) => return Err(source.err(span, "`job` is an array of tables: use [[job]]")),
+            ("scene" | "name", _) => {
+                return Err(source.err(
+                    key.span(),
+                    format!(
+                        "`{}` belongs in a [[job]], not with the defaults",
+                        key.get_ref()
+                    ),
+                ));
+            }
+            (_, v) => {
+                defaults.insert(key, Spanned::new(span, v));
             }
         }
-        let settings = JobSettings {
-            backend: cli.backend.or(k.backend.or(d.backend).map(|b| match b {
-                BackendName::Embree => Backend::Embree,
-                BackendName::Bvh => Backend::Bvh,
-            })),
-            render: RenderRequest {
-                res: cli.res.or(k.res.or(d.res).map(|r| (r.0, r.1))),
-                spp: cli.spp.or(k.spp).or(d.spp),
-                max_depth: cli.max_depth.or(k.max_depth).or(d.max_depth),
-                spd: cli.spd || k.spd.or(d.spd).unwrap_or(false),
-                ..RenderRequest::default()
-            },
-            encoding: cli.encoding.unwrap_or(match k.encoding.or(d.encoding) {
-                Some(EncodingName::Linear) => Encoding::Linear,
-                _ => Encoding::Srgb,
-            }),
-        };
-        let scene = if j.scene.starts_with("spd:") {
-            PathBuf::from(&j.scene)
+    }
+    Ok((defaults, jobs))
+}
+
+/// One `[[job]]` read: its own keys and its render options over the defaults.
+struct Entry {
+    /// Where the job's table is.
+    span: std::ops::Range<usize>,
+    scene: String,
+    name: Option<String>,
+    output: Option<String>,
+    options: RenderOptions,
+}
+
+impl Entry {
+    /// Read `job` over the `defaults`.
+    fn read(
+        source: &Source,
+        defaults: &Table<'_>,
+        job: Spanned<Table<'_>>,
+    ) -> Result<Entry, LoadError> {
+        let span = job.span();
+        let mut merged = defaults.clone();
+        for (k, v) in job.into_inner() {
+            merged.insert(k, v);
+        }
+        let mut own = [None, None, None];
+        let mut options = Table::new();
+        for (k, v) in merged {
+            match JOB_KEYS.iter().position(|j| *j == k.get_ref().as_ref()) {
+                Some(i) => own[i] = Some(text_value(source, k.get_ref(), v)?),
+                None => {
+                    options.insert(k, v);
+                }
+            }
+        }
+        let [scene, name, output] = own;
+        let scene = scene.ok_or_else(|| source.err(span.clone(), "missing key `scene`"))?;
+        let de = toml::de::Deserializer::from(Spanned::new(span.clone(), options));
+        let options = RenderOptions::deserialize(de)
+            .map_err(|e| source.err(e.span().unwrap_or(0..0), serde_message(e.message())))?;
+        Ok(Entry {
+            span,
+            scene,
+            name,
+            output,
+            options,
+        })
+    }
+
+    /// The job, the `index`th of the manifest in the folder `base`, with the command
+    /// line's overrides.
+    fn job(self, base: &Path, index: usize, cli: &Overrides) -> Result<Job, TemplateError> {
+        let scene = if self.scene.starts_with("spd:") {
+            PathBuf::from(&self.scene)
         } else {
-            base.join(&j.scene)
+            base.join(&self.scene)
         };
+        let mut own = self.options;
+        if let Some(env) = &own.envmap {
+            own.envmap = Some(base.join(env));
+        }
+        let relative_maps = cli.options.heatmap.is_empty();
+        let options = cli.options.over(&own);
+        let name = OutputName {
+            scene: &scene,
+            backend: options.backend_options().backend,
+            index,
+            spp: options.spp,
+        };
+        let from_manifest = cli.output.is_none();
         let template = cli
             .output
             .clone()
-            .or_else(|| k.output.clone())
-            .or_else(|| d.output.clone())
+            .or(self.output)
             .unwrap_or_else(|| "{stem}.png".into());
-        let out = job_output(&template, &scene, &settings, i)
-            .map_err(|e| whole(format!("job {i}: {e}")))?;
-        let output = if cli.output.is_some() {
-            PathBuf::from(&out)
-        } else {
-            base.join(&out)
+        let place = |t: &str, relative: bool| -> Result<PathBuf, TemplateError> {
+            let file = PathBuf::from(name.expand(t)?);
+            Ok(if relative { base.join(file) } else { file })
         };
-        jobs.push(Job {
-            name: j
+        let image = place(&template, from_manifest)?;
+        let heatmaps = options
+            .heatmap
+            .chunks(2)
+            .filter_map(|pair| pair.get(1))
+            .map(|t| place(t, relative_maps))
+            .collect::<Result<_, _>>()?;
+        Ok(Job {
+            name: self
                 .name
-                .clone()
-                .unwrap_or_else(|| output.to_string_lossy().into_owned()),
-            scene,
-            output,
-            settings,
-        });
+                .unwrap_or_else(|| image.to_string_lossy().into_owned()),
+            scene: SceneSource::File(scene),
+            options,
+            task: Task::Render,
+            outputs: Outputs {
+                image: Some(image),
+                heatmaps,
+                ..Outputs::default()
+            },
+        })
     }
-    Ok(jobs)
+}
+
+/// The string value of the job key `key`.
+fn text_value(
+    source: &Source,
+    key: &str,
+    value: Spanned<DeValue<'_>>,
+) -> Result<String, LoadError> {
+    let span = value.span();
+    match value.into_inner() {
+        DeValue::String(s) => Ok(s.into_owned()),
+        _ => Err(source.err(span, format!("`{key}` must be a string"))),
+    }
 }
 
 #[cfg(test)]
@@ -232,46 +239,67 @@ mod tests {
             dir.path(),
             "output = \"out/{stem}-{backend}.png\"\nbackend = \"bvh\"\nres = \"32x16\"\n\
              [[job]]\nscene = \"a.nff\"\n\
-             [[job]]\nname = \"g\"\nscene = \"spd:gears?size=1\"\nspp = 4\noutput = \"g.exr\"\n",
+             [[job]]\nname = \"g\"\nscene = \"spd:gears?size=1\"\nspp = 4\noutput = \"g.exr\"\n\
+             radiosity = { patch_size = 0.5 }\n",
         );
         let jobs = load(&p, &Overrides::default()).unwrap();
         assert_eq!(jobs.len(), 2);
-        assert_eq!(jobs[0].scene, dir.path().join("a.nff"));
-        assert_eq!(jobs[0].output, dir.path().join("out/a-bvh.png"));
-        assert_eq!(jobs[0].name, jobs[0].output.to_string_lossy());
-        assert_eq!(jobs[0].settings.render.res, Some((32, 16)));
+        let image = |j: &Job| j.outputs.image.clone().unwrap();
+        assert_eq!(jobs[0].scene, SceneSource::File(dir.path().join("a.nff")));
+        assert_eq!(image(&jobs[0]), dir.path().join("out/a-bvh.png"));
+        assert_eq!(jobs[0].name, image(&jobs[0]).to_string_lossy());
+        assert_eq!(jobs[0].options.res, Some("32x16".parse().unwrap()));
         assert_eq!(jobs[1].name, "g");
-        assert_eq!(jobs[1].scene, PathBuf::from("spd:gears?size=1"));
-        assert_eq!(jobs[1].settings.render.spp, Some(4));
+        assert_eq!(jobs[1].scene, SceneSource::File("spd:gears?size=1".into()));
+        assert_eq!(jobs[1].options.spp, Some(4));
+        assert_eq!(jobs[1].options.radiosity.patch_size, Some(0.5));
         let cli = Overrides {
-            spp: Some(2),
+            options: RenderOptions {
+                spp: Some(2),
+                ..RenderOptions::default()
+            },
             ..Overrides::default()
         };
         assert!(
             load(&p, &cli)
                 .unwrap()
                 .iter()
-                .all(|j| j.settings.render.spp == Some(2))
+                .all(|j| j.options.spp == Some(2) && j.options.backend.is_some())
         );
     }
 
     #[test]
     fn errors_name_the_line() {
         let dir = tempfile::tempdir().unwrap();
-        let p = write(dir.path(), "[[job]]\nscene = \"a.nff\"\nres = \"big\"\n");
-        let e = load(&p, &Overrides::default()).unwrap_err().to_string();
+        let err = |text: &str| {
+            let p = write(dir.path(), text);
+            load(&p, &Overrides::default()).unwrap_err().to_string()
+        };
+        let e = err("[[job]]\nscene = \"a.nff\"\nres = \"big\"\n");
         assert!(e.contains("jobs.toml:3:"), "{e}");
         assert!(e.contains("WxH"), "{e}");
-        let p = write(dir.path(), "[[job]]\nscene = \"a.nff\"\nspeed = 3\n");
-        let e = load(&p, &Overrides::default()).unwrap_err().to_string();
-        assert!(e.contains("jobs.toml:"), "{e}");
-        assert!(e.contains("speed"), "{e}");
-        let p = write(dir.path(), "output = \"x.png\"\n");
+        let e = err("[[job]]\nscene = \"a.nff\"\nspeed = 3\n");
+        assert!(e.contains("jobs.toml:3:"), "{e}");
+        assert!(e.contains("unknown key `speed`"), "{e}");
+        let e = err("spq = 3\n[[job]]\nscene = \"a.nff\"\n");
+        assert!(e.contains("jobs.toml:1:"), "{e}");
+        let e = err("[[job]]\nscene = \"a.nff\"\nradiosity = { patch = 1 }\n");
+        assert!(e.contains("jobs.toml:3:") && e.contains("`patch`"), "{e}");
+        let e = err("[[job]]\nname = \"x\"\n");
         assert!(
-            load(&p, &Overrides::default())
-                .unwrap_err()
-                .to_string()
-                .contains("no [[job]]")
+            e.contains("jobs.toml:1:") && e.contains("missing key `scene`"),
+            "{e}"
+        );
+        let e = err("scene = \"a.nff\"\n[[job]]\nscene = \"b.nff\"\n");
+        assert!(
+            e.contains("jobs.toml:1:") && e.contains("belongs in a [[job]]"),
+            "{e}"
+        );
+        assert!(err("output = \"x.png\"\n").contains("no [[job]]"));
+        let e = err("[[job]]\nscene = \"a.nff\"\noutput = \"{colour}.png\"\n");
+        assert!(
+            e.contains("jobs.toml:1:") && e.contains("'{colour}'"),
+            "{e}"
         );
     }
 }

@@ -3,43 +3,12 @@
 //! carries a hash of the scene and the settings; [`merge`] checks that the parts come
 //! from one render and cover the image exactly once.
 
-use crate::accel::Backend;
 use crate::output::aov::read_ids;
 use crate::output::channels::{Channel, read_exr_channels};
 use crate::output::part::{HASH_ATTRIBUTE, PartInfo};
+use crate::render::Film;
 use crate::render::aov::ids::IdEntry;
-use crate::render::{Film, RenderSettings};
-use crate::scene::Scene;
-use std::fmt::Write as _;
 use std::path::{Path, PathBuf};
-
-/// A `fmt::Write` sink that hashes what is written (FNV-1a 64), so a scene is hashed
-/// through its `Debug` form without building the string.
-struct Hasher(u64);
-
-impl std::fmt::Write for Hasher {
-    fn write_str(&mut self, s: &str) -> std::fmt::Result {
-        for &b in s.as_bytes() {
-            self.0 ^= b as u64;
-            self.0 = self.0.wrapping_mul(0x0000_0100_0000_01b3);
-        }
-        Ok(())
-    }
-}
-
-/// The hash of a render that parts must share: the whole scene (every value the
-/// loader produced), the settings that change pixels (not the region, not the tile
-/// size) and the backend, as 16 hex digits.
-pub fn render_hash(scene: &Scene, settings: &RenderSettings, backend: Backend) -> String {
-    let mut h = Hasher(0xcbf2_9ce4_8422_2325);
-    let s = RenderSettings {
-        region: None,
-        tile: 0,
-        ..settings.clone()
-    };
-    let _ = write!(h, "{scene:?}|{s:?}|{}", backend.name());
-    format!("{:016x}", h.0)
-}
 
 /// Why parts do not make one image.
 #[derive(Debug, thiserror::Error)]

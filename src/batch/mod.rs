@@ -14,43 +14,10 @@ mod runner;
 
 pub use runner::{BatchOptions, BatchReport, Cancel, JobRecord, JobStatus, Observer, run};
 
-use crate::accel::Backend;
-use crate::job::template::{OutputName, TemplateError};
-use crate::job::{IndexOfError, RenderRequest, parse_index_of};
-use crate::output::{Encoding, OutputError};
-use crate::spd::Database;
-use std::path::{Path, PathBuf};
-
-/// How one job renders.
-#[derive(Clone, Debug, Default, PartialEq)]
-pub struct JobSettings {
-    /// Ray-query backend (default: Embree when built in, else the BVH).
-    pub backend: Option<Backend>,
-    /// What the render asks for besides the scene (resolution, spp, depth, SPD mode).
-    pub render: RenderRequest,
-    /// PNG value encoding.
-    pub encoding: Encoding,
-}
-
-impl JobSettings {
-    /// The backend this job uses.
-    pub fn backend(&self) -> Backend {
-        self.backend.unwrap_or_else(Backend::default_available)
-    }
-}
-
-/// One render of a batch.
-#[derive(Clone, Debug, PartialEq)]
-pub struct Job {
-    /// Stable name (default: the output path as given); the shard hashes it.
-    pub name: String,
-    /// Scene file, or a generated `spd:NAME[?size=N]` scene.
-    pub scene: PathBuf,
-    /// Output image (.png or .exr).
-    pub output: PathBuf,
-    /// How to render.
-    pub settings: JobSettings,
-}
+use crate::job::template::TemplateError;
+use crate::job::{Band, Job, JobError, RenderOptions, SceneSource};
+use crate::output::OutputError;
+use std::path::PathBuf;
 
 /// Why a batch cannot be put together: found before any job runs.
 #[derive(Debug, thiserror::Error)]
@@ -69,9 +36,9 @@ pub enum BatchError {
     /// A glob that matches nothing.
     #[error("glob '{0}' matches no file")]
     NoMatch(String),
-    /// An `spd:` scene spec that names no database or a size it cannot generate.
-    #[error("{0}")]
-    Spec(#[from] crate::spd::SpecError),
+    /// A job that cannot be done, or two jobs writing one file.
+    #[error(transparent)]
+    Job(#[from] JobError),
     /// An output file of an unsupported format.
     #[error(transparent)]
     Output(#[from] OutputError),
@@ -85,37 +52,6 @@ pub enum BatchError {
         /// Their name.
         name: String,
     },
-    /// Two jobs writing one file.
-    #[error(
-        "jobs {first} and {second} write the same file '{}' (use {{stem}}, {{backend}} or \
-         {{index}} in the template)",
-        output.display()
-    )]
-    SameOutput {
-        /// The first job's index.
-        first: usize,
-        /// The second job's index.
-        second: usize,
-        /// Their output file.
-        output: PathBuf,
-    },
-}
-
-/// The output file of the job `index` rendering `scene` with `settings`, from
-/// `template` (the placeholders of [`OutputName`]).
-pub fn job_output(
-    template: &str,
-    scene: &Path,
-    settings: &JobSettings,
-    index: usize,
-) -> Result<String, TemplateError> {
-    OutputName {
-        scene,
-        backend: settings.backend(),
-        index,
-        spp: settings.render.spp,
-    }
-    .expand(template)
 }
 
 /// The 64-bit FNV-1a hash of `bytes`: fixed by its definition, the same on every
@@ -137,8 +73,8 @@ pub fn shard_of(name: &str, count: u32) -> u32 {
 }
 
 /// Parse `--shard I/N` (shard `I` of `N`, `0 <= I < N`).
-pub fn parse_shard(s: &str) -> Result<(u32, u32), IndexOfError> {
-    parse_index_of("shard", s)
+pub fn parse_shard(s: &str) -> Result<Band, String> {
+    Band::parse("shard", s)
 }
 
 /// Expand scene arguments: an argument holding `*`, `?` or `[` is a glob (sorted
@@ -165,35 +101,30 @@ pub fn expand_scene_args(args: &[PathBuf]) -> Result<Vec<PathBuf>, BatchError> {
     Ok(out)
 }
 
-/// The jobs for scene arguments rendered to `template` with `settings`.
+/// The jobs rendering `scenes` with `options` to the images `template` names, each
+/// named by its image's path.
 pub fn jobs_from_scenes(
     scenes: &[PathBuf],
     template: &str,
-    settings: &JobSettings,
+    options: &RenderOptions,
 ) -> Result<Vec<Job>, BatchError> {
-    scenes
-        .iter()
-        .enumerate()
-        .map(|(i, s)| {
-            let out = job_output(template, s, settings, i)?;
-            Ok(Job {
-                name: out.clone(),
-                scene: s.clone(),
-                output: PathBuf::from(out),
-                settings: settings.clone(),
-            })
-        })
-        .collect()
+    let sources = scenes.iter().cloned().map(SceneSource::File).collect();
+    let mut jobs = crate::job::plan(sources, Some(template), options)?;
+    for job in &mut jobs {
+        if let Some(image) = &job.outputs.image {
+            job.name = image.display().to_string();
+        }
+    }
+    Ok(jobs)
 }
 
-/// Refuse a batch whose jobs share a name or an output file, or write an unsupported
-/// format, before anything runs.
+/// Refuse a batch whose jobs share a name or a file, or cannot be done (a scene spec
+/// that names no database, options out of range, an unsupported format), before
+/// anything runs.
 pub fn check_jobs(jobs: &[Job]) -> Result<(), BatchError> {
     let mut names = std::collections::HashMap::new();
-    let mut outputs = std::collections::HashMap::new();
     for (i, j) in jobs.iter().enumerate() {
-        crate::output::Format::from_path(&j.output)?;
-        Database::parse_spec(&j.scene.to_string_lossy()).map_err(BatchError::Spec)?;
+        j.check()?;
         if let Some(k) = names.insert(j.name.as_str(), i) {
             return Err(BatchError::SameName {
                 first: k,
@@ -201,14 +132,8 @@ pub fn check_jobs(jobs: &[Job]) -> Result<(), BatchError> {
                 name: j.name.clone(),
             });
         }
-        if let Some(k) = outputs.insert(j.output.as_path(), i) {
-            return Err(BatchError::SameOutput {
-                first: k,
-                second: i,
-                output: j.output.clone(),
-            });
-        }
     }
+    crate::job::check_distinct(jobs)?;
     Ok(())
 }
 
@@ -224,21 +149,21 @@ mod tests {
     }
 
     #[test]
-    fn jobs_name_their_outputs_with_their_settings() {
-        let s = JobSettings {
-            backend: Some(Backend::Bvh),
-            render: RenderRequest {
-                spp: Some(4),
-                ..RenderRequest::default()
-            },
-            ..JobSettings::default()
+    fn jobs_name_their_outputs_with_their_options() {
+        let o = RenderOptions {
+            backend: Some(crate::accel::Backend::Bvh),
+            spp: Some(4),
+            ..RenderOptions::default()
         };
-        let p = Path::new("dir/balls.nff");
-        assert_eq!(
-            job_output("out/{stem}-{backend}-{spp}-{index}.exr", p, &s, 3).unwrap(),
-            "out/balls-bvh-4-3.exr"
-        );
-        let e = jobs_from_scenes(&[p.to_path_buf()], "{colour}.png", &s).unwrap_err();
+        let p = PathBuf::from("dir/balls.nff");
+        let jobs = jobs_from_scenes(
+            &[p.clone(), p.clone(), p.clone(), p.clone()],
+            "out/{stem}-{backend}-{spp}-{index}.exr",
+            &o,
+        )
+        .unwrap();
+        assert_eq!(jobs[3].name, "out/balls-bvh-4-3.exr");
+        let e = jobs_from_scenes(&[p], "{colour}.png", &o).unwrap_err();
         assert!(
             e.to_string().contains("unknown placeholder '{colour}'"),
             "{e}"
@@ -247,9 +172,9 @@ mod tests {
 
     #[test]
     fn shards_parse() {
-        assert_eq!(parse_shard("2/5"), Ok((2, 5)));
+        assert_eq!(parse_shard("2/5"), Ok(Band { index: 2, count: 5 }));
         assert_eq!(
-            parse_shard("5/5").unwrap_err().to_string(),
+            parse_shard("5/5").unwrap_err(),
             "shard '5/5': need 0 <= I < N"
         );
         assert!(parse_shard("1/0").is_err());
@@ -258,19 +183,21 @@ mod tests {
 
     #[test]
     fn duplicate_names_and_outputs_are_refused() {
-        let job = |name: &str, out: &str| Job {
-            name: name.into(),
-            scene: "a.nff".into(),
-            output: out.into(),
-            settings: JobSettings::default(),
+        let job = |name: &str, out: &str| {
+            let mut j = Job::render(
+                SceneSource::File("a.nff".into()),
+                RenderOptions::default(),
+                Some(out.into()),
+            );
+            j.name = name.into();
+            j
         };
         let e = check_jobs(&[job("a", "a.png"), job("a", "b.png")]).unwrap_err();
         assert_eq!(e.to_string(), "jobs 0 and 1 have the same name 'a'");
         let e = check_jobs(&[job("a", "a.png"), job("b", "a.png")]).unwrap_err();
         assert_eq!(
             e.to_string(),
-            "jobs 0 and 1 write the same file 'a.png' (use {stem}, {backend} or {index} in \
-             the template)"
+            "a and b would both write a.png: use an output template that tells them apart"
         );
     }
 }

@@ -1,8 +1,7 @@
 //! Running a batch: workers, the JSON report, progress through an [`Observer`], and a
 //! clean stop when the [`Cancel`] flag is set.
 
-use super::Job;
-use crate::job::{Report, limits, load_scene};
+use crate::job::{Event, Job, Rendered, Report};
 use crate::output::OutputError;
 use serde::Serialize;
 use std::path::{Path, PathBuf};
@@ -21,8 +20,6 @@ pub struct BatchOptions {
     pub skip_existing: bool,
     /// Where the JSON report goes, rewritten after every job.
     pub report: Option<PathBuf>,
-    /// Refuse a job whose estimated memory exceeds this many bytes.
-    pub max_memory: u64,
     /// The shard `I/N` being run, for the report.
     pub shard: Option<(u32, u32)>,
 }
@@ -70,8 +67,13 @@ impl JobRecord {
         JobRecord {
             index,
             name: job.name.clone(),
-            scene: job.scene.to_string_lossy().into_owned(),
-            output: job.output.to_string_lossy().into_owned(),
+            scene: job.scene.name(),
+            output: job
+                .outputs
+                .image
+                .as_ref()
+                .map(|p| p.to_string_lossy().into_owned())
+                .unwrap_or_default(),
             status: JobStatus::NotRun,
             wall_ms: 0.0,
             stats: None,
@@ -189,30 +191,15 @@ enum Msg {
     Finished(Box<JobRecord>),
 }
 
-/// Load and render one job; the error is the report's `error`.
-fn render_job(
-    job: &Job,
-    max_memory: u64,
-    progress: &(dyn Fn(usize, usize) + Sync),
-) -> Result<(crate::render::Film, Report), String> {
-    let t0 = Instant::now();
-    let scene = load_scene(&job.scene).map_err(|e| e.to_string())?;
-    let load_ms = t0.elapsed().as_secs_f64() * 1e3;
-    let name = job.scene.to_string_lossy();
-    let settings = (job.settings.render)
-        .settings(&scene)
-        .map_err(|e| format!("{name}: {e}"))?;
-    limits::check(&job.scene, &scene, &settings, max_memory).map_err(|e| e.to_string())?;
-    let (film, report) = crate::job::render_scene(
-        &name,
-        &scene,
-        job.settings.backend(),
-        &settings,
-        load_ms,
-        Some(progress),
-    )
-    .map_err(|e| format!("{name}: {e}"))?;
-    Ok((film, report))
+/// Load and render one job, telling `progress` of its tiles; the error is the
+/// report's `error`.
+fn render_job(job: &Job, progress: &(dyn Fn(usize, usize) + Sync)) -> Result<Rendered, String> {
+    let observer = |e: Event<'_>| {
+        if let Event::Tiles { done, total } = e {
+            progress(done, total)
+        }
+    };
+    crate::job::render(job, &observer).map_err(|e| e.to_string())
 }
 
 fn panic_message(p: &(dyn std::any::Any + Send)) -> String {
@@ -264,16 +251,19 @@ fn run_job(
     tx: &mpsc::Sender<Msg>,
 ) -> Option<JobRecord> {
     let t0 = Instant::now();
-    crate::output::remove_stale_temps(&job.output);
+    for file in job.files() {
+        crate::output::remove_stale_temps(&file);
+    }
     let mut record = JobRecord::not_run(i, job);
     record.status = JobStatus::Ok;
-    if shared.opts.skip_existing && crate::output::is_complete_image(&job.output) {
+    let whole = |p: &PathBuf| crate::output::is_complete_image(p);
+    if shared.opts.skip_existing && job.outputs.image.as_ref().is_some_and(whole) {
         record.status = JobStatus::Skipped;
         record.wall_ms = t0.elapsed().as_secs_f64() * 1e3;
         return Some(record);
     }
     // An output that cannot be written fails the job before it renders.
-    if let Err(e) = crate::output::prepare(&job.output) {
+    if let Err(e) = job.prepare() {
         record.status = JobStatus::Failed;
         record.error = Some(e.to_string());
         record.wall_ms = t0.elapsed().as_secs_f64() * 1e3;
@@ -284,7 +274,7 @@ fn run_job(
         let _ = txp.send(Msg::Progress(i, d, t));
     };
     let result = std::panic::catch_unwind(std::panic::AssertUnwindSafe(|| {
-        pool.install(|| render_job(job, shared.opts.max_memory, &progress))
+        pool.install(|| render_job(job, &progress))
     }));
     // The image is written and the job reported with the gate held shared, and not at
     // all once the batch is cancelled (see `Shared::write_gate`).
@@ -293,10 +283,10 @@ fn run_job(
         return None;
     }
     let result = result.map(|r| {
-        r.and_then(|(film, report)| {
+        r.and_then(|rendered| {
             let _ = tx.send(Msg::Writing(i));
-            crate::output::write_image(&job.output, &film, job.settings.encoding)
-                .map(|()| report)
+            crate::job::write(job, &rendered, &())
+                .map(|()| rendered.report)
                 .map_err(|e| e.to_string())
         })
     });
@@ -310,7 +300,7 @@ fn run_job(
             record.status = JobStatus::Failed;
             record.error = Some(format!(
                 "{}: internal error: {}",
-                job.scene.display(),
+                job.scene.name(),
                 panic_message(&*p)
             ));
         }

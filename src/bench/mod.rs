@@ -8,8 +8,10 @@ pub mod peer;
 pub mod raw;
 pub mod report;
 
-use crate::accel::{AccelError, Backend, BackendOptions, WithAccel};
-use crate::job::{RenderRequest, SceneError, load_scene};
+use crate::accel::{AccelError, Backend, WithAccel};
+use crate::job::{
+    Event, Job, JobError, OptionsError, RenderOptions, SceneError, SceneSource, load_scene,
+};
 use crate::output::OutputError;
 use crate::render::RenderSettings;
 use crate::scene::Scene;
@@ -17,6 +19,7 @@ use crate::spd::Database;
 use serde::{Deserialize, Serialize};
 use std::path::{Path, PathBuf};
 use std::process::Command;
+use std::sync::{Arc, Mutex};
 use std::time::Instant;
 
 /// Why a benchmark (or one of its runs) failed.
@@ -28,9 +31,6 @@ pub enum BenchError {
     /// A scene file that is not there.
     #[error("{0}: no such scene file")]
     NoSuchScene(String),
-    /// A backend name other than `embree` and `bvh`.
-    #[error("unknown backend '{0}' (embree or bvh)")]
-    UnknownBackend(String),
     /// The worker threads could not be started.
     #[error("cannot start {threads} threads: {message}")]
     Threads {
@@ -42,6 +42,12 @@ pub enum BenchError {
     /// The backend could not be built.
     #[error(transparent)]
     Accel(#[from] AccelError),
+    /// The render options cannot be met.
+    #[error(transparent)]
+    Options(#[from] OptionsError),
+    /// The render failed.
+    #[error(transparent)]
+    Job(#[from] JobError),
     /// The child process could not be started.
     #[error("cannot run {}: {message}", exe.display())]
     Spawn {
@@ -129,27 +135,10 @@ pub enum Mode {
 pub struct RunSpec {
     /// Scene: `spd:NAME[?size=N]` or a scene file.
     pub scene: String,
-    /// Backend name (`embree` or `bvh`).
-    pub backend: String,
     /// Worker threads.
     pub threads: usize,
-    /// Image width.
-    pub width: u32,
-    /// Image height.
-    pub height: u32,
-    /// SPD testing mode.
-    pub spd: bool,
     /// What to measure.
     pub mode: Mode,
-    /// Embree build quality.
-    #[serde(default)]
-    pub embree_quality: crate::accel::EmbreeQuality,
-    /// Eye rays per packet (see [`RenderSettings::packet_width`]).
-    #[serde(default = "default_packet_width")]
-    pub packet_width: u32,
-    /// Embree without `RTC_SCENE_FLAG_ROBUST` (the renderer's default sets it).
-    #[serde(default)]
-    pub embree_fast: bool,
     /// Eye rays only: one ray per pixel centre (never SPD mode), the scene's lights
     /// removed and the ray tree cut at depth 1, so that a render casts its camera rays
     /// and nothing else, and render ÷ raw is the cost of
@@ -157,12 +146,29 @@ pub struct RunSpec {
     /// the same rays.
     #[serde(default)]
     pub eye_only: bool,
+    /// The render options, the backend among them ([`Config::options`]); a run saved
+    /// by a version that described it otherwise reads as the defaults.
+    #[serde(default)]
+    pub options: RenderOptions,
 }
 
-/// What runs recorded before `packet_width` existed are read with: the renderer's
-/// default.
-fn default_packet_width() -> u32 {
-    8
+impl RunSpec {
+    /// The backend's name.
+    pub fn backend(&self) -> &'static str {
+        self.options.backend_options().backend.name()
+    }
+
+    /// The options the run renders with: its own, with depth 1 and no SPD mode for
+    /// eye rays alone.
+    fn render_options(&self) -> RenderOptions {
+        let mut o = self.options.clone();
+        if self.eye_only {
+            o.max_depth = Some(1);
+            // SPD mode's corner rays and fixed depth are not eye rays alone.
+            o.spd = Some(false);
+        }
+        o
+    }
 }
 
 /// Rays by type, as the render counted them.
@@ -221,45 +227,15 @@ pub struct RunResult {
     pub accel_bytes: usize,
 }
 
-fn backend_named(name: &str) -> Result<Backend, BenchError> {
-    match name {
-        "embree" => Ok(Backend::Embree),
-        "bvh" => Ok(Backend::Bvh),
-        _ => Err(BenchError::UnknownBackend(name.to_string())),
-    }
-}
-
 /// What a child measured of its render or raw casting.
 struct Measure {
+    prims: usize,
     build_ms: f64,
     ms: f64,
     counts: crate::render::RayCounts,
     stats: crate::accel::AccelStats,
     cpu_ms: Option<f64>,
     steal_ms: Option<f64>,
-}
-
-/// The render, its CPU and stolen time measured around the render alone.
-struct RenderWork<'a> {
-    scene: &'a Scene,
-    settings: &'a RenderSettings,
-}
-
-impl WithAccel for RenderWork<'_> {
-    type Output = Measure;
-    fn run<A: crate::accel::Accel>(self, accel: &A, build_ms: f64) -> Measure {
-        let mark = cpu::Mark::now();
-        let (_, stats) = crate::render::render(self.scene, accel, self.settings, None);
-        let (cpu_ms, steal_ms) = mark.elapsed();
-        Measure {
-            build_ms,
-            ms: stats.render_ms,
-            counts: stats.rays,
-            stats: accel.stats(),
-            cpu_ms,
-            steal_ms,
-        }
-    }
 }
 
 /// The raw-casting work: record the render's queries, then cast them timed.
@@ -276,6 +252,7 @@ impl WithAccel for RawWork<'_> {
         let cast = raw::cast(accel, &queries);
         let (cpu_ms, steal_ms) = mark.elapsed();
         Measure {
+            prims: 0,
             build_ms,
             ms: cast.ms,
             counts,
@@ -286,27 +263,8 @@ impl WithAccel for RawWork<'_> {
     }
 }
 
-/// The settings of every run: the image size asked for, one sample per pixel, depth 5
-/// and the full ray tree (no bailout) whatever the scene file says, so that runs of
-/// every version measure the same work; SPD mode if asked.
-fn run_settings(spec: &RunSpec, scene: &Scene) -> RenderSettings {
-    let request = RenderRequest {
-        res: Some((spec.width, spec.height)),
-        spp: Some(1),
-        max_depth: Some(if spec.eye_only { 1 } else { 5 }),
-        // SPD mode's corner rays and fixed depth are not eye rays alone.
-        spd: spec.spd && !spec.eye_only,
-        bailout: Some(0.0),
-        ..RenderRequest::default()
-    };
-    request
-        .settings(scene)
-        .expect("a request without a part fits every scene")
-}
-
 /// Do one run in this process (the child side of `emray bench`).
 pub fn run_child(spec: &RunSpec) -> Result<RunResult, BenchError> {
-    let backend = backend_named(&spec.backend)?;
     let pool = rayon::ThreadPoolBuilder::new()
         .num_threads(spec.threads.max(1))
         .build()
@@ -320,37 +278,19 @@ pub fn run_child(spec: &RunSpec) -> Result<RunResult, BenchError> {
         scene.lights.clear();
     }
     let load_ms = t0.elapsed().as_secs_f64() * 1e3;
-    let settings = run_settings(spec, &scene);
-    let options = BackendOptions {
-        backend,
-        embree_quality: spec.embree_quality,
-        embree_robust: !spec.embree_fast,
-        packet_width: spec.packet_width,
-    };
-    let (scene_ref, settings_ref) = (&scene, &settings);
+    let options = spec.render_options();
     let m = pool.install(|| match spec.mode {
-        Mode::Render => {
-            let work = RenderWork {
-                scene: scene_ref,
-                settings: settings_ref,
-            };
-            crate::accel::build(scene_ref, &options, work)
-        }
-        Mode::Raw => {
-            let work = RawWork {
-                scene: scene_ref,
-                settings: settings_ref,
-            };
-            crate::accel::build(scene_ref, &options, work)
-        }
+        Mode::Render => measure_render(&spec.scene, scene, options.clone()),
+        Mode::Raw => measure_raw(&scene, &options),
     })?;
-    let accel = match (backend, spec.packet_width) {
-        (Backend::Embree, 0) => format!("{}, eye rays one by one", m.stats.detail),
-        (Backend::Embree, w) => format!("{}, eye rays in packets of {w}", m.stats.detail),
+    let packet_width = options.backend_options().packet_width;
+    let accel = match (spec.backend(), packet_width) {
+        ("embree", 0) => format!("{}, eye rays one by one", m.stats.detail),
+        ("embree", w) => format!("{}, eye rays in packets of {w}", m.stats.detail),
         _ => m.stats.detail.clone(),
     };
     Ok(RunResult {
-        prims: scene.prim_count_with_instances(),
+        prims: m.prims,
         load_ms,
         build_ms: m.build_ms,
         ms: m.ms,
@@ -361,6 +301,55 @@ pub fn run_child(spec: &RunSpec) -> Result<RunResult, BenchError> {
         steal_ms: m.steal_ms,
         accel_bytes: m.stats.bytes,
     })
+}
+
+/// The render of a [`Job`] of the loaded `scene`, its CPU and stolen time measured
+/// around the render phase alone.
+fn measure_render(name: &str, scene: Scene, options: RenderOptions) -> Result<Measure, BenchError> {
+    let prims = scene.prim_count_with_instances();
+    let source = SceneSource::Loaded {
+        name: name.to_string(),
+        scene: Arc::new(scene),
+    };
+    let job = Job::render(source, options, None);
+    let mark: Mutex<Option<cpu::Mark>> = Mutex::new(None);
+    let times: Mutex<(Option<f64>, Option<f64>)> = Mutex::new((None, None));
+    let observer = |e: Event<'_>| {
+        let mut m = mark.lock().unwrap_or_else(|e| e.into_inner());
+        match e {
+            Event::Rendering => *m = Some(cpu::Mark::now()),
+            Event::Rendered => {
+                if let Some(start) = m.take() {
+                    *times.lock().unwrap_or_else(|e| e.into_inner()) = start.elapsed();
+                }
+            }
+            _ => {}
+        }
+    };
+    let rendered = crate::job::render(&job, &observer)?;
+    let (cpu_ms, steal_ms) = *times.lock().unwrap_or_else(|e| e.into_inner());
+    let r = &rendered.report;
+    Ok(Measure {
+        prims,
+        build_ms: r.time_ms.build,
+        ms: r.time_ms.render,
+        counts: rendered.rays,
+        stats: rendered.accel.clone(),
+        cpu_ms,
+        steal_ms,
+    })
+}
+
+/// The render's rays recorded, then cast again with no shading, timed.
+fn measure_raw(scene: &Scene, options: &RenderOptions) -> Result<Measure, BenchError> {
+    let resolved = options.resolve(scene)?;
+    let work = RawWork {
+        scene,
+        settings: &resolved.settings,
+    };
+    let mut m = crate::accel::build(scene, &resolved.backend, work)?;
+    m.prims = scene.prim_count_with_instances();
+    Ok(m)
 }
 
 /// This process's peak resident set size in KiB, from `/proc/self/status` (Linux).
@@ -386,7 +375,7 @@ pub fn run_in_child(exe: &Path, spec: &RunSpec) -> Result<RunResult, BenchError>
     if !out.status.success() {
         return Err(BenchError::RunFailed {
             scene: spec.scene.clone(),
-            backend: spec.backend.clone(),
+            backend: spec.backend().to_string(),
             threads: spec.threads,
             mode: spec.mode,
             status: out.status.to_string(),
@@ -412,24 +401,51 @@ pub struct Config {
     pub threads: Vec<usize>,
     /// Repetitions of every run.
     pub reps: usize,
-    /// Image width.
-    pub width: u32,
-    /// Image height.
-    pub height: u32,
-    /// SPD testing mode.
-    pub spd: bool,
     /// Also measure raw casting.
     pub raw: bool,
     /// Also run the Tachyon peer when installed.
     pub peer: bool,
-    /// Embree build quality.
-    pub embree_quality: crate::accel::EmbreeQuality,
-    /// Eye rays per packet (see [`RenderSettings::packet_width`]).
-    pub packet_width: u32,
-    /// Embree without `RTC_SCENE_FLAG_ROBUST`.
-    pub embree_fast: bool,
     /// Eye rays only (see [`RunSpec::eye_only`]).
     pub eye_only: bool,
+    /// The render options of every run (the backend aside, which each run sets):
+    /// what the command line asks for over the suite's own rules ([`Config::rules`]).
+    pub options: RenderOptions,
+}
+
+impl Config {
+    /// The suite's rules, under the options asked for: 512 × 512 in SPD mode, one
+    /// sample per pixel, depth 5 and the full ray tree (no bailout) whatever the scene
+    /// file says, so that runs of every version measure the same work.
+    pub fn rules() -> RenderOptions {
+        RenderOptions {
+            res: Some(crate::job::Res {
+                width: 512,
+                height: 512,
+            }),
+            spd: Some(true),
+            spp: Some(1),
+            max_depth: Some(5),
+            bailout: Some(0.0),
+            ..RenderOptions::default()
+        }
+    }
+
+    /// The image size of every run.
+    pub fn res(&self) -> (u32, u32) {
+        let r = self.options.res.unwrap_or(crate::job::Res {
+            width: 512,
+            height: 512,
+        });
+        (r.width, r.height)
+    }
+
+    /// The options of a run on `backend`.
+    fn run_options(&self, backend: Backend) -> RenderOptions {
+        RenderOptions {
+            backend: Some(backend),
+            ..self.options.clone()
+        }
+    }
 }
 
 /// The default suite: the eight SPD scenes at their default sizes, then balls and jacks
@@ -567,22 +583,16 @@ pub fn run_suite(
                     for &mode in modes {
                         let spec = RunSpec {
                             scene: scene.clone(),
-                            backend: backend.name().to_string(),
                             threads,
-                            width: cfg.width,
-                            height: cfg.height,
-                            spd: cfg.spd,
                             mode,
-                            embree_quality: cfg.embree_quality,
-                            packet_width: cfg.packet_width,
-                            embree_fast: cfg.embree_fast,
                             eye_only: cfg.eye_only,
+                            options: cfg.run_options(backend),
                         };
                         let result = run_in_child(exe, &spec)?;
                         log(&format!(
                             "rep {} {scene} {} {threads}t {mode:?}: {:.1} ms",
                             rep + 1,
-                            spec.backend,
+                            spec.backend(),
                             result.ms
                         ));
                         m.samples.push(Sample { spec, rep, result });
@@ -592,7 +602,8 @@ pub fn run_suite(
                     continue;
                 };
                 let image = nff.with_extension("ppm");
-                let t = peer::run(nff, &image, cfg.width, cfg.height, threads)?;
+                let (width, height) = cfg.res();
+                let t = peer::run(nff, &image, width, height, threads)?;
                 let emray_ms = run_peer_emray(cfg, exe, nff, threads)?;
                 log(&format!(
                     "rep {} {scene} tachyon {threads}t: {:.1} ms (emray on its file {:.1} ms)",
@@ -628,16 +639,13 @@ fn run_peer_emray(cfg: &Config, exe: &Path, nff: &Path, threads: usize) -> Resul
     };
     let spec = RunSpec {
         scene: nff.to_string_lossy().into_owned(),
-        backend: backend.name().to_string(),
         threads,
-        width: cfg.width,
-        height: cfg.height,
-        spd: false,
         mode: Mode::Render,
-        embree_quality: cfg.embree_quality,
-        packet_width: cfg.packet_width,
-        embree_fast: cfg.embree_fast,
         eye_only: false,
+        options: RenderOptions {
+            spd: Some(false),
+            ..cfg.run_options(backend)
+        },
     };
     Ok(run_in_child(exe, &spec)?.ms)
 }
@@ -651,7 +659,7 @@ fn peer_framing(nff: &Path, image: &Path, cfg: &Config) -> Result<f64, BenchErro
         action: "read",
         message: "not a binary 8-bit PPM".into(),
     })?;
-    if (w, h) != (cfg.width, cfg.height) {
+    if (w, h) != cfg.res() {
         return Ok(0.0);
     }
     Ok(peer::framing(&scene, w, h, &rgb))
@@ -785,16 +793,14 @@ mod tests {
     fn child_run_measures_and_counts() {
         let spec = RunSpec {
             scene: "spd:balls?size=1".into(),
-            backend: "bvh".into(),
             threads: 1,
-            width: 16,
-            height: 16,
-            spd: true,
             mode: Mode::Render,
-            embree_quality: Default::default(),
-            packet_width: 8,
-            embree_fast: false,
             eye_only: false,
+            options: RenderOptions {
+                backend: Some(Backend::Bvh),
+                res: Some("16x16".parse().unwrap()),
+                ..Config::rules()
+            },
         };
         let r = run_child(&spec).unwrap();
         assert_eq!(r.rays.eye, 17 * 17);
@@ -832,7 +838,7 @@ mod tests {
         assert_eq!(raw.rays, e.rays);
         assert!(
             run_child(&RunSpec {
-                backend: "nope".into(),
+                scene: "spd:nope".into(),
                 ..spec
             })
             .is_err()

@@ -97,7 +97,11 @@ pub fn rows(samples: &[Sample]) -> Vec<Row> {
     let mut order: Vec<(String, String, usize)> = Vec::new();
     let mut groups: BTreeMap<(String, String, usize), Vec<&Sample>> = BTreeMap::new();
     for s in samples {
-        let key = (s.spec.scene.clone(), s.spec.backend.clone(), s.spec.threads);
+        let key = (
+            s.spec.scene.clone(),
+            s.spec.backend().to_string(),
+            s.spec.threads,
+        );
         if !groups.contains_key(&key) {
             order.push(key.clone());
         }
@@ -681,16 +685,16 @@ mod tests {
         Sample {
             spec: RunSpec {
                 scene: scene.into(),
-                backend: backend.into(),
                 threads,
-                width: 8,
-                height: 8,
-                spd: false,
                 mode,
-                embree_quality: Default::default(),
-                packet_width: 8,
-                embree_fast: false,
                 eye_only: false,
+                options: crate::job::RenderOptions {
+                    backend: Some(match backend {
+                        "bvh" => crate::accel::Backend::Bvh,
+                        _ => crate::accel::Backend::Embree,
+                    }),
+                    ..Default::default()
+                },
             },
             rep: 0,
             result: RunResult {

@@ -173,6 +173,21 @@ pub fn write_heatmap(
     write_png_rgb8(path, pic.width, pic.height, &pic.rgb)
 }
 
+/// Write the heat map of what a render's variables `aov` gathered of `q` to the PNG
+/// `path`.
+pub fn write_aov_heatmap(
+    path: &Path,
+    aov: &crate::render::aov::AovFilm,
+    q: Quantity,
+) -> Result<(), OutputError> {
+    let values = match q {
+        Quantity::Rays => &aov.rays,
+        Quantity::Time => &aov.time,
+        Quantity::Depth => &aov.tree_depth,
+    };
+    write_heatmap(path, values, aov.width, aov.height, q)
+}
+
 #[cfg(test)]
 mod tests {
     use super::*;

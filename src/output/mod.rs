@@ -109,6 +109,26 @@ pub fn write_text(path: &Path, text: &str) -> Result<(), OutputError> {
     })
 }
 
+/// Append `value` as one JSON line to `path` (the statistics log: one record per
+/// render), creating the file and its folder if missing.
+pub fn append_json_line(path: &Path, value: &impl serde::Serialize) -> Result<(), OutputError> {
+    let err = |e: std::io::Error| OutputError::Write {
+        path: path.to_path_buf(),
+        message: e.to_string(),
+    };
+    let line = match serde_json::to_string(value) {
+        Ok(l) => l,
+        Err(e) => unreachable!("a report serialises: {e}"),
+    };
+    create_folder(path)?;
+    let mut f = std::fs::OpenOptions::new()
+        .create(true)
+        .append(true)
+        .open(path)
+        .map_err(err)?;
+    writeln!(f, "{line}").map_err(err)
+}
+
 /// Whether `path` holds a whole image that decodes (what a resumed batch trusts).
 pub fn is_complete_image(path: &Path) -> bool {
     match Format::from_path(path) {

@@ -496,7 +496,7 @@ impl RadiosityReport {
     }
 }
 
-fn solve_and_view<A: Accel>(
+pub(crate) fn solve_and_view<A: Accel>(
     scene: &Scene,
     accel: &A,
     settings: &RadiositySettings,

@@ -5,7 +5,9 @@
 use super::Film;
 
 /// How linear values become 8-bit values.
-#[derive(Clone, Copy, Debug, Default, PartialEq, Eq)]
+#[derive(Clone, Copy, Debug, Default, PartialEq, Eq, serde::Serialize, serde::Deserialize)]
+#[serde(rename_all = "lowercase")]
+#[cfg_attr(feature = "cli", derive(clap::ValueEnum))]
 pub enum Encoding {
     /// Linear values through the sRGB transfer curve (what image viewers expect).
     #[default]

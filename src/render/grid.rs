@@ -55,9 +55,18 @@ where
     let raygen = RayGen::new(&tracer.scene.camera, at.full.0, at.full.1);
     let (ox, oy) = at.origin;
     let (gw, gh) = at.size;
-    let (grid, recs) = sample_grid(ox, oy, gw, gh, settings.tile, progress, new, |t, out, r| {
-        tracer.tile(&raygen, t, &mut |v| out.push(v), r);
-    });
+    let (grid, recs) = sample_grid(
+        ox,
+        oy,
+        gw,
+        gh,
+        settings.tile_size,
+        progress,
+        new,
+        |t, out, r| {
+            tracer.tile(&raygen, t, &mut |v| out.push(v), r);
+        },
+    );
     let film = if settings.spd {
         grid.average_corners()
     } else {
@@ -85,7 +94,7 @@ pub(super) fn adaptive_render<A: Accel>(
         r.y0,
         cw,
         ch,
-        settings.tile,
+        settings.tile_size,
         None,
         RayCounts::default,
         corner,
@@ -107,7 +116,7 @@ pub(super) fn adaptive_render<A: Accel>(
         r.y0,
         rw,
         rh,
-        settings.tile,
+        settings.tile_size,
         progress,
         RayCounts::default,
         refine,

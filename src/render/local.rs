@@ -100,7 +100,7 @@ impl<A: Accel> Tracer<'_, A> {
                 self.accel,
                 &self.area_lights,
                 at,
-                self.area_samples,
+                self.area_strata,
                 path,
                 rec,
             );

@@ -44,10 +44,11 @@ pub struct RenderSettings {
     /// SPD testing mode: `(w+1) × (h+1)` corner rays, each pixel the mean of its four
     /// corners; the corner grid's outer rows span the camera's angle.
     pub spd: bool,
-    /// Tile edge in pixels.
-    pub tile: u32,
-    /// Shadow rays per emitting triangle (area light): `area_samples²`, stratified.
-    pub area_samples: u32,
+    /// The edge of the square tiles the image is rendered in, in pixels.
+    pub tile_size: u32,
+    /// Shadow rays per emitting triangle (area light): `area_strata²`, stratified
+    /// (`area_strata` per axis).
+    pub area_strata: u32,
     /// Antialiasing: uniform `spp` samples per pixel, or adaptive subdivision.
     pub aa: Aa,
     /// Hall & Greenberg's adaptive ray-tree depth: a reflected or refracted ray whose
@@ -132,6 +133,21 @@ pub enum Aa {
     },
 }
 
+/// Samples per pixel when neither the options nor the scene file give them.
+pub const DEFAULT_SPP: u32 = 1;
+/// Ray-tree depth when neither the options nor the scene file give one.
+pub const DEFAULT_MAX_DEPTH: u32 = 5;
+/// Tile edge in pixels.
+pub const DEFAULT_TILE_SIZE: u32 = 16;
+/// Shadow rays per emitting triangle (area light) when none are asked for: 4 × 4
+/// strata.
+pub const DEFAULT_AREA_SAMPLES: u32 = 16;
+/// Image side in SPD testing mode when no resolution is asked for: 512 × 512 pixels
+/// from a 513 × 513 grid of corner rays.
+pub const SPD_SIDE: u32 = 512;
+/// Ray-tree depth in SPD testing mode, whatever the options or the scene say.
+pub const SPD_MAX_DEPTH: u32 = 5;
+
 /// Default `--bailout` outside SPD mode: a ray contributing less than this share of
 /// its radiance cannot move an 8-bit pixel of radiance up to about 2.
 pub const DEFAULT_BAILOUT: f32 = 1e-3;
@@ -141,17 +157,18 @@ pub const DEFAULT_AA_THRESHOLD: f32 = 0.05;
 pub const DEFAULT_AA_DEPTH: u32 = 2;
 
 impl RenderSettings {
-    /// Defaults for `scene`: its resolution, 1 spp, depth 5, 16×16 tiles, uniform
-    /// sampling, no bailout (the full ray tree), skips on.
+    /// Defaults for `scene`: its resolution, [`DEFAULT_SPP`], [`DEFAULT_MAX_DEPTH`],
+    /// tiles of [`DEFAULT_TILE_SIZE`], [`DEFAULT_AREA_SAMPLES`], uniform sampling, no
+    /// bailout (the full ray tree), skips on.
     pub fn for_scene(scene: &Scene) -> Self {
         RenderSettings {
             width: scene.camera.width,
             height: scene.camera.height,
-            spp: 1,
-            max_depth: 5,
+            spp: DEFAULT_SPP,
+            max_depth: DEFAULT_MAX_DEPTH,
             spd: false,
-            tile: 16,
-            area_samples: 4,
+            tile_size: DEFAULT_TILE_SIZE,
+            area_strata: DEFAULT_AREA_SAMPLES.isqrt(),
             aa: Aa::Uniform,
             bailout: 0.0,
             skip: true,

@@ -19,8 +19,8 @@ pub(super) struct Tracer<'a, A: Accel> {
     spp: u32,
     /// Emitting triangles, sampled as area lights.
     pub(super) area_lights: Vec<area::AreaLight>,
-    /// Shadow rays per area light: `area_samples²`.
-    pub(super) area_samples: u32,
+    /// Shadow rays per area light: `area_strata²` (`area_strata` per axis).
+    pub(super) area_strata: u32,
     /// Two-pass mode: the diffuse term of the surfaces this solution covers.
     gi: Option<&'a dyn GlobalIllumination>,
     /// Hall & Greenberg's adaptive tree depth: no secondary ray whose weight (largest
@@ -84,7 +84,7 @@ impl<'a, A: Accel> Tracer<'a, A> {
             max_depth: s.max_depth.max(1),
             spp: s.spp.max(1),
             area_lights: area::collect(scene),
-            area_samples: s.area_samples,
+            area_strata: s.area_strata,
             gi: None,
             bailout: if s.bailout.is_finite() {
                 s.bailout.max(0.0)

@@ -17,7 +17,7 @@ pub fn render_has_no_nan(scene: &emray::Scene) {
     settings.height = 5;
     settings.max_depth = settings.max_depth.min(6);
     settings.spp = 1;
-    settings.area_samples = settings.area_samples.min(2);
+    settings.area_strata = settings.area_strata.min(2);
     for &backend in BACKENDS {
         if let Ok((film, _)) =
             emray::job::render_scene("fuzz", scene, backend, &settings, 0.0, None)

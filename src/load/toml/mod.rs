@@ -101,17 +101,6 @@ fn parse_file_in(source: &Source) -> Result<SceneFile, LoadError> {
     })
 }
 
-/// Read and deserialise a TOML file other than a scene (a batch manifest), with errors
-/// at their `path:line:col`.
-pub(crate) fn parse_toml_file<T: serde::de::DeserializeOwned>(path: &Path) -> Result<T, LoadError> {
-    let text = read_text(path)?;
-    let source = Source::new(path, &text);
-    ::toml::from_str::<T>(&text).map_err(|e| {
-        let span = e.span().unwrap_or(0..0);
-        source.err(span, serde_message(e.message()))
-    })
-}
-
 /// The file's bytes as text (see [`super::text`]; invalid UTF-8 is an error: TOML
 /// requires UTF-8).
 pub(crate) fn read_text(path: &Path) -> Result<String, LoadError> {
@@ -131,7 +120,7 @@ pub(crate) struct Source<'a> {
 }
 
 impl<'a> Source<'a> {
-    fn new(path: &'a Path, text: &'a str) -> Self {
+    pub(crate) fn new(path: &'a Path, text: &'a str) -> Self {
         let mut line_starts = vec![0];
         line_starts.extend(text.match_indices('\n').map(|(i, _)| i + 1));
         Source {
@@ -155,7 +144,7 @@ impl<'a> Source<'a> {
     }
 
     /// An error at the start of `span`.
-    fn err(&self, span: Range<usize>, message: impl Into<String>) -> LoadError {
+    pub(crate) fn err(&self, span: Range<usize>, message: impl Into<String>) -> LoadError {
         let (line, col) = self.position(span.start);
         LoadError {
             path: self.path.to_path_buf(),
@@ -168,7 +157,7 @@ impl<'a> Source<'a> {
 
 /// A serde/TOML message made to read like the rest: "key" rather than "field", with a
 /// suggestion for a misspelt key, and on one line.
-fn serde_message(msg: &str) -> String {
+pub(crate) fn serde_message(msg: &str) -> String {
     let msg = msg.trim().replace('\n', "; ");
     if let Some(rest) = msg.strip_prefix("unknown field ") {
         let names: Vec<&str> = rest.split('`').skip(1).step_by(2).collect();

@@ -51,10 +51,15 @@ impl AovSet {
         "depth", "normal", "albedo", "position", "id", "rays", "time",
     ];
 
-    /// Add the variable named `name` (one of [`AovSet::NAMES`]); `false` if there is
-    /// none of that name.
-    pub fn add(&mut self, name: &str) -> bool {
-        let flag = match name {
+    /// Whether the variable named `name` (one of [`AovSet::NAMES`]) is in the set.
+    pub fn has(&self, name: &str) -> bool {
+        let mut copy = *self;
+        copy.flag(name).is_some_and(|f| *f)
+    }
+
+    /// The flag of the variable named `name`.
+    fn flag(&mut self, name: &str) -> Option<&mut bool> {
+        Some(match name {
             "depth" => &mut self.depth,
             "normal" => &mut self.normal,
             "albedo" => &mut self.albedo,
@@ -62,10 +67,14 @@ impl AovSet {
             "id" => &mut self.id,
             "rays" => &mut self.rays,
             "time" => &mut self.time,
-            _ => return false,
-        };
-        *flag = true;
-        true
+            _ => return None,
+        })
+    }
+
+    /// Add the variable named `name` (one of [`AovSet::NAMES`]); `false` if there is
+    /// none of that name.
+    pub fn add(&mut self, name: &str) -> bool {
+        self.flag(name).map(|f| *f = true).is_some()
     }
 
     /// Whether any variable is wanted.
@@ -224,7 +233,12 @@ pub fn render_aov<A: Accel>(
     }
     let at = Positions::of(settings);
     let (gw, gh) = at.size;
-    let cells = grid::scatter(gw, gh, settings.tile, recs.into_iter().map(|r| r.cells));
+    let cells = grid::scatter(
+        gw,
+        gh,
+        settings.tile_size,
+        recs.into_iter().map(|r| r.cells),
+    );
     let cells = if settings.spd {
         corner_cells(&cells, gw, gh)
     } else {

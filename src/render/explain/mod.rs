@@ -332,7 +332,7 @@ pub fn explain<A: Accel>(
     let mut rec = ExplainRecorder::new(scene, wanted.clone(), share);
     let mut tiles: Vec<Region> = Vec::new();
     for &(i, j) in &wanted {
-        let t = super::tile_of(i, j, grid.0, grid.1, settings.tile);
+        let t = super::tile_of(i, j, grid.0, grid.1, settings.tile_size);
         if !tiles.contains(&t) {
             tiles.push(t);
         }

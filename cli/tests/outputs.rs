@@ -129,7 +129,7 @@ fn every_output_gets_the_mode_the_umask_gives_a_new_file() {
 
 /// The Cornell box of `scenes/`, whose light is an emitting polygon.
 fn cornell_box() -> String {
-    format!("{}/scenes/cornell-box.toml", env!("CARGO_MANIFEST_DIR"))
+    format!("{}/scenes/cornell-box.toml", common::repo().display())
 }
 
 #[test]

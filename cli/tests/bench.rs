@@ -7,12 +7,9 @@ use emray::render::RenderSettings;
 mod common;
 use common::emray;
 
-fn backends() -> &'static str {
-    if cfg!(feature = "embree") {
-        "embree,bvh"
-    } else {
-        "bvh"
-    }
+/// The backends the suite runs by default: both, or the BVH alone without Embree.
+fn backends() -> usize {
+    if cfg!(feature = "embree") { 2 } else { 1 }
 }
 
 #[test]
@@ -22,8 +19,6 @@ fn tiny_suite_writes_its_reports_and_compares_with_a_baseline() {
     let args = [
         "bench",
         "spd:tetra?size=1",
-        "--backend",
-        backends(),
         "-t",
         "1",
         "--reps",
@@ -44,7 +39,7 @@ fn tiny_suite_writes_its_reports_and_compares_with_a_baseline() {
     // 17 x 17 corner rays, all of them eye rays.
     assert!(md.contains("- spd:tetra?size=1: 289 / 0 / 0 /"), "{md}");
     let csv = std::fs::read_to_string(d.join("base.csv")).unwrap();
-    let n_backends = backends().split(',').count();
+    let n_backends = backends();
     assert_eq!(csv.lines().count(), 1 + n_backends);
     let saved = bench::read_saved(&d.join("base.json")).unwrap();
     assert_eq!(saved.rows.len(), n_backends);
@@ -143,16 +138,15 @@ fn raw_casting_replays_exactly_the_rays_of_the_render() {
 fn child_runs_report_the_same_rays_on_both_modes() {
     let spec = RunSpec {
         scene: "spd:jacks?size=1".into(),
-        backend: "bvh".into(),
         threads: 1,
-        width: 10,
-        height: 10,
-        spd: false,
         mode: Mode::Raw,
-        embree_quality: Default::default(),
-        packet_width: 8,
-        embree_fast: false,
         eye_only: false,
+        options: emray::job::RenderOptions {
+            backend: Some(emray::Backend::Bvh),
+            res: Some("10x10".parse().unwrap()),
+            spd: Some(false),
+            ..bench::Config::rules()
+        },
     };
     let raw = bench::run_child(&spec).unwrap();
     let render = bench::run_child(&RunSpec {

@@ -59,7 +59,7 @@ fn adaptive_aa_is_deterministic_shares_corners_and_beats_one_sample() {
         depth: 2,
     };
     let (a, ra) = render(&s, &st);
-    st.tile = 5;
+    st.tile_size = 5;
     let (b, rb) = render(&s, &st);
     assert_eq!(a, b, "independent of the tiling");
     assert_eq!(ra.rays, rb.rays);
@@ -320,7 +320,7 @@ fn f32_render_agrees_with_the_f64_reference() {
 
 #[test]
 fn the_reference_refuses_what_it_does_not_model() {
-    let prims = Path::new(env!("CARGO_MANIFEST_DIR")).join("scenes/primitives.toml");
+    let prims = common::repo().join("scenes/primitives.toml");
     let out = emray()
         .args(["render", "--reference", "--res", "8x8", "-q", "-o"])
         .arg(std::env::temp_dir().join("emray-never-written.png"))

@@ -259,7 +259,7 @@ fn batch_usage_errors_exit_2_before_any_job() {
         ),
         (
             vec!["batch", "a.nff", "a.nff", "-o", "same.png"],
-            "jobs 0 and 1 have the same name 'same.png'",
+            "2 scenes but one output file 'same.png'",
         ),
         (vec!["batch", "spd:nope"], "unknown database 'nope'"),
     ] {
@@ -411,6 +411,7 @@ fn options_under(help: &str, heading: &str) -> Vec<String> {
 fn help_lists_the_radiosity_options_alone_under_radiosity() {
     let dir = tempfile::tempdir().unwrap();
     let radiosity = [
+        "--gi",
         "--patch-size",
         "--ff-samples",
         "--vis-samples",
@@ -431,11 +432,20 @@ fn help_lists_the_radiosity_options_alone_under_radiosity() {
             radiosity,
             "emray {command} --help:\n{help}"
         );
-        let options = options_under(&help, "Options");
-        for other in ["--aov", "--heatmap", "--area-samples", "--embree-quality"] {
-            if help.contains(&format!("{other} ")) {
-                assert!(options.iter().any(|o| o == other), "{command}: {other}");
-            }
+        let headings = [
+            ("Image", "--area-samples"),
+            ("Output", "--aov"),
+            ("Output", "--heatmap"),
+        ];
+        for (heading, other) in headings
+            .into_iter()
+            .chain([("Backend", "--embree-quality")])
+        {
+            let under = options_under(&help, heading);
+            assert!(
+                under.iter().any(|o| o == other),
+                "{command}: {other} under {heading}"
+            );
         }
     }
 }

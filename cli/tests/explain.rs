@@ -7,7 +7,7 @@
 
 use emray::Scene;
 use emray::accel::{self, Accel, BackendOptions, WithAccel};
-use emray::job::{RenderRequest, load_scene};
+use emray::job::{RenderOptions, load_scene};
 use emray::math::Rng;
 use emray::radiosity::RadiositySettings;
 use emray::render::explain::{Explanation, RayNode, explain, text};
@@ -125,11 +125,11 @@ fn features(node: &RayNode, seen: &mut BTreeSet<String>) {
 fn check(
     name: &str,
     scene: &Scene,
-    request: RenderRequest,
+    request: RenderOptions,
     radiosity: Option<RadiositySettings>,
 ) -> BTreeSet<String> {
     let mut seen = BTreeSet::new();
-    let settings = request.settings(scene).unwrap();
+    let settings = request.resolve(scene).unwrap().settings;
     for b in backends() {
         let work = Check {
             scene,
@@ -181,10 +181,13 @@ fn has(seen: &BTreeSet<String>, what: &[&str]) {
     }
 }
 
-fn request(res: (u32, u32)) -> RenderRequest {
-    RenderRequest {
-        res: Some(res),
-        ..RenderRequest::default()
+fn request(res: (u32, u32)) -> RenderOptions {
+    RenderOptions {
+        res: Some(emray::job::Res {
+            width: res.0,
+            height: res.1,
+        }),
+        ..RenderOptions::default()
     }
 }
 
@@ -197,8 +200,8 @@ fn glass_and_mirrors_of_the_gears() {
         &seen,
         &["Refraction", "Reflection", "shadowed", "lit", "source"],
     );
-    let spd = RenderRequest {
-        spd: true,
+    let spd = RenderOptions {
+        spd: Some(true),
         ..request((32, 32))
     };
     check("gears --spd", &scene, spd, None);
@@ -215,7 +218,7 @@ fn smooth_patches_cones_and_samples() {
                f 1 0.4 0.2 0.7 0.3 10 0 1\nc -1.5 1 0 0.5 -1.5 1 1.5 0.1\n\
                f 0 0 0 0 1 1 0 1\np 3 1.5 1 0 2.5 1 0 2 1 2\n";
     let scene = emray::load::nff::parse_str(src, Path::new("t.nff")).unwrap();
-    let req = RenderRequest {
+    let req = RenderOptions {
         spp: Some(4),
         ..request((32, 32))
     };
@@ -286,10 +289,9 @@ material = "floor"
     )
     .unwrap();
     let scene = load_scene(&path).unwrap();
-    let seen = check("textured", &scene, RenderRequest::default(), None);
+    let seen = check("textured", &scene, RenderOptions::default(), None);
     has(&seen, &["Refraction", "Reflection", "Ambient", "source"]);
-    let ice =
-        load_scene(Path::new(env!("CARGO_MANIFEST_DIR")).join("scenes/ice-cube.toml")).unwrap();
+    let ice = load_scene(common::repo().join("scenes/ice-cube.toml")).unwrap();
     let seen = check("ice cube", &ice, request((32, 24)), None);
     has(&seen, &["Refraction", "tir"]);
 }
@@ -297,9 +299,9 @@ material = "floor"
 /// An area light's soft shadows, and the radiosity of the two-pass mode.
 #[test]
 fn area_light_and_radiosity() {
-    let path = Path::new(env!("CARGO_MANIFEST_DIR")).join("scenes/cornell-box.toml");
+    let path = common::repo().join("scenes/cornell-box.toml");
     let scene = load_scene(&path).unwrap();
-    let req = RenderRequest {
+    let req = RenderOptions {
         area_samples: Some(4),
         ..request((24, 24))
     };

@@ -3,9 +3,10 @@
 //! `quality` feature (FLIP).
 
 use super::Error;
-use super::args::{EncodingArg, LogArgs};
+use super::args::LogArgs;
 #[cfg(feature = "quality")]
 use super::error::print;
+use emray::output::Encoding;
 use std::path::PathBuf;
 
 /// `emray compare`.
@@ -27,8 +28,8 @@ pub struct Args {
     #[arg(long, value_name = "Y")]
     pub max_flip: Option<f64>,
     /// How PNG values are decoded to linear (EXR is linear already).
-    #[arg(long, value_enum, default_value_t = EncodingArg::Srgb)]
-    pub encoding: EncodingArg,
+    #[arg(long, value_enum, default_value_t = Encoding::Srgb)]
+    pub encoding: Encoding,
     /// Print one JSON object instead of the table.
     #[arg(long)]
     pub json: bool,
@@ -71,7 +72,7 @@ pub fn run(a: Args) -> Result<(), Error> {
         emray::output::prepare(out).map_err(|e| Error::Usage(e.into()))?;
     }
     let usage = |e: metrics::MetricsError| Error::Usage(e.into());
-    let enc: Encoding = a.encoding.into();
+    let enc = a.encoding;
     let test = metrics::read_image(&a.test, enc).map_err(usage)?;
     let reference = metrics::read_image(&a.reference, enc).map_err(usage)?;
     metrics::check_sizes(&test, &a.test, &reference, &a.reference).map_err(usage)?;

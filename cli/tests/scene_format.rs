@@ -2156,9 +2156,7 @@ fn valid_but_surprising_inputs() {
 /// get one, and the materials the examples use).
 #[test]
 fn documentation_examples_build() {
-    let doc =
-        std::fs::read_to_string(Path::new(env!("CARGO_MANIFEST_DIR")).join("docs/scene-format.md"))
-            .unwrap();
+    let doc = std::fs::read_to_string(common::repo().join("docs/scene-format.md")).unwrap();
     let dir = temp_dir();
     write(dir.path(), "parts/table.nff", TABLE_NFF);
     write(dir.path(), "table.nff", TABLE_NFF);

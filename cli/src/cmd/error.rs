@@ -85,6 +85,16 @@ impl<E: std::error::Error + Send + Sync + 'static> From<E> for Error {
     }
 }
 
+/// A job's failure: a usage error (exit 2) when the job was asked something it cannot
+/// do, else a failure (exit 1).
+pub fn job_error(e: emray::job::JobError) -> Error {
+    if e.is_usage() {
+        Error::Usage(e.into())
+    } else {
+        Error::Failed(e.into())
+    }
+}
+
 /// Whether `e` comes from writing to a pipe whose reader has gone.
 pub fn is_closed_pipe(e: &anyhow::Error) -> bool {
     e.chain().any(|cause| {

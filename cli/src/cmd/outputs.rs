@@ -11,11 +11,3 @@ pub fn prepare<'a>(files: impl IntoIterator<Item = &'a Path>) -> Result<(), Erro
     }
     Ok(())
 }
-
-/// Check that the `--stats-json` file, if any, can be appended to.
-pub fn prepare_log(file: Option<&Path>) -> Result<(), Error> {
-    if let Some(f) = file {
-        emray::output::prepare_append(f)?;
-    }
-    Ok(())
-}

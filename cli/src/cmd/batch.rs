@@ -2,16 +2,14 @@
 //! resumable jobs, optionally one shard of them; Ctrl-C or SIGTERM stops it after
 //! writing the report of what finished (a second one at once).
 
-use super::args::{BackendArg, EncodingArg, LogArgs, parse_res};
+use super::args::LogArgs;
 use super::error::print;
 use super::interrupt::stop_flag;
 use super::progress::BatchDisplay;
 use super::{Error, outputs};
-use emray::accel::Backend;
-use emray::batch::{self, BatchOptions, BatchReport, Job, JobSettings};
-use emray::job::RenderRequest;
+use emray::batch::{self, BatchOptions, BatchReport};
 use emray::job::template;
-use emray::output::Encoding;
+use emray::job::{Band, Job, RenderOptions};
 use std::path::PathBuf;
 
 /// `emray batch`.
@@ -27,24 +25,6 @@ pub struct Args {
     /// [default: `{stem}.png`, or the manifest's].
     #[arg(short, long, value_name = "TEMPLATE")]
     pub output: Option<String>,
-    /// Ray-query backend (overrides the manifest).
-    #[arg(long, value_enum)]
-    pub backend: Option<BackendArg>,
-    /// Image size, overriding the scenes' (and the manifest's).
-    #[arg(long, value_name = "WxH", value_parser = parse_res)]
-    pub res: Option<(u32, u32)>,
-    /// Samples per pixel (overrides the manifest).
-    #[arg(long, value_parser = clap::value_parser!(u32).range(1..=65536))]
-    pub spp: Option<u32>,
-    /// Maximum ray-tree depth (overrides the manifest).
-    #[arg(long, value_parser = clap::value_parser!(u32).range(1..=64))]
-    pub max_depth: Option<u32>,
-    /// SPD testing mode for every job.
-    #[arg(long)]
-    pub spd: bool,
-    /// PNG value encoding (overrides the manifest).
-    #[arg(long, value_enum)]
-    pub encoding: Option<EncodingArg>,
     /// Worker threads in all (default: all cores).
     #[arg(short, long, value_name = "N", value_parser = clap::value_parser!(u32).range(1..=4096))]
     pub threads: Option<u32>,
@@ -54,7 +34,7 @@ pub struct Args {
     /// Run only shard I of N (I counts from 0: 0 ≤ I < N): the jobs whose name hashes
     /// (FNV-1a 64) to I modulo N.
     #[arg(long, value_name = "I/N", value_parser = emray::batch::parse_shard)]
-    pub shard: Option<(u32, u32)>,
+    pub shard: Option<Band>,
     /// Skip jobs whose output exists and decodes as a whole image (resume).
     #[arg(long)]
     pub skip_existing: bool,
@@ -65,25 +45,20 @@ pub struct Args {
     /// Print this shard's jobs (name, scene, output) and exit without rendering.
     #[arg(long)]
     pub list: bool,
-    /// Refuse jobs estimated to need more memory (e.g. 8G) [default: 3/4 of RAM].
-    #[arg(long, value_name = "SIZE", value_parser = emray::job::limits::parse_size)]
-    pub max_memory: Option<u64>,
+    /// What every job renders and how, over the manifest's options.
+    #[command(flatten)]
+    pub options: RenderOptions,
     /// `-q` and `-v`.
     #[command(flatten)]
     pub log: LogArgs,
 }
 
 impl Args {
-    /// The settings that override every job's.
+    /// What overrides every job's output and options.
     pub fn overrides(&self) -> emray::batch::manifest::Overrides {
         emray::batch::manifest::Overrides {
             output: self.output.clone(),
-            backend: self.backend.map(Backend::from),
-            res: self.res,
-            spp: self.spp,
-            max_depth: self.max_depth,
-            spd: self.spd,
-            encoding: self.encoding.map(Encoding::from),
+            options: self.options.clone(),
         }
     }
 }
@@ -94,9 +69,9 @@ pub fn run(b: Args) -> Result<(), Error> {
     batch::check_jobs(&jobs).map_err(|e| Error::Usage(e.into()))?;
     let report = report_path(&b)?;
     let jobs: Vec<Job> = match b.shard {
-        Some((i, n)) => jobs
+        Some(Band { index, count }) => jobs
             .into_iter()
-            .filter(|j| batch::shard_of(&j.name, n) == i)
+            .filter(|j| batch::shard_of(&j.name, count) == index)
             .collect(),
         None => jobs,
     };
@@ -105,8 +80,12 @@ pub fn run(b: Args) -> Result<(), Error> {
             print(format_args!(
                 "{}\t{}\t{}\n",
                 j.name,
-                j.scene.display(),
-                j.output.display()
+                j.scene.name(),
+                j.outputs
+                    .image
+                    .as_ref()
+                    .map(|p| p.display().to_string())
+                    .unwrap_or_default()
             ))?;
         }
         return Ok(());
@@ -116,13 +95,11 @@ pub fn run(b: Args) -> Result<(), Error> {
         jobs: b.jobs as usize,
         skip_existing: b.skip_existing,
         report,
-        max_memory: b
-            .max_memory
-            .unwrap_or_else(emray::job::limits::default_max_memory),
-        shard: b.shard,
+        shard: b.shard.map(|s| (s.index, s.count)),
     };
-    let images = jobs.iter().map(|j| j.output.as_path());
-    outputs::prepare(opts.report.as_deref().into_iter().chain(images))?;
+    outputs::prepare(opts.report.as_deref())?;
+    let files: Vec<PathBuf> = jobs.iter().flat_map(Job::files).collect();
+    outputs::prepare(files.iter().map(PathBuf::as_path))?;
     let cancel = stop_flag();
     let mut display = BatchDisplay::new(jobs.len(), b.log.quiet);
     let report = batch::run(jobs, &opts, &cancel, &mut display);
@@ -144,7 +121,7 @@ pub fn run(b: Args) -> Result<(), Error> {
 /// The `--report` file, its `{shard}` the shard's index (0 without `--shard`); another
 /// placeholder is a usage error.
 fn report_path(b: &Args) -> Result<Option<PathBuf>, Error> {
-    let shard = b.shard.map_or(0, |(i, _)| i).to_string();
+    let shard = b.shard.map_or(0, |s| s.index).to_string();
     b.report
         .as_deref()
         .map(|r| template::expand("report name", r, &["shard"], |_| shard.clone()))
@@ -173,19 +150,8 @@ fn jobs(b: &Args) -> Result<Vec<Job>, Error> {
     if b.scenes.is_empty() {
         return Err(Error::usage("give scene files, globs or --manifest FILE"));
     }
-    let settings = JobSettings {
-        backend: b.backend.map(Backend::from),
-        render: RenderRequest {
-            res: b.res,
-            spp: b.spp,
-            max_depth: b.max_depth,
-            spd: b.spd,
-            ..RenderRequest::default()
-        },
-        encoding: b.encoding.map(Into::into).unwrap_or_default(),
-    };
     let template = b.output.as_deref().unwrap_or("{stem}.png");
     batch::expand_scene_args(&b.scenes)
-        .and_then(|s| batch::jobs_from_scenes(&s, template, &settings))
+        .and_then(|s| batch::jobs_from_scenes(&s, template, &b.options))
         .map_err(|e| Error::Usage(e.into()))
 }

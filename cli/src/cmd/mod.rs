@@ -14,9 +14,7 @@ mod error;
 mod eta;
 mod explain;
 mod generate;
-mod insight;
 mod interrupt;
-mod jobs;
 mod merge;
 mod outputs;
 mod progress;
@@ -31,8 +29,6 @@ use args::LogArgs;
 
 use anyhow::Context;
 use clap::{Parser, Subcommand};
-use std::io::Write;
-use std::path::Path;
 
 /// emray: a Whitted ray tracer for NFF scenes on Intel Embree or a pure-Rust BVH.
 #[derive(Parser, Debug)]
@@ -138,17 +134,4 @@ fn thread_pool(threads: Option<u32>) -> anyhow::Result<rayon::ThreadPool> {
         builder = builder.num_threads(t as usize);
     }
     builder.build().context("cannot start the worker threads")
-}
-
-/// Append `value` as one JSON line to `path` (the `--stats-json` log: one record per
-/// run), creating its folder if missing.
-fn append_json_line(path: &Path, value: &impl serde::Serialize) -> anyhow::Result<()> {
-    let line = serde_json::to_string(value).expect("report serialises");
-    emray::output::create_folder(path)?;
-    let mut f = std::fs::OpenOptions::new()
-        .create(true)
-        .append(true)
-        .open(path)
-        .with_context(|| format!("{}: cannot open for writing", path.display()))?;
-    writeln!(f, "{line}").with_context(|| format!("{}: cannot write", path.display()))
 }

@@ -2,9 +2,10 @@
 //! reference, to CSV, SVG and PNG. Needs the `quality` feature (FLIP, plots).
 
 use super::Error;
-use super::args::{LogArgs, parse_res};
+use super::args::LogArgs;
 #[cfg(feature = "quality")]
 use super::error::print;
+use emray::job::Res;
 use std::path::PathBuf;
 
 /// `emray study`.
@@ -18,8 +19,8 @@ pub struct Args {
     #[arg(long, value_name = "DIR")]
     pub out: PathBuf,
     /// Image size of every run.
-    #[arg(long, value_name = "WxH", default_value = "128x128", value_parser = parse_res)]
-    pub res: (u32, u32),
+    #[arg(long, value_name = "WxH", default_value = "128x128")]
+    pub res: Res,
     /// Reference samples per pixel side (N×N).
     #[arg(long, default_value_t = 16, value_parser = clap::value_parser!(u32).range(1..=64))]
     pub reference_strata: u32,
@@ -44,7 +45,7 @@ pub fn run(a: Args) -> Result<(), Error> {
     if cfg!(feature = "embree") {
         backends.push(emray::Backend::Embree);
     }
-    let (w, h) = a.res;
+    let (w, h) = (a.res.width, a.res.height);
     let rows =
         emray::quality::study::write(&scene, &name, &a.out, w, h, a.reference_strata, &backends)
             .map_err(|e| Error::failed(format!("{name}: {e}")))?;

@@ -1,8 +1,9 @@
 //! `emray merge`: stitch the parts rendered with `render --tile` or `--crop` into the
 //! whole image, with the output variables they were rendered with (`--aov`).
 
-use super::args::{EncodingArg, LogArgs};
+use super::args::LogArgs;
 use super::{Error, outputs};
+use emray::output::Encoding;
 use emray::output::aov::{ids_path, write_ids};
 use emray::output::channels::write_exr_channels;
 use emray::output::{self, Format};
@@ -18,8 +19,8 @@ pub struct Args {
     #[arg(short, long, value_name = "FULL")]
     pub output: PathBuf,
     /// PNG value encoding.
-    #[arg(long, value_enum, default_value_t = EncodingArg::Srgb)]
-    pub encoding: EncodingArg,
+    #[arg(long, value_enum, default_value_t = Encoding::Srgb)]
+    pub encoding: Encoding,
     /// `-q` and `-v`.
     #[command(flatten)]
     pub log: LogArgs,
@@ -40,7 +41,7 @@ pub fn run(m: Args) -> Result<(), Error> {
                 m.output.display()
             );
         }
-        output::write_image(&m.output, &merged.film, m.encoding.into())?;
+        output::write_image(&m.output, &merged.film, m.encoding)?;
         return Ok(());
     }
     write_exr_channels(&m.output, &merged.film, &merged.channels, None)?;

@@ -1,11 +1,12 @@
 //! `emray bench`: the benchmark suite, each run in a child process of its own (the
 //! hidden `--child` option is that child's side).
 
-use super::args::{BackendArg, LogArgs, QualityArg, packet_width, parse_res};
+use super::args::LogArgs;
 use super::error::print;
 use super::{Error, outputs};
 use emray::accel::Backend;
 use emray::bench::{self, RunSpec};
+use emray::job::RenderOptions;
 use emray::spd::Database;
 use std::path::PathBuf;
 
@@ -17,30 +18,15 @@ pub struct Args {
     /// 2, 3].
     #[arg(value_name = "SCENE")]
     pub scenes: Vec<String>,
-    /// Backends to compare [default: both, or the BVH alone without Embree].
-    #[arg(long, value_enum, value_delimiter = ',')]
-    pub backend: Vec<BackendArg>,
     /// Thread counts [default: 1 and all cores].
     #[arg(short, long, value_delimiter = ',', value_parser = clap::value_parser!(u32).range(1..=4096))]
     pub threads: Vec<u32>,
     /// Repetitions of every run (median and spread are reported).
     #[arg(long, default_value_t = 3, value_parser = clap::value_parser!(u32).range(1..=1000))]
     pub reps: u32,
-    /// Image size.
-    #[arg(long, value_name = "WxH", value_parser = parse_res, default_value = "512x512")]
-    pub res: (u32, u32),
     /// Render with one ray per pixel centre instead of SPD mode's corner rays.
     #[arg(long)]
     pub no_spd: bool,
-    /// Embree build quality (RTC_BUILD_QUALITY_*).
-    #[arg(long, value_enum, default_value_t = QualityArg::Medium)]
-    pub embree_quality: QualityArg,
-    /// Eye rays per Embree packet (0, 4, 8 or 16; 0 casts them one by one).
-    #[arg(long, value_name = "N", default_value_t = 8, value_parser = packet_width)]
-    pub packet_width: u32,
-    /// Embree's fast traversal, without RTC_SCENE_FLAG_ROBUST (as `render --embree-fast`).
-    #[arg(long)]
-    pub embree_fast: bool,
     /// Eye rays only: one per pixel centre, lights removed, depth 1, so that render ÷ raw is the cost of the
     /// eye-ray pipeline over casting the same rays.
     #[arg(long)]
@@ -60,6 +46,11 @@ pub struct Args {
     /// Compare with a JSON file of an earlier run: per-row ratios.
     #[arg(long, value_name = "FILE.json")]
     pub baseline: Option<PathBuf>,
+    /// The render options of every run over the suite's rules (512x512 in SPD mode,
+    /// depth 5, the full ray tree): `--backend` keeps one backend of the two, `--res`
+    /// changes the size, and so on.
+    #[command(flatten)]
+    pub options: RenderOptions,
     /// Run one measurement in this process (used by the suite itself).
     #[arg(long, hide = true, value_name = "JSON")]
     pub child: Option<String>,
@@ -106,21 +97,22 @@ fn child(json: &str) -> Result<(), Error> {
     Ok(())
 }
 
-/// The suite the options ask for: both backends (or the BVH alone without Embree)
-/// and 1 and all threads unless told otherwise.
+/// The suite the options ask for: both backends (or the BVH alone without Embree, or
+/// the one `--backend` names) and 1 and all threads unless told otherwise.
 fn config(b: &Args) -> bench::Config {
-    let mut backends: Vec<Backend> = b.backend.iter().map(|&x| Backend::from(x)).collect();
-    if backends.is_empty() {
-        backends = if cfg!(feature = "embree") {
-            vec![Backend::Embree, Backend::Bvh]
-        } else {
-            vec![Backend::Bvh]
-        };
-    }
+    let backends = match b.options.backend {
+        Some(one) => vec![one],
+        None if cfg!(feature = "embree") => vec![Backend::Embree, Backend::Bvh],
+        None => vec![Backend::Bvh],
+    };
     let mut threads: Vec<usize> = b.threads.iter().map(|&t| t as usize).collect();
     if threads.is_empty() {
         let all = std::thread::available_parallelism().map_or(1, |n| n.get());
         threads = if all > 1 { vec![1, all] } else { vec![1] };
+    }
+    let mut rules = bench::Config::rules();
+    if b.no_spd {
+        rules.spd = Some(false);
     }
     bench::Config {
         scenes: if b.scenes.is_empty() {
@@ -131,14 +123,9 @@ fn config(b: &Args) -> bench::Config {
         backends,
         threads,
         reps: b.reps as usize,
-        width: b.res.0,
-        height: b.res.1,
-        spd: !b.no_spd,
         raw: !b.no_raw,
         peer: !b.no_peer,
-        embree_quality: b.embree_quality.into(),
-        packet_width: b.packet_width,
-        embree_fast: b.embree_fast,
         eye_only: b.eye_only,
+        options: b.options.over(&rules),
     }
 }

@@ -5,7 +5,8 @@
 
 use super::error::error_line;
 use super::eta;
-use emray::batch::{Job, JobRecord, JobStatus, Observer};
+use emray::batch::{JobRecord, JobStatus, Observer};
+use emray::job::Job;
 use emray::output::OutputError;
 use indicatif::{MultiProgress, ProgressBar, ProgressStyle};
 use std::collections::HashMap;
@@ -205,7 +206,9 @@ impl Observer for BatchDisplay {
 
     fn writing(&mut self, index: usize, job: &Job) {
         if let Some(t) = self.job_bars.get(&index) {
-            t.writing(&job.output);
+            if let Some(image) = &job.outputs.image {
+                t.writing(image);
+            }
         }
     }
 

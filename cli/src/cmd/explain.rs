@@ -1,0 +1,76 @@
+//! `emray explain`: one pixel's whole ray tree, traced by the renderer's own code with
+//! the camera, samples and settings of `emray render`, as indented text or as JSON
+//! (docs/explain.md).
+
+use super::Error;
+use super::args::LogArgs;
+use super::error::{job_error, print};
+use emray::job::{self, Job, Outputs, Product, RenderOptions, SceneSource, Task};
+use emray::render::explain::{Explanation, text};
+use serde::Serialize;
+use std::path::PathBuf;
+
+/// `emray explain`.
+#[derive(clap::Args, Debug, Clone)]
+pub struct Args {
+    /// Scene file: NFF, TOML (`.toml`), OBJ (`.obj`), or `spd:NAME[?size=N]`.
+    #[arg(value_name = "SCENE")]
+    pub scene: PathBuf,
+    /// Pixel column, from 0 at the left.
+    #[arg(value_name = "X")]
+    pub x: u32,
+    /// Pixel row, from 0 at the top.
+    #[arg(value_name = "Y")]
+    pub y: u32,
+    /// Print the tree as JSON (schema in docs/explain.md).
+    #[arg(long)]
+    pub json: bool,
+    /// The render whose pixel it is, as `emray render` takes it.
+    #[command(flatten)]
+    pub options: RenderOptions,
+    /// `-q` and `-v`.
+    #[command(flatten)]
+    pub log: LogArgs,
+}
+
+/// The JSON `--json` prints: the explanation with the scene and backend it is of.
+#[derive(Serialize)]
+struct Output<'a> {
+    scene: String,
+    backend: &'static str,
+    #[serde(flatten)]
+    explanation: &'a Explanation,
+}
+
+/// Explain the pixel and print the tree.
+pub fn run(a: Args) -> Result<(), Error> {
+    let job = Job {
+        name: a.scene.display().to_string(),
+        scene: SceneSource::File(a.scene.clone()),
+        options: a.options.clone(),
+        task: Task::Explain { x: a.x, y: a.y },
+        outputs: Outputs::default(),
+    };
+    job.check().map_err(job_error)?;
+    let rendered = job::run(&job, &()).map_err(job_error)?;
+    let Product::Explanation(explanation) = &rendered.product else {
+        unreachable!("an explain job explains");
+    };
+    let backend = rendered.resolved.backend.backend.name();
+    if a.json {
+        let out = Output {
+            scene: job.name,
+            backend,
+            explanation,
+        };
+        let json = serde_json::to_string_pretty(&out).expect("an explanation serialises");
+        print(format_args!("{json}\n"))?;
+    } else {
+        print(format_args!(
+            "scene {}, backend {backend}\n{}",
+            job.name,
+            text::format(explanation)
+        ))?;
+    }
+    Ok(())
+}
