@@ -135,12 +135,14 @@ fn near_degenerate_quadric_roots_match_the_f64_reference() {
 #[cfg(feature = "embree")]
 #[test]
 fn embree_with_and_without_the_robust_flag_never_misses_rays_that_must_enter() {
-    use emray::accel::embree::EmbreeAccel;
     let case = stress::bipyramid(100, Vec3::new(1e3, -2e3, 5e2));
     for (robust, word) in [(false, "fast traversal"), (true, "robust traversal")] {
-        let e = EmbreeAccel::build_with(&case.scene, "", Default::default(), robust).unwrap();
-        assert!(e.stats().detail.contains(word), "{}", e.stats().detail);
-        let st = case.run(&e, 6, 3.0);
+        let options = emray::accel::BackendOptions {
+            embree_robust: robust,
+            ..Backend::Embree.into()
+        };
+        let (st, detail) = case.run_on(&options, 6, 3.0).unwrap();
+        assert!(detail.contains(word), "{detail}");
         assert!(st.rays > 300, "{st:?}");
         assert_eq!(st.misses, 0, "robust {robust}: {st:?}");
     }

@@ -1,6 +1,6 @@
 //! `emray batch`, shards, `render --tile/--crop` and `emray merge`, through the binary.
 
-use emray::output::part::read_exr;
+use emray::output::read_exr;
 use std::path::Path;
 use std::process::{Command, Output, Stdio};
 use std::time::{Duration, Instant};

@@ -1,8 +1,7 @@
 //! `emray bench`: a tiny suite end to end (child processes, markdown, CSV, JSON,
-//! baseline), raw casting against the render's own ray counts, and bad input.
+//! baseline), both modes of a run, and bad input.
 
-use emray::bench::{self, Mode, RunSpec, raw};
-use emray::render::RenderSettings;
+use emray::bench::{self, Mode, RunSpec};
 
 mod common;
 use common::emray;
@@ -93,45 +92,6 @@ fn bad_input_is_refused_clearly() {
     assert_eq!(o.status.code(), Some(1));
     assert!(String::from_utf8_lossy(&o.stderr).contains("missing.nff: no such scene file"));
     assert!(!d.join("missing.json").exists());
-}
-
-#[test]
-fn raw_casting_replays_exactly_the_rays_of_the_render() {
-    // A sphereflake without transmitters: every query is a counted ray.
-    let scene = emray::job::load_scene("spd:balls?size=1").unwrap();
-    let accel = emray::accel::bvh::Bvh::build(&scene);
-    let mut s = RenderSettings::for_scene(&scene);
-    s.width = 12;
-    s.height = 12;
-    s.spd = true;
-    let pool = rayon::ThreadPoolBuilder::new()
-        .num_threads(2)
-        .build()
-        .unwrap();
-    let (queries, counts) = pool.install(|| raw::record(&scene, &accel, &s));
-    assert_eq!(queries.len() as u64, counts.total());
-    let shadow = queries.iter().filter(|q| q.occluded).count() as u64;
-    assert_eq!(shadow, counts.shadow);
-    // The eye rays went in batches, one per tile, which raw casting replays as batches.
-    let batches: Vec<raw::Batch> = queries.iter().filter_map(|q| q.batch).collect();
-    assert_eq!(batches.len(), 1, "13x13 corner rays: one 16x16 tile");
-    assert_eq!(batches[0], raw::Batch { len: 169 });
-    let cast = pool.install(|| raw::cast(&accel, &queries));
-    assert_eq!(cast.queries, counts.total());
-    // Eye rays that hit, reflection rays that hit and occluded shadow rays, found again
-    // one by one.
-    let expected = queries
-        .iter()
-        .filter(|q| {
-            if q.occluded {
-                emray::Accel::occluded(&accel, &q.ray)
-            } else {
-                emray::Accel::intersect(&accel, &q.ray).is_some()
-            }
-        })
-        .count() as u64;
-    assert_eq!(cast.hits, expected);
-    assert!(cast.hits >= counts.eye_hit);
 }
 
 #[test]

@@ -7,7 +7,7 @@
 pub mod bvh;
 #[cfg(feature = "embree")]
 pub mod embree;
-pub mod unbounded;
+pub(crate) mod unbounded;
 
 use crate::geometry::Kind;
 use crate::math::Ray;
@@ -181,9 +181,9 @@ pub trait WithAccel {
     fn run<A: Accel>(self, accel: &A, build_ms: f64) -> Self::Output;
 }
 
-/// Build the backend `options` names over `scene` (timed) and run `work` with it. This
-/// is the one place a backend is chosen and built. Embree builds with as many threads
-/// as the current rayon pool has.
+/// Build the backend `options` names over `scene` (timed) and run `work` with it: the
+/// one place a backend is chosen and built. Embree builds on the process's device for
+/// as many threads as the current rayon pool has.
 pub fn build<W: WithAccel>(
     scene: &Scene,
     options: &BackendOptions,
@@ -199,14 +199,7 @@ pub fn build<W: WithAccel>(
         }
         #[cfg(feature = "embree")]
         Backend::Embree => {
-            let config = format!("threads={}", rayon::current_num_threads());
-            let accel = embree::EmbreeAccel::build_with(
-                scene,
-                &config,
-                options.embree_quality,
-                options.embree_robust,
-            )?
-            .with_packet_width(options.packet_width);
+            let accel = embree::EmbreeAccel::build_with(scene, options)?;
             let build_ms = ms(t0);
             Ok(work.run(&accel, build_ms))
         }

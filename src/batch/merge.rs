@@ -3,9 +3,10 @@
 //! carries a hash of the scene and the settings; [`merge`] checks that the parts come
 //! from one render and cover the image exactly once.
 
-use crate::output::aov::read_ids;
-use crate::output::channels::{Channel, read_exr_channels};
+use crate::output::aov::{ids_path, read_ids, write_ids};
+use crate::output::channels::{Channel, read_exr_channels, write_exr_channels};
 use crate::output::part::{HASH_ATTRIBUTE, PartInfo};
+use crate::output::{Encoding, Format, OutputError, write_image};
 use crate::render::Film;
 use crate::render::aov::ids::IdEntry;
 use std::path::{Path, PathBuf};
@@ -112,6 +113,39 @@ pub struct Merged {
     pub channels: Vec<Channel>,
     /// The ids, when there is an `id` channel.
     pub ids: Option<Vec<IdEntry>>,
+}
+
+impl Merged {
+    /// The files [`Merged::write`] writes to `path`: the image, and beside an EXR the
+    /// ids of an `id` channel.
+    pub fn files(path: &Path) -> Result<Vec<PathBuf>, OutputError> {
+        let mut files = vec![path.to_path_buf()];
+        if Format::from_path(path)? == Format::Exr {
+            files.push(ids_path(path));
+        }
+        Ok(files)
+    }
+
+    /// Write the whole image to `path`: every channel of the parts to an EXR (with the
+    /// `.ids.json` of an `id` channel), the colour alone to a PNG (`encoding`), saying
+    /// so when channels are left out.
+    pub fn write(&self, path: &Path, encoding: Encoding) -> Result<(), OutputError> {
+        let format = Format::from_path(path)?;
+        if self.channels.is_empty() || format == Format::Png {
+            if !self.channels.is_empty() {
+                log::warn!(
+                    "{}: a PNG holds the colour alone; the parts' other channels are left out",
+                    path.display()
+                );
+            }
+            return write_image(path, &self.film, encoding);
+        }
+        write_exr_channels(path, &self.film, &self.channels, None)?;
+        if let Some(ids) = &self.ids {
+            write_ids(path, ids)?;
+        }
+        Ok(())
+    }
 }
 
 /// A part as read.

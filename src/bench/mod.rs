@@ -3,10 +3,10 @@
 //! interleaved (every backend and thread count of a scene side by side in each
 //! repetition), with raw-casting runs for the renderer's overhead and Tachyon as a peer.
 
-pub mod cpu;
-pub mod peer;
-pub mod raw;
-pub mod report;
+mod cpu;
+mod peer;
+pub(crate) mod raw;
+mod report;
 
 use crate::accel::{AccelError, Backend, WithAccel};
 use crate::job::{

@@ -9,8 +9,7 @@
 //! its `angle` set to Tachyon's, renders it on emray with one ray per pixel centre as
 //! Tachyon does, and checks the two pictures frame the scene alike ([`framing`]).
 
-use crate::accel::Accel;
-use crate::accel::bvh::Bvh;
+use crate::accel::{Accel, Backend, WithAccel};
 use crate::render::RayGen;
 use crate::scene::Scene;
 use serde::{Deserialize, Serialize};
@@ -86,7 +85,38 @@ pub fn read_ppm(bytes: &[u8]) -> Option<(u32, u32, Vec<u8>)> {
 /// emray's eye ray through the pixel centre hits nothing) or both see the scene.
 /// `tachyon` is Tachyon's picture as RGB bytes.
 pub fn framing(scene: &Scene, width: u32, height: u32, tachyon: &[u8]) -> f64 {
-    let bvh = Bvh::build(scene);
+    let work = Framing {
+        scene,
+        width,
+        height,
+        tachyon,
+    };
+    crate::accel::build(scene, &Backend::Bvh.into(), work).unwrap_or(0.0)
+}
+
+/// [`framing`] with a built backend.
+struct Framing<'a> {
+    scene: &'a Scene,
+    width: u32,
+    height: u32,
+    tachyon: &'a [u8],
+}
+
+impl WithAccel for Framing<'_> {
+    type Output = f64;
+    fn run<A: Accel>(self, accel: &A, _build_ms: f64) -> f64 {
+        let Framing {
+            scene,
+            width,
+            height,
+            tachyon,
+        } = self;
+        alike_share(scene, accel, width, height, tachyon)
+    }
+}
+
+/// The share of pixels whose background-or-scene `accel` and Tachyon's picture agree on.
+fn alike_share<A: Accel>(scene: &Scene, accel: &A, width: u32, height: u32, tachyon: &[u8]) -> f64 {
     let raygen = RayGen::new(&scene.camera, width, height);
     let bg = scene
         .background
@@ -101,7 +131,7 @@ pub fn framing(scene: &Scene, width: u32, height: u32, tachyon: &[u8]) -> f64 {
             };
             let tachyon_bg = px.iter().zip(bg).all(|(&p, b)| (p as f32 - b).abs() <= 1.0);
             let ray = raygen.ray(i as f32 + 0.5, j as f32 + 0.5);
-            let emray_bg = bvh.intersect(&ray).is_none();
+            let emray_bg = accel.intersect(&ray).is_none();
             alike += usize::from(tachyon_bg == emray_bg);
         }
     }
@@ -257,7 +287,7 @@ mod tests {
             crate::load::nff::parse_str(&src, Path::new("f.nff")).unwrap()
         };
         let picture = |s: &Scene| {
-            let bvh = Bvh::build(s);
+            let bvh = crate::accel::bvh::Bvh::build(s);
             let raygen = RayGen::new(&s.camera, 32, 32);
             let mut rgb = Vec::new();
             for j in 0..32 {

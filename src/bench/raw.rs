@@ -182,3 +182,47 @@ pub fn record<A: Accel>(
     let (_, stats) = render::render(scene, &rec, settings, None);
     (rec.into_queries(), stats.rays)
 }
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+
+    #[test]
+    fn raw_casting_replays_exactly_the_rays_of_the_render() {
+        // A sphereflake without transmitters: every query is a counted ray.
+        let scene = crate::job::load_scene("spd:balls?size=1").unwrap();
+        let accel = crate::accel::bvh::Bvh::build(&scene);
+        let mut s = RenderSettings::for_scene(&scene);
+        s.width = 12;
+        s.height = 12;
+        s.spd = true;
+        let pool = rayon::ThreadPoolBuilder::new()
+            .num_threads(2)
+            .build()
+            .unwrap();
+        let (queries, counts) = pool.install(|| record(&scene, &accel, &s));
+        assert_eq!(queries.len() as u64, counts.total());
+        let shadow = queries.iter().filter(|q| q.occluded).count() as u64;
+        assert_eq!(shadow, counts.shadow);
+        // The eye rays went in batches, one per tile, which raw casting replays as batches.
+        let batches: Vec<Batch> = queries.iter().filter_map(|q| q.batch).collect();
+        assert_eq!(batches.len(), 1, "13x13 corner rays: one 16x16 tile");
+        assert_eq!(batches[0], Batch { len: 169 });
+        let cast = pool.install(|| cast(&accel, &queries));
+        assert_eq!(cast.queries, counts.total());
+        // Eye rays that hit, reflection rays that hit and occluded shadow rays, found again
+        // one by one.
+        let expected = queries
+            .iter()
+            .filter(|q| {
+                if q.occluded {
+                    Accel::occluded(&accel, &q.ray)
+                } else {
+                    Accel::intersect(&accel, &q.ray).is_some()
+                }
+            })
+            .count() as u64;
+        assert_eq!(cast.hits, expected);
+        assert!(cast.hits >= counts.eye_hit);
+    }
+}

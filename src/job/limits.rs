@@ -56,37 +56,6 @@ pub fn default_max_memory() -> u64 {
         .unwrap_or(16 << 30)
 }
 
-/// A `--max-memory` value that is not a size.
-#[derive(Clone, Debug, PartialEq, Eq, thiserror::Error)]
-#[error("'{0}' is not a size (e.g. 512M, 4G, 1.5G, 1000000)")]
-pub struct SizeError(pub String);
-
-/// Parse a size: bytes, or a number with `K`, `M`, `G` or `T` (binary multiples;
-/// `KiB`/`KB`-style suffixes are accepted too).
-pub fn parse_size(s: &str) -> Result<u64, SizeError> {
-    let t = s.trim();
-    let bad = || SizeError(s.to_string());
-    let split = t
-        .find(|c: char| !(c.is_ascii_digit() || c == '.'))
-        .unwrap_or(t.len());
-    let (num, unit) = t.split_at(split);
-    let v: f64 = num.parse().map_err(|_| bad())?;
-    let unit = unit.trim().to_ascii_uppercase();
-    let shift = match unit.trim_end_matches('B').trim_end_matches('I') {
-        "" => 0,
-        "K" => 10,
-        "M" => 20,
-        "G" => 30,
-        "T" => 40,
-        _ => return Err(bad()),
-    };
-    let bytes = v * (1u64 << shift) as f64;
-    if !bytes.is_finite() || bytes < 1.0 || bytes > u64::MAX as f64 / 2.0 {
-        return Err(bad());
-    }
-    Ok(bytes as u64)
-}
-
 /// Human-readable bytes.
 pub fn format_bytes(b: u64) -> String {
     let gib = b as f64 / (1u64 << 30) as f64;
@@ -119,19 +88,9 @@ pub struct MemoryLimitError {
     pub limit: u64,
 }
 
-/// Refuse the render when its estimate is over `max` bytes.
+/// Refuse the render when its estimate, plus `extra` bytes (output variables:
+/// [`aov_bytes`]), is over `max` bytes.
 pub fn check(
-    scene_path: &Path,
-    scene: &Scene,
-    settings: &RenderSettings,
-    max: u64,
-) -> Result<(), MemoryLimitError> {
-    check_with(scene_path, scene, settings, 0, max)
-}
-
-/// [`check`] for a render that needs `extra` bytes besides (output variables:
-/// [`aov_bytes`]).
-pub fn check_with(
     scene_path: &Path,
     scene: &Scene,
     settings: &RenderSettings,
@@ -157,21 +116,6 @@ mod tests {
     use super::*;
 
     #[test]
-    fn sizes_parse() {
-        assert_eq!(parse_size("1000"), Ok(1000));
-        assert_eq!(
-            parse_size("lots").unwrap_err().to_string(),
-            "'lots' is not a size (e.g. 512M, 4G, 1.5G, 1000000)"
-        );
-        assert_eq!(parse_size("512M"), Ok(512 << 20));
-        assert_eq!(parse_size("4GiB"), Ok(4 << 30));
-        assert_eq!(parse_size("1.5g"), Ok(3 << 29));
-        assert!(parse_size("lots").is_err());
-        assert!(parse_size("0").is_err());
-        assert!(parse_size("5Q").is_err());
-    }
-
-    #[test]
     fn big_images_are_refused_with_numbers() {
         let scene = crate::load::nff::parse_str(
             "v\nfrom 0 0 5\nat 0 0 0\nup 0 1 0\nangle 40\nhither 1\nresolution 8 8\ns 0 0 0 1\n",
@@ -179,10 +123,10 @@ mod tests {
         )
         .unwrap();
         let mut s = RenderSettings::for_scene(&scene);
-        assert!(check(Path::new("t.nff"), &scene, &s, 1 << 20).is_ok());
+        assert!(check(Path::new("t.nff"), &scene, &s, 0, 1 << 20).is_ok());
         s.width = 30000;
         s.height = 30000;
-        let e = check(Path::new("t.nff"), &scene, &s, 1 << 30)
+        let e = check(Path::new("t.nff"), &scene, &s, 0, 1 << 30)
             .unwrap_err()
             .to_string();
         assert!(e.starts_with("t.nff: rendering 30000x30000"), "{e}");
@@ -194,8 +138,8 @@ mod tests {
         s.width = 4000;
         s.height = 4000;
         let max = estimate_bytes(&scene, &s) + 1;
-        assert!(check(Path::new("t.nff"), &scene, &s, max).is_ok());
+        assert!(check(Path::new("t.nff"), &scene, &s, 0, max).is_ok());
         let extra = aov_bytes(&s);
-        assert!(check_with(Path::new("t.nff"), &scene, &s, extra, max).is_err());
+        assert!(check(Path::new("t.nff"), &scene, &s, extra, max).is_err());
     }
 }

@@ -13,7 +13,7 @@
 //! - [`limits`]: the memory a render needs, checked before it starts;
 //! - [`template`]: the one template language of output file names.
 
-pub mod limits;
+mod limits;
 pub mod options;
 mod pipeline;
 mod report;
@@ -23,6 +23,7 @@ pub mod template;
 pub mod values;
 mod work;
 
+pub use limits::MemoryLimitError;
 pub use options::{AaMode, FormFactors, Gi, RadiosityOptions, RenderOptions, Solver};
 pub use pipeline::{
     Event, Job, JobError, Observer, Outputs, Rendered, Task, check_distinct, plan, render, run,

@@ -392,7 +392,7 @@ pub fn render(job: &Job, observer: &dyn Observer) -> Result<Rendered, JobError> 
     } else {
         0
     };
-    limits::check_with(
+    limits::check(
         job.scene.path(),
         &scene,
         &resolved.settings,

@@ -21,8 +21,6 @@ use crate::scene::Scene;
 
 /// Samples per pixel of the f64 reference when none are asked for (16×16 strata).
 pub const DEFAULT_REFERENCE_SPP: u32 = 256;
-/// Hemicube resolution when none is asked for.
-pub const DEFAULT_HEMICUBE_RES: u32 = 128;
 
 /// Options that cannot be met, named as the command line and a manifest name them.
 #[derive(Clone, Debug, PartialEq, thiserror::Error)]
@@ -212,9 +210,10 @@ impl RadiosityOptions {
             form_factors: match self.form_factors {
                 None => d.form_factors,
                 Some(FormFactors::Raycast) => FormFactorMethod::RayCast,
-                Some(FormFactors::Hemicube) => {
-                    FormFactorMethod::Hemicube(self.hemicube_res.unwrap_or(DEFAULT_HEMICUBE_RES))
-                }
+                Some(FormFactors::Hemicube) => FormFactorMethod::Hemicube(
+                    self.hemicube_res
+                        .unwrap_or(crate::radiosity::hemicube::DEFAULT_RES),
+                ),
             },
             subdiv_threshold: self.subdiv_threshold.or(d.subdiv_threshold),
             min_patch_size: self.min_patch_size.or(d.min_patch_size),
@@ -546,7 +545,7 @@ mod tests {
         .settings();
         assert_eq!(
             hemicube.form_factors,
-            FormFactorMethod::Hemicube(DEFAULT_HEMICUBE_RES)
+            FormFactorMethod::Hemicube(crate::radiosity::hemicube::DEFAULT_RES)
         );
         assert_eq!(hemicube.shooter_level, 2);
     }

@@ -6,17 +6,18 @@
 //! ([`aov`], [`channels`]) and the cost heat maps ([`heatmap`]), drawn with the colour
 //! maps of [`colormap`].
 
-pub mod aov;
+pub(crate) mod aov;
 mod atomic;
-pub mod channels;
-pub mod colormap;
+pub(crate) mod channels;
+pub(crate) mod colormap;
 mod font;
-pub mod heatmap;
-pub mod part;
+pub(crate) mod heatmap;
+pub(crate) mod part;
 mod pending;
 
 pub(crate) use atomic::write_atomic;
 pub use atomic::{create_folder, prepare, prepare_append, remove_stale_temps};
+pub use part::{PartInfo, read_exr};
 pub use pending::abandon_writes;
 
 // The PNG writer's encodings, defined with the colour curves in `render`.

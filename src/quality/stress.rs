@@ -1,8 +1,7 @@
 //! Numerical stress cases, shared by `tests/stability.rs` (which asserts bounds on
 //! small counts) and `emray stress` (which prints the measured numbers on full counts).
 
-use crate::accel::Accel;
-use crate::accel::Backend;
+use crate::accel::{Accel, AccelError, Backend, BackendOptions, WithAccel};
 use crate::geometry::reference as r64;
 use crate::job::render_scene;
 use crate::load::nff::{parse_str, parse_str_at};
@@ -100,6 +99,18 @@ pub fn acne<A: Accel>(scene: &Scene, accel: &A) -> (u64, u64) {
         }
     }
     (lit, acne)
+}
+
+/// [`acne`] on the backend `options` names, built by [`crate::accel::build`].
+pub fn acne_on(scene: &Scene, options: &BackendOptions) -> Result<(u64, u64), AccelError> {
+    struct Acne<'a>(&'a Scene);
+    impl WithAccel for Acne<'_> {
+        type Output = (u64, u64);
+        fn run<A: Accel>(self, accel: &A, _build_ms: f64) -> (u64, u64) {
+            acne(self.0, accel)
+        }
+    }
+    crate::accel::build(scene, options, Acne(scene))
 }
 
 /// Share (0..1) of pixels whose 8-bit sRGB value differs.
@@ -274,6 +285,26 @@ impl Watertight {
             }
         }
         st
+    }
+}
+
+impl Watertight {
+    /// [`Watertight::run`] on the backend `options` names, built by
+    /// [`crate::accel::build`]; also what the backend says of itself.
+    pub fn run_on(
+        &self,
+        options: &BackendOptions,
+        n: u32,
+        r: f32,
+    ) -> Result<(WatertightStats, String), AccelError> {
+        struct Run<'a>(&'a Watertight, u32, f32);
+        impl WithAccel for Run<'_> {
+            type Output = (WatertightStats, String);
+            fn run<A: Accel>(self, accel: &A, _build_ms: f64) -> Self::Output {
+                (self.0.run(accel, self.1, self.2), accel.stats().detail)
+            }
+        }
+        crate::accel::build(&self.scene, options, Run(self, n, r))
     }
 }
 

@@ -125,6 +125,7 @@ pub fn element_form_factor<A: Accel>(
     sum / s.shooter.len() as f32 * (seen as f32 / k as f32)
 }
 
+#[cfg(test)]
 /// The analytic form factor between two directly opposed parallel `a × b` rectangles
 /// at distance `c` (Howell's catalogue, C-11).
 pub fn parallel_rectangles(a: f64, b: f64, c: f64) -> f64 {
@@ -140,6 +141,7 @@ pub fn parallel_rectangles(a: f64, b: f64, c: f64) -> f64 {
             - y * y.atan())
 }
 
+#[cfg(test)]
 /// The analytic form factor from an `l × w` rectangle to an `l × h` rectangle
 /// perpendicular to it along their common edge of length `l` (Howell's catalogue,
 /// C-14).
@@ -157,6 +159,7 @@ pub fn perpendicular_rectangles(l: f64, w: f64, h: f64) -> f64 {
             + 0.25 * (a.ln() + w2 * b.ln() + h2 * c.ln()))
 }
 
+#[cfg(test)]
 /// The analytic form factor from a differential area facing a coaxial disk of radius
 /// `r` at distance `h`.
 pub fn point_to_disk(r: f64, h: f64) -> f64 {

@@ -137,11 +137,7 @@ impl Hemicube {
         })
     }
 
-    /// Pixels across the top face.
-    pub fn res(&self) -> u32 {
-        self.res as u32
-    }
-
+    #[cfg(test)]
     /// Sum of all delta form factors (one, up to rounding).
     pub fn delta_sum(&self) -> f64 {
         self.top.iter().map(|&d| d as f64).sum::<f64>()

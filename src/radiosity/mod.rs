@@ -14,11 +14,14 @@
 //! Elements are one-sided: they emit and receive on the side their triangle's winding
 //! makes the front (counterclockwise seen from the front); the back side shows black.
 
-pub mod formfactor;
-pub mod hemicube;
-pub mod mesh;
-pub mod solver;
-pub mod tessellate;
+pub(crate) mod formfactor;
+pub(crate) mod hemicube;
+pub(crate) mod mesh;
+pub(crate) mod solver;
+pub(crate) mod tessellate;
+
+#[cfg(test)]
+mod tests;
 
 use crate::accel::{Accel, AccelError, BackendOptions, Hit, WithAccel};
 use crate::geometry::Kind;

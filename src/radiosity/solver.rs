@@ -67,34 +67,6 @@ fn emitted(mesh: &Mesh) -> Result<Vec<Vec3>, RadiosityError> {
     Ok(e)
 }
 
-/// Progressive refinement until the residual is below `epsilon` or after
-/// `max_shots` shots.
-pub fn progressive<A: Accel>(
-    mesh: &Mesh,
-    accel: &A,
-    s: &Sampling,
-    epsilon: f64,
-    max_shots: usize,
-) -> Result<Solve, RadiosityError> {
-    progressive_rows(
-        mesh,
-        |i| form_factor_row(mesh, accel, s, i),
-        epsilon,
-        max_shots,
-    )
-}
-
-/// Progressive refinement with the rows of form factors `F_ij` (all `j`) from `row(i)`,
-/// whatever computes them (ray casting, hemicube).
-pub fn progressive_rows<R: Fn(usize) -> Vec<f32>>(
-    mesh: &Mesh,
-    row: R,
-    epsilon: f64,
-    max_shots: usize,
-) -> Result<Solve, RadiosityError> {
-    progressive_rows_from(mesh, row, epsilon, max_shots, None)
-}
-
 /// Add to `b` and `u` what the receivers of row `f` of element `i` gather from its
 /// radiosity `shot`.
 fn receive(mesh: &Mesh, i: usize, f: &[f32], shot: Vec3, b: &mut [Vec3], u: &mut [Vec3]) {
@@ -187,33 +159,6 @@ pub fn progressive_rows_from<R: Fn(usize) -> Vec<f32>>(
     out.form_factor_ms = ff_ms;
     out.total_ms = start.elapsed().as_secs_f64() * 1e3;
     Ok(out)
-}
-
-/// Gauss–Seidel sweeps over the full system until no radiosity changes by more than
-/// `tolerance` (relative to the largest emission), or after `max_sweeps` sweeps.
-pub fn gauss_seidel<A: Accel>(
-    mesh: &Mesh,
-    accel: &A,
-    s: &Sampling,
-    tolerance: f64,
-    max_sweeps: usize,
-) -> Result<Solve, RadiosityError> {
-    gauss_seidel_rows(
-        mesh,
-        |i| form_factor_row(mesh, accel, s, i),
-        tolerance,
-        max_sweeps,
-    )
-}
-
-/// Gauss–Seidel with the rows of form factors from `row(i)`.
-pub fn gauss_seidel_rows<R: Fn(usize) -> Vec<f32>>(
-    mesh: &Mesh,
-    row: R,
-    tolerance: f64,
-    max_sweeps: usize,
-) -> Result<Solve, RadiosityError> {
-    gauss_seidel_rows_from(mesh, row, tolerance, max_sweeps, None)
 }
 
 /// Gauss–Seidel with the rows of form factors from `row(i)`, starting from the

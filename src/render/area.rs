@@ -6,7 +6,6 @@
 //! irradiance from the light divided by π, so that a diffuse surface of reflectance
 //! `ρ` shows `ρ ×` it, the same units as the radiosity solution's `B`.
 
-use super::RayCounts;
 use super::record::Recorder;
 use crate::accel::Accel;
 use crate::math::{Ray, Vec3, gamma, hash, hash_unit as unit, next_float_down, offset_ray_origin};
@@ -86,6 +85,7 @@ pub struct Receiver {
     pub ns: Vec3,
 }
 
+#[cfg(test)]
 /// `(irradiance / π)` from `lights` at the point `at`, with `n × n`
 /// stratified shadow rays per light, jittered by `seed` (the ray-tree path of the hit,
 /// which does not depend on the hit point's rounding, so both backends draw the same
@@ -97,7 +97,7 @@ pub fn direct<A: Accel>(
     n: u32,
     seed: u32,
 ) -> (Vec3, u64) {
-    direct_recorded(accel, lights, at, n, seed, &mut RayCounts::default())
+    direct_recorded(accel, lights, at, n, seed, &mut super::RayCounts::default())
 }
 
 /// [`direct`], each light's share reported to `rec` ([`Recorder::area_light`]).

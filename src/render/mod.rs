@@ -5,18 +5,18 @@
 //! implements it); [`color`] turns the film's linear values into encoded 8-bit ones.
 
 pub mod aov;
-pub mod area;
+pub(crate) mod area;
 mod camera;
 pub mod color;
 mod counts;
 pub mod explain;
 mod film;
-pub mod gi;
+pub(crate) mod gi;
 mod grid;
 mod local;
-pub mod media;
+pub(crate) mod media;
 mod optics;
-pub mod record;
+pub(crate) mod record;
 pub mod reference;
 mod shade;
 mod whitted;

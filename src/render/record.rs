@@ -74,8 +74,6 @@ pub struct Met<'a> {
     pub hit: &'a Hit,
     /// The surface there.
     pub surf: &'a Surface,
-    /// The ray's unit direction.
-    pub dir: Vec3,
     /// Whether the ray enters the solid (hits the front of the geometric normal).
     pub entering: bool,
     /// The media the ray travels in before the surface.

@@ -244,7 +244,6 @@ impl<'a, A: Accel> Tracer<'a, A> {
             let met = Met {
                 hit: &hit,
                 surf: &surf,
-                dir: d,
                 entering,
                 media: &media,
             };

@@ -3,10 +3,8 @@
 
 use super::args::LogArgs;
 use super::{Error, outputs};
+use emray::batch::merge::{Merged, merge};
 use emray::output::Encoding;
-use emray::output::aov::{ids_path, write_ids};
-use emray::output::channels::write_exr_channels;
-use emray::output::{self, Format};
 use std::path::PathBuf;
 
 /// `emray merge`.
@@ -26,27 +24,10 @@ pub struct Args {
     pub log: LogArgs,
 }
 
-/// Check that the parts make one image, and write it: every channel of the parts to
-/// an EXR (with the `.ids.json` of an `id` channel), the colour alone to a PNG.
+/// Check that the parts make one image, and write it.
 pub fn run(m: Args) -> Result<(), Error> {
-    let format = Format::from_path(&m.output)?;
-    // The ids file of parts with an `id` channel goes beside an EXR.
-    let ids = (format == Format::Exr).then(|| ids_path(&m.output));
-    outputs::prepare([m.output.as_path()].into_iter().chain(ids.as_deref()))?;
-    let merged = emray::batch::merge::merge(&m.parts)?;
-    if merged.channels.is_empty() || format == Format::Png {
-        if !merged.channels.is_empty() {
-            log::warn!(
-                "{}: a PNG holds the colour alone; the parts' other channels are left out",
-                m.output.display()
-            );
-        }
-        output::write_image(&m.output, &merged.film, m.encoding)?;
-        return Ok(());
-    }
-    write_exr_channels(&m.output, &merged.film, &merged.channels, None)?;
-    if let Some(ids) = &merged.ids {
-        write_ids(&m.output, ids)?;
-    }
+    let files = Merged::files(&m.output)?;
+    outputs::prepare(files.iter().map(PathBuf::as_path))?;
+    merge(&m.parts)?.write(&m.output, m.encoding)?;
     Ok(())
 }

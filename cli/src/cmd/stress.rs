@@ -5,7 +5,6 @@ use super::Error;
 use super::args::LogArgs;
 use super::error::print;
 use emray::Backend;
-use emray::accel::bvh::Bvh;
 use emray::quality::stress::*;
 
 /// `emray stress`.
@@ -81,7 +80,7 @@ fn scale(checks: &mut Checks, backends: &[Backend]) {
     }
     for e in -4..=4 {
         let c = convex_scene(10f64.powi(e), 0.0, 256);
-        let (lit, bad) = acne(&c, &Bvh::build(&c));
+        let (lit, bad) = acne_on(&c, &Backend::Bvh.into()).expect("the BVH builds");
         checks.check(
             bad == 0,
             format!("scale 1e{e}: acne {bad} of {lit} lit points"),
@@ -94,7 +93,7 @@ fn offset(checks: &mut Checks) {
     let base = render(&convex_scene(1.0, 0.0, 256), Backend::Bvh);
     for e in 3..=6 {
         let s = convex_scene(1.0, 10f64.powi(e), 256);
-        let (lit, bad) = acne(&s, &Bvh::build(&s));
+        let (lit, bad) = acne_on(&s, &Backend::Bvh.into()).expect("the BVH builds");
         let share = differing_share(&render(&s, Backend::Bvh), &base);
         checks.check(
             e > 5 || bad == 0,
@@ -187,31 +186,27 @@ fn watertight(checks: &mut Checks) {
         )
     };
     for (name, case, n) in watertight_cases() {
-        let st = case.run(&Bvh::build(&case.scene), n, 3.0);
-        checks.check(
-            st.misses == 0,
-            format!("watertight ({name}, bvh): {}", touching(&st)),
-        );
+        match case.run_on(&Backend::Bvh.into(), n, 3.0) {
+            Ok((st, _)) => checks.check(
+                st.misses == 0,
+                format!("watertight ({name}, bvh): {}", touching(&st)),
+            ),
+            Err(e) => checks.check(false, format!("watertight ({name}, bvh): {e}")),
+        }
         #[cfg(feature = "embree")]
         for robust in [false, true] {
             let flag = if robust { "robust" } else { "default flags" };
-            match emray::accel::embree::EmbreeAccel::build_with(
-                &case.scene,
-                "",
-                Default::default(),
-                robust,
-            ) {
-                Ok(e) => {
-                    let st = case.run(&e, n, 3.0);
-                    let info = touching(&st);
-                    let _ = print(format_args!(
-                        "info watertight ({name}, embree {flag}): {info}\n"
-                    ));
-                }
-                Err(e) => {
-                    let _ = print(format_args!("info embree unavailable: {e}\n"));
-                }
-            }
+            let options = emray::accel::BackendOptions {
+                embree_robust: robust,
+                ..Backend::Embree.into()
+            };
+            let _ = match case.run_on(&options, n, 3.0) {
+                Ok((st, _)) => print(format_args!(
+                    "info watertight ({name}, embree {flag}): {}\n",
+                    touching(&st)
+                )),
+                Err(e) => print(format_args!("info embree unavailable: {e}\n")),
+            };
         }
     }
 }

@@ -2,23 +2,29 @@
 //! that records what went wrong, so that every build step can return it as an
 //! [`EmbreeError`].
 
+use std::cell::RefCell;
 use std::ffi::{CStr, CString, c_char, c_void};
 use std::panic::{AssertUnwindSafe, catch_unwind};
 use std::ptr;
-use std::sync::Mutex;
 use std::sync::atomic::{AtomicIsize, Ordering};
 
 use super::error::EmbreeError;
 use super::sys;
 
-/// What the device callbacks write. Boxed, so its address stays fixed while Embree holds
-/// a pointer to it.
+/// What the memory monitor writes. Boxed, so its address stays fixed while Embree
+/// holds a pointer to it.
 #[derive(Debug, Default)]
 struct DeviceState {
-    /// The first error reported since the last [`Device::check`]: code and message.
-    error: Mutex<Option<(u32, String)>>,
     /// Bytes Embree currently has allocated (memory-monitor callback; build time only).
     bytes: AtomicIsize,
+}
+
+thread_local! {
+    /// The first error Embree reported on this thread since the last
+    /// [`Device::check`] there: code and message. Embree calls the error callback on
+    /// the thread of the call that failed and keeps its error codes per thread, so
+    /// builds on other threads sharing the device never see this one's errors.
+    static LAST_ERROR: RefCell<Option<(u32, String)>> = const { RefCell::new(None) };
 }
 
 /// An owned `RTCDevice`.
@@ -35,7 +41,7 @@ pub(super) struct Device {
 // `DeviceState` the callbacks write is synchronised (a `Mutex` and an atomic).
 unsafe impl Send for Device {}
 // SAFETY: as for `Send`: `&Device` only allows `rtcGetDeviceProperty`,
-// `rtcGetDeviceError` and reading the synchronised state.
+// `rtcGetDeviceError` and reading the synchronised state (errors are kept per thread).
 unsafe impl Sync for Device {}
 
 impl Device {
@@ -88,7 +94,7 @@ impl Device {
     pub(super) fn check(&self, operation: impl Into<String>) -> Result<(), EmbreeError> {
         // SAFETY: `self.raw` is a live device.
         let code = unsafe { sys::rtcGetDeviceError(self.raw) };
-        let recorded = lock(&self.state.error).take();
+        let recorded = LAST_ERROR.take();
         match recorded {
             Some((code, message)) => Err(EmbreeError::embree(operation, code, message)),
             None if code != sys::RTCError::RTC_ERROR_NONE => {
@@ -141,15 +147,10 @@ impl Drop for Device {
     }
 }
 
-/// Lock, ignoring poisoning (the data is a plain record).
-fn lock<T>(m: &Mutex<T>) -> std::sync::MutexGuard<'_, T> {
-    m.lock().unwrap_or_else(|poisoned| poisoned.into_inner())
-}
-
-/// Embree's error callback: keep the first error (code and message) for `Device::check`.
-/// Never unwinds into Embree.
+/// Embree's error callback: keep the first error (code and message) on this thread for
+/// `Device::check`. Never unwinds into Embree.
 unsafe extern "C" fn error_callback(
-    user_ptr: *mut c_void,
+    _user_ptr: *mut c_void,
     code: sys::RTCError,
     message: *const c_char,
 ) {
@@ -161,23 +162,20 @@ unsafe extern "C" fn error_callback(
             .to_string_lossy()
             .into_owned()
     };
-    // SAFETY: `user_ptr` is the `DeviceState` registered in `Device::new`, alive until the
-    // callback is unregistered in `Drop`; only a shared reference is formed.
-    let Some(state) = (unsafe { user_ptr.cast::<DeviceState>().as_ref() }) else {
-        return;
-    };
     // Nothing here should panic, but a panic must not cross into C.
     let _ = catch_unwind(AssertUnwindSafe(|| {
-        let mut slot = lock(&state.error);
-        if slot.is_none() {
-            *slot = Some((code.0, message));
-        }
+        LAST_ERROR.with_borrow_mut(|slot| {
+            if slot.is_none() {
+                *slot = Some((code.0, message));
+            }
+        })
     }));
 }
 
 /// Embree's memory monitor: track the bytes allocated; never refuse an allocation.
 unsafe extern "C" fn memory_callback(user_ptr: *mut c_void, bytes: isize, _post: bool) -> bool {
-    // SAFETY: as in `error_callback`.
+    // SAFETY: `user_ptr` is the `DeviceState` registered in `Device::new`, alive until
+    // the callback is unregistered in `Drop`; only a shared reference is formed.
     if let Some(state) = unsafe { user_ptr.cast::<DeviceState>().as_ref() } {
         state.bytes.fetch_add(bytes, Ordering::Relaxed);
     }

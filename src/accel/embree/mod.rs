@@ -26,22 +26,24 @@ mod tests;
 
 pub use error::EmbreeError;
 
-use crate::accel::{Accel, AccelStats, EmbreeQuality, Hit};
+use crate::accel::{Accel, AccelStats, Backend, BackendOptions, Hit};
 use crate::math::Ray;
 use crate::scene::Scene;
 use device::Device;
 use scene::CommittedScene;
+use std::sync::{Arc, Mutex};
 
 /// A committed Embree scene over a [`Scene`]'s primitives.
 ///
 /// Immutable once built, and `Send + Sync`: queries run from any number of threads.
 /// Dropping it releases the scene (then frees the primitive data its user-geometry
-/// callbacks read), then the device.
+/// callbacks read), then its hold on the device, which the process shares
+/// ([`shared_device`]).
 #[derive(Debug)]
 pub struct EmbreeAccel {
     // Fields drop in declaration order: the scene before the device.
     scene: CommittedScene,
-    device: Device,
+    device: Arc<Device>,
     prims: usize,
     bytes: usize,
     detail: String,
@@ -49,30 +51,36 @@ pub struct EmbreeAccel {
     packet_width: u32,
 }
 
+/// The process's Embree device for `threads` build threads, created at the first
+/// build that asks for it with the configuration `threads=N` (as `rtcNewDevice`
+/// documents it) and kept for the process's life: one device per process, or one per
+/// thread count for a process whose builds run on pools of different sizes.
+fn shared_device(threads: usize) -> Result<Arc<Device>, EmbreeError> {
+    static DEVICES: Mutex<Vec<(usize, Arc<Device>)>> = Mutex::new(Vec::new());
+    let mut devices = DEVICES.lock().unwrap_or_else(|e| e.into_inner());
+    if let Some((_, d)) = devices.iter().find(|(t, _)| *t == threads) {
+        return Ok(Arc::clone(d));
+    }
+    let device = Arc::new(Device::new(&format!("threads={threads}"))?);
+    devices.push((threads, Arc::clone(&device)));
+    Ok(device)
+}
+
 impl EmbreeAccel {
-    /// Build with Embree's default device configuration.
+    /// Build with emray's defaults: medium build quality, robust traversal.
     pub fn build(scene: &Scene) -> Result<EmbreeAccel, EmbreeError> {
-        EmbreeAccel::build_with_config(scene, "")
+        EmbreeAccel::build_with(scene, &BackendOptions::new(Backend::Embree))
     }
 
-    /// Build with an Embree device configuration string, e.g. `"threads=2"` (see
-    /// `rtcNewDevice`), the default build quality and robust traversal (emray's
-    /// defaults).
-    pub fn build_with_config(scene: &Scene, config: &str) -> Result<EmbreeAccel, EmbreeError> {
-        EmbreeAccel::build_with(scene, config, EmbreeQuality::default(), true)
-    }
-
-    /// Build with a device configuration string, a build quality, and with or without
-    /// `RTC_SCENE_FLAG_ROBUST` on every scene (the top level and each instanced
-    /// object's): robust traversal avoids the arithmetic shortcuts that can let a ray
-    /// slip between two triangles sharing an edge, at some cost in speed.
-    pub fn build_with(
-        scene: &Scene,
-        config: &str,
-        quality: EmbreeQuality,
-        robust: bool,
-    ) -> Result<EmbreeAccel, EmbreeError> {
-        let device = Device::new(config)?;
+    /// Build with `options` (build quality, robust traversal, packet width), on the
+    /// process's device for the current rayon pool's thread count. Robust traversal
+    /// (`RTC_SCENE_FLAG_ROBUST` on every scene: the top level and each instanced
+    /// object's) avoids the arithmetic shortcuts that can let a ray slip between two
+    /// triangles sharing an edge, at some cost in speed.
+    pub fn build_with(scene: &Scene, options: &BackendOptions) -> Result<EmbreeAccel, EmbreeError> {
+        let device = shared_device(rayon::current_num_threads())?;
+        let (quality, robust) = (options.embree_quality, options.embree_robust);
+        let before = device.allocated_bytes();
         let committed = CommittedScene::build(&device, scene, quality, robust)?;
         let api = if cfg!(embree4) { "embree4" } else { "embree3" };
         let detail = format!(
@@ -83,15 +91,16 @@ impl EmbreeAccel {
             quality.name(),
         );
         Ok(EmbreeAccel {
-            // Embree's own allocations (hierarchy, triangle buffers), read after the
-            // commit has freed the build's temporaries, and the primitive data emray
-            // keeps for the callbacks.
-            bytes: device.allocated_bytes() + committed.rust_bytes(),
+            // Embree's own allocations for this scene (hierarchy, triangle buffers), read
+            // after the commit has freed the build's temporaries (on a device building
+            // one scene at a time), and the primitive data emray keeps for the
+            // callbacks.
+            bytes: device.allocated_bytes().saturating_sub(before) + committed.rust_bytes(),
             scene: committed,
             device,
             prims: scene.prim_count_with_instances(),
             detail,
-            packet_width: crate::accel::DEFAULT_PACKET_WIDTH,
+            packet_width: options.packet_width,
         })
     }
 

@@ -472,18 +472,34 @@ fn queries_from_many_threads_agree() {
 
 #[test]
 fn bad_device_configuration_is_an_error() {
-    let s = scene();
-    let e = EmbreeAccel::build_with_config(&s, "threads=1\0").unwrap_err();
+    let e = device::Device::new("threads=1\0").unwrap_err();
     assert_eq!(e.code(), None);
     assert!(e.to_string().contains("NUL"), "{e}");
     // Embree 3.13 fails to create the device on an unparsable value (RTC_ERROR_UNKNOWN).
-    let e = EmbreeAccel::build_with_config(&s, "threads=abc").unwrap_err();
+    let e = device::Device::new("threads=abc").unwrap_err();
     assert!(e.code().is_some_and(|c| c != 0), "{e}");
     assert!(
         e.to_string().contains("rtcNewDevice(\"threads=abc\")"),
         "{e}"
     );
-    assert!(EmbreeAccel::build_with_config(&s, "threads=1").is_ok());
+    assert!(device::Device::new("threads=1").is_ok());
+}
+
+/// One device for the process's builds on pools of one size: two builds share it.
+#[test]
+fn builds_share_the_process_device() {
+    let mut s = scene();
+    add_triangle(&mut s, Vec3::ZERO, Vec3::X, Vec3::Y);
+    s.geometry.push(Sphere::new(Vec3::Z * 3.0, 1.0), 0);
+    let pool = rayon::ThreadPoolBuilder::new()
+        .num_threads(3)
+        .build()
+        .unwrap();
+    let (a, b) = pool.install(|| (build(&s), build(&s)));
+    assert!(Arc::ptr_eq(&a.device, &b.device));
+    assert!(a.stats().bytes > 0 && b.stats().bytes > 0);
+    drop(a);
+    assert_eq!(b.stats().prims, s.prim_count_with_instances());
 }
 
 #[test]

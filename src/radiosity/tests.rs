@@ -1,18 +1,18 @@
-//! Radiosity: form factors against analytic values, reciprocity and closure, energy
+//! Tests of the radiosity pass: form factors against analytic values, reciprocity and closure, energy
 //! conservation against the geometric series, solver convergence and agreement, both
 //! backends.
 
-use emray::accel::bvh::Bvh;
-use emray::geometry::Triangle;
-use emray::math::Vec3;
-use emray::radiosity::formfactor::{
+use crate::accel::bvh::Bvh;
+use crate::geometry::Triangle;
+use crate::math::Vec3;
+use crate::radiosity::formfactor::{
     Sampling, element_form_factor, parallel_rectangles, perpendicular_rectangles, point_to_disk,
     point_to_polygon,
 };
-use emray::radiosity::hemicube::Hemicube;
-use emray::radiosity::mesh::{Mesh, longest_edge};
-use emray::radiosity::{self, FormFactorMethod, RadiositySettings, SolverKind, solver};
-use emray::scene::{Camera, Material, Scene};
+use crate::radiosity::hemicube::Hemicube;
+use crate::radiosity::mesh::{Mesh, longest_edge};
+use crate::radiosity::{self, FormFactorMethod, RadiositySettings, SolverKind, solver};
+use crate::scene::{Camera, Material, Scene};
 
 fn camera() -> Camera {
     Camera {
@@ -201,7 +201,7 @@ fn form_factors_are_reciprocal_on_random_pairs() {
     let mesh = Mesh::build(&scene, 0.45).unwrap();
     let n = mesh.elements.len();
     let s = Sampling::new(3, 1);
-    let mut rng = emray::math::Rng::new(0x1234_5678);
+    let mut rng = crate::math::Rng::new(0x1234_5678);
     let mut next = || rng.below(n as u32) as usize;
     let mut checked = 0;
     while checked < 40 {
@@ -406,7 +406,7 @@ fn both_backends_give_the_same_solution() {
         ..Default::default()
     };
     let bvh = Bvh::build(&scene);
-    let embree = emray::accel::embree::EmbreeAccel::build(&scene).unwrap();
+    let embree = crate::accel::embree::EmbreeAccel::build(&scene).unwrap();
     let a = radiosity::solve(&scene, &bvh, &settings).unwrap();
     let b = radiosity::solve(&scene, &embree, &settings).unwrap();
     assert_eq!(a.solve.iterations, b.solve.iterations);
@@ -455,7 +455,7 @@ fn the_view_shows_the_interpolated_solution() {
 
 #[test]
 fn area_light_sampling_matches_the_form_factor_and_softens_shadows() {
-    use emray::render::area;
+    use crate::render::area;
     // A 1 × 1 emitter facing down, 1 above the origin of a floor facing up.
     let mut s = Scene::new(camera());
     s.materials.push(Material::DEFAULT);
@@ -524,10 +524,10 @@ fn two_pass_without_specular_paths_shows_the_radiosity_solution() {
     )
     .unwrap();
     let view = radiosity::render_view(&scene, &accel, &sol, 16, 16, 1);
-    let mut settings = emray::RenderSettings::for_scene(&scene);
+    let mut settings = crate::RenderSettings::for_scene(&scene);
     settings.width = 16;
     settings.height = 16;
-    let (film, stats) = emray::render::render_with_gi(&scene, &accel, &settings, Some(&sol), None);
+    let (film, stats) = crate::render::render_with_gi(&scene, &accel, &settings, Some(&sol), None);
     // Everything is diffuse and there are no point lights: one diffuse term, counted
     // once, from the solution; no shadow rays.
     assert_eq!(stats.rays.shadow, 0);
@@ -536,9 +536,9 @@ fn two_pass_without_specular_paths_shows_the_radiosity_solution() {
     }
     // Without the solution the emitter still lights the room, through area-light
     // sampling, with soft shadows: direct light only, so darker on average.
-    let (direct, stats) = emray::render::render(&scene, &accel, &settings, None);
+    let (direct, stats) = crate::render::render(&scene, &accel, &settings, None);
     assert!(stats.rays.shadow > 0);
-    let mean = |f: &emray::render::Film| {
+    let mean = |f: &crate::render::Film| {
         f.pixels.iter().map(|p| p.x + p.y + p.z).sum::<f32>() / f.pixels.len() as f32
     };
     assert!(mean(&direct) > 0.0 && mean(&direct) < mean(&film));
@@ -829,7 +829,7 @@ fn adaptive_subdivision_refines_the_shadow_boundary_without_cracks() {
 #[test]
 fn classroom_ceiling_and_desk_undersides_are_lit_only_indirectly_but_lit() {
     let path = std::path::Path::new(env!("CARGO_MANIFEST_DIR")).join("scenes/classroom.toml");
-    let scene = emray::load::load_path(&path).unwrap();
+    let scene = crate::load::load_path(&path).unwrap();
     let accel = Bvh::build(&scene);
     let sol = radiosity::solve(
         &scene,
@@ -873,7 +873,7 @@ fn classroom_ceiling_and_desk_undersides_are_lit_only_indirectly_but_lit() {
 /// The white box of [`white_box`] with a sphere over the middle of the floor and a
 /// small box floating in a corner, all of the walls' reflectance.
 fn sphere_in_box(rho: f32) -> Scene {
-    use emray::geometry::{AaBox, Shape, Sphere};
+    use crate::geometry::{AaBox, Shape, Sphere};
     let mut s = white_box(rho);
     s.geometry.add_shape(
         Shape::Sphere(Sphere::new(Vec3::new(0.5, 0.2, 0.5), 0.15)),
@@ -886,8 +886,8 @@ fn sphere_in_box(rho: f32) -> Scene {
 
 #[test]
 fn tessellated_shapes_receive_reflect_and_shadow() {
-    use emray::accel::{Accel, Hit};
-    use emray::math::Ray;
+    use crate::accel::{Accel, Hit};
+    use crate::math::Ray;
     let rho = 0.5;
     let scene = sphere_in_box(rho);
     let bvh = Bvh::build(&scene);
@@ -914,7 +914,7 @@ fn tessellated_shapes_receive_reflect_and_shadow() {
     ];
     #[cfg(feature = "embree")]
     {
-        let embree = emray::accel::embree::EmbreeAccel::build(&scene).unwrap();
+        let embree = crate::accel::embree::EmbreeAccel::build(&scene).unwrap();
         let sol = radiosity::solve(&scene, &embree, &base).unwrap();
         // Both backends agree.
         for (x, y) in runs[0].1.solve.radiosity.iter().zip(&sol.solve.radiosity) {
@@ -926,7 +926,7 @@ fn tessellated_shapes_receive_reflect_and_shadow() {
         let m = &sol.mesh;
         assert_eq!(m.unmeshed, 0, "{name}: sphere and box are meshed");
         let b = |k: usize| sol.solve.radiosity[k].x;
-        let mean = |pick: &dyn Fn(&emray::radiosity::mesh::Element) -> bool| {
+        let mean = |pick: &dyn Fn(&crate::radiosity::mesh::Element) -> bool| {
             let (mut sum, mut area) = (0.0, 0.0);
             for (k, e) in m.elements.iter().enumerate() {
                 if pick(e) {
@@ -937,11 +937,11 @@ fn tessellated_shapes_receive_reflect_and_shadow() {
             assert!(area > 0.0, "{name}: no elements picked");
             sum / area
         };
-        let on_sphere = |e: &emray::radiosity::mesh::Element| {
+        let on_sphere = |e: &crate::radiosity::mesh::Element| {
             (e.centroid() - Vec3::new(0.5, 0.2, 0.5)).length() < 0.16
         };
-        let floor = |e: &emray::radiosity::mesh::Element| e.centroid().y < 1e-3 && e.n.y > 0.9;
-        let xz = |e: &emray::radiosity::mesh::Element| {
+        let floor = |e: &crate::radiosity::mesh::Element| e.centroid().y < 1e-3 && e.n.y > 0.9;
+        let xz = |e: &crate::radiosity::mesh::Element| {
             let c = e.centroid();
             (c.x - 0.5).hypot(c.z - 0.5)
         };
@@ -980,7 +980,7 @@ fn tessellated_shapes_receive_reflect_and_shadow() {
         let look = |from: Vec3, dir: Vec3| {
             let ray = Ray::new(from, dir);
             let hit: Hit = bvh.intersect(&ray).unwrap();
-            assert_eq!(hit.geom_id, emray::geometry::Kind::Sphere as u32);
+            assert_eq!(hit.geom_id, crate::geometry::Kind::Sphere as u32);
             sol.radiosity_at(&hit, ray.at(hit.t), dir).unwrap().x
         };
         let shown_top = look(Vec3::new(0.5, 0.9, 0.5), -Vec3::Y);
@@ -1031,8 +1031,8 @@ fn adaptive_rounds_go_on_from_the_previous_solution() {
 }
 
 /// A receiver at `p` facing +y.
-fn at(p: Vec3) -> emray::render::area::Receiver {
-    emray::render::area::Receiver {
+fn at(p: Vec3) -> crate::render::area::Receiver {
+    crate::render::area::Receiver {
         p,
         err: Vec3::ZERO,
         ng: Vec3::Y,
