@@ -61,7 +61,8 @@ impl Unbounded {
         Unbounded { entries }
     }
 
-    /// True when the scene has none.
+    /// True when the scene has none (the Embree backend then skips testing them).
+    #[cfg(feature = "embree")]
     pub fn is_empty(&self) -> bool {
         self.entries.is_empty()
     }
