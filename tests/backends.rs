@@ -205,7 +205,7 @@ fn a_huge_floor_seen_from_close_by_is_whole_on_both_backends() {
              p 4\n-{x} 0 -{z}\n-{x} 0 {z}\n{x} 0 {z}\n{x} 0 -{z}\n"
         );
         let scene = emray::load::nff::parse_str(&src, std::path::Path::new("floor.nff")).unwrap();
-        let settings = emray::RenderSettings::for_scene(&scene);
+        let settings = emray::render::RenderSettings::for_scene(&scene);
         let render = |backend| {
             emray::job::render_scene("floor", &scene, backend, &settings, 0.0, None).unwrap()
         };

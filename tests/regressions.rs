@@ -31,7 +31,7 @@ fn inputs(format: &str) -> Vec<PathBuf> {
 
 /// Render `scene` as the fuzz targets do (6×5, depth ≤ 6, one sample) on every backend.
 fn renders_without_nan(path: &Path, scene: &Scene) {
-    let mut settings = emray::RenderSettings::for_scene(scene);
+    let mut settings = emray::render::RenderSettings::for_scene(scene);
     settings.width = 6;
     settings.height = 5;
     settings.max_depth = settings.max_depth.min(6);
@@ -151,7 +151,7 @@ fn overflowing_radiance_is_saturated_and_counted() {
             emray::load::toml::load(&dir.join("toml/overflowing-light.toml")).unwrap(),
         ),
     ] {
-        let mut settings = emray::RenderSettings::for_scene(&scene);
+        let mut settings = emray::render::RenderSettings::for_scene(&scene);
         (settings.width, settings.height) = (8, 8);
         let (film, report) =
             emray::job::render_scene("overflow", &scene, Backend::Bvh, &settings, 0.0, None)

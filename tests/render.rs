@@ -284,3 +284,38 @@ fn progress_hears_the_tile_count_before_the_first_tile() {
         assert!(calls.iter().all(|&(d, t)| t == total && d <= total));
     }
 }
+
+/// The embedding facade: a file rendered in memory with an output variable, as the
+/// `render_file` example does; the image is the command line's (`render_scene` of the
+/// same settings) and the depth layer holds the eye-to-surface distance where the
+/// centre ray meets a sphere of `scenes/spheres.toml`.
+#[test]
+fn render_file_renders_in_memory_with_its_output_variables() {
+    let path = std::path::Path::new(env!("CARGO_MANIFEST_DIR")).join("scenes/spheres.toml");
+    let options = emray::RenderOptions {
+        res: Some("40x30".parse().unwrap()),
+        aov: Some("depth,normal".parse().unwrap()),
+        backend: Some(emray::Backend::Bvh),
+        ..emray::RenderOptions::default()
+    };
+    let rendered = emray::render_file(&path, &options).unwrap();
+    let (film, aov) = rendered.image().unwrap();
+    let aov = aov.unwrap();
+    assert_eq!((film.width, film.height), (40, 30));
+    assert_eq!(aov.depth.len(), 40 * 30);
+    let centre = aov.depth[15 * 40 + 20];
+    assert!(centre.is_finite() && centre > 0.0, "{centre}");
+    assert!(aov.depth.iter().any(|d| d.is_infinite()), "some rays miss");
+    let scene = emray::load::load_path(&path).unwrap();
+    let settings = options.resolve(&scene).unwrap().settings;
+    let (plain, _) =
+        emray::job::render_scene("spheres", &scene, emray::Backend::Bvh, &settings, 0.0, None)
+            .unwrap();
+    assert_eq!(plain.pixels, film.pixels);
+    // The options' errors come back typed, before any work.
+    let bad = emray::RenderOptions {
+        spp: Some(0),
+        ..emray::RenderOptions::default()
+    };
+    assert!(emray::render_file(&path, &bad).unwrap_err().is_usage());
+}

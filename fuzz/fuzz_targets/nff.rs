@@ -7,7 +7,7 @@ use std::path::Path;
 fuzz_target!(|data: &[u8]| {
     if let Ok(text) = std::str::from_utf8(data) {
         if let Ok(scene) = emray::load::nff::parse_str(text, Path::new("fuzz.nff")) {
-            let settings = emray::RenderSettings::for_scene(&scene);
+            let settings = emray::render::RenderSettings::for_scene(&scene);
             let _ = emray::job::limits::estimate_bytes(&scene, &settings);
         }
     }

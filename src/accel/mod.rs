@@ -1,7 +1,7 @@
 //! Acceleration structures behind one trait: Intel Embree (feature `embree`) and the
 //! pure-Rust BVH. Both report hits in the same terms (geometry id = [`Kind`], primitive
 //! index within the kind), so the renderer cannot tell them apart. Primitives with
-//! infinite bounds stay out of both structures: [`unbounded`] tests them first, for
+//! infinite bounds stay out of both structures: `unbounded` tests them first, for
 //! both.
 
 pub mod bvh;

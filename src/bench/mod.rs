@@ -540,7 +540,7 @@ pub struct Measured {
     pub peers: Vec<PeerSample>,
     /// Scene → how Tachyon's picture differs.
     pub peer_notes: std::collections::BTreeMap<String, String>,
-    /// Scene → share of pixels Tachyon and emray frame alike ([`peer::framing`]).
+    /// Scene → share of pixels Tachyon and emray frame alike (`peer::framing`).
     pub peer_framing: std::collections::BTreeMap<String, f64>,
     /// Why there are no Tachyon runs, if there are none.
     pub peer_missing: String,

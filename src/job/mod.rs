@@ -6,11 +6,11 @@
 //!   declared once, with the values written as text in [`values`];
 //! - [`resolve`]: the options checked, then resolved against the scene, every default
 //!   applied there and nowhere else;
-//! - [`Job`], [`run`] ([`pipeline`]): a scene, options, a task and the files to write,
+//! - [`Job`], [`run`] (`pipeline`): a scene, options, a task and the files to write,
 //!   run from load to written output, reporting each phase to an [`Observer`];
-//! - [`work`]: what the job does with its built backend;
-//! - [`Report`] ([`report`]): what a render reports;
-//! - [`limits`]: the memory a render needs, checked before it starts;
+//! - `work`: what the job does with its built backend;
+//! - [`Report`] (`report`): what a render reports;
+//! - `limits`: the memory a render needs, checked before it starts;
 //! - [`template`]: the one template language of output file names.
 
 mod limits;

@@ -21,9 +21,10 @@ use crate::accel::{self, AccelError, AccelStats};
 use crate::output::part::PartInfo;
 use crate::output::{self, Format, OutputError};
 use crate::radiosity::RadiosityError;
-use crate::render::RayCounts;
 use crate::render::aov::AovError;
+use crate::render::aov::AovFilm;
 use crate::render::explain::ExplainError;
+use crate::render::{Film, RayCounts};
 use crate::scene::Scene;
 use std::collections::HashMap;
 use std::path::{Path, PathBuf};
@@ -214,6 +215,18 @@ pub struct Rendered {
     /// Where the scene's zero lies in the world (the PLY mesh is written in world
     /// coordinates).
     pub origin: crate::math::DVec3,
+}
+
+impl Rendered {
+    /// The image and its output variables, when the job made an image (a render or a
+    /// radiosity view).
+    pub fn image(&self) -> Option<(&Film, Option<&AovFilm>)> {
+        match &self.product {
+            Product::Image { film, aov } => Some((film, aov.as_deref())),
+            Product::Radiosity { film, .. } => Some((film, None)),
+            Product::Explanation(_) => None,
+        }
+    }
 }
 
 impl Job {

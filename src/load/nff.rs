@@ -37,7 +37,7 @@ pub const MAX_PIXELS: u64 = 1 << 28;
 /// `path: cannot read: …` when the file cannot be read, `path: …` when it is not text
 /// (gzip-compressed, UTF-16), otherwise whatever [`parse_str`] reports. A leading
 /// UTF-8 byte-order mark is skipped, and bytes that are not UTF-8 (in comments, say)
-/// are replaced, which leaves line and column numbers intact (see [`super::text`]).
+/// are replaced, which leaves line and column numbers intact (see `super::text`).
 pub fn load(path: &Path) -> Result<Scene, LoadError> {
     let scene = parse_str(&text::read_lossy(path)?, path)?;
     super::warn_if_empty(&scene, path);

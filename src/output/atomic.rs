@@ -148,7 +148,7 @@ const TEMP_SUFFIX: &str = ".tmp";
 const TEMP_RAND: usize = 8;
 
 /// Remove temporary files that an earlier, killed process left for `path` (their
-/// names are `.NAME.XXXXXXXX.tmp`, see [`write_atomic`]; older versions put their
+/// names are `.NAME.XXXXXXXX.tmp`, see `write_atomic`; older versions put their
 /// process id there); returns how many went.
 pub fn remove_stale_temps(path: &Path) -> usize {
     let (Some(dir), Some(name)) = (path.parent(), path.file_name()) else {

@@ -3,8 +3,8 @@
 //! so a failed or interrupted write never leaves a truncated image, and
 //! [`abandon_writes`] removes the temporary files of the writes in progress for a
 //! process about to end. Besides the colour: the output variables' EXR channels
-//! ([`aov`], [`channels`]) and the cost heat maps ([`heatmap`]), drawn with the colour
-//! maps of [`colormap`].
+//! (`aov`, `channels`) and the cost heat maps (`heatmap`), drawn with the colour
+//! maps of `colormap`.
 
 pub(crate) mod aov;
 mod atomic;

@@ -1,9 +1,9 @@
 //! Radiosity: diffuse interreflection between the scene's surfaces, view-independent.
 //!
-//! The phases: [`mesh`] splits every triangle, and the faces of the analytic shapes
-//! [`tessellate`] handles, into elements of at most the patch size;
-//! [`formfactor`] estimates form factors by ray casting (exact point-to-polygon form
-//! factors with visibility from `Accel::occluded`, either backend); [`solver`] solves
+//! The phases: `mesh` splits every triangle, and the faces of the analytic shapes
+//! `tessellate` handles, into elements of at most the patch size;
+//! `formfactor` estimates form factors by ray casting (exact point-to-polygon form
+//! factors with visibility from `Accel::occluded`, either backend); `solver` solves
 //! the system by progressive refinement (or Gauss–Seidel on the full matrix); a
 //! [`Solution`] then holds per-vertex radiosities (area-weighted averages of the
 //! adjacent elements) that any camera can look at through ray casting, Gouraud
@@ -185,7 +185,7 @@ impl Solution {
     /// The Gouraud-interpolated radiosity at a hit at point `p` seen along `dir`: on a
     /// meshed triangle, at the hit's barycentric coordinates (zero on its back side); on
     /// a tessellated analytic shape, at the projection of `p` onto the face under it (see
-    /// [`tessellate`]; the back side of an open cone is not meshed: `None`); `None` for
+    /// `tessellate`; the back side of an open cone is not meshed: `None`); `None` for
     /// primitives that are not meshed.
     pub fn radiosity_at(&self, hit: &Hit, p: Vec3, dir: Vec3) -> Option<Vec3> {
         let (k, u, v) = match hit.kind() {

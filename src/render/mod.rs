@@ -1,5 +1,5 @@
 //! The Whitted renderer: eye rays, local Phong light with shadow rays, area lights
-//! ([`area`]), mirror reflection, Snell refraction with total internal reflection, a
+//! (`area`), mirror reflection, Snell refraction with total internal reflection, a
 //! depth limit; tiles rendered in parallel, deterministic whatever the thread count.
 //! Global illumination comes in through [`GlobalIllumination`] (a radiosity solution
 //! implements it); [`color`] turns the film's linear values into encoded 8-bit ones.

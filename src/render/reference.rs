@@ -342,7 +342,7 @@ pub fn render(scene: &Scene, width: u32, height: u32, n: u32, max_depth: u32) ->
 const ESTIMATE_PIXELS: u32 = 64;
 
 /// The time in milliseconds [`render`] would take with the same arguments on
-/// `threads` threads, extrapolated from [`ESTIMATE_PIXELS`] pixels spread over the
+/// `threads` threads, extrapolated from `ESTIMATE_PIXELS` pixels spread over the
 /// picture (a diagonal-free lattice, so a scene's empty corners and busy centre both
 /// count), traced on this thread.
 pub fn estimate_ms(

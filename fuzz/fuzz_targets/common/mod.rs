@@ -12,7 +12,7 @@ const BACKENDS: &[emray::accel::Backend] = &[
 /// Build each backend over `scene` and render a tiny image of it: no panic, no abort,
 /// no hang (depth and area samples capped), and no NaN pixel.
 pub fn render_has_no_nan(scene: &emray::Scene) {
-    let mut settings = emray::RenderSettings::for_scene(scene);
+    let mut settings = emray::render::RenderSettings::for_scene(scene);
     settings.width = 6;
     settings.height = 5;
     settings.max_depth = settings.max_depth.min(6);

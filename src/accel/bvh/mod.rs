@@ -87,7 +87,7 @@ const MAX_DEPTH: usize = 64;
 impl Bvh {
     /// Build over every primitive of `scene`: a hierarchy per instanced object, and a
     /// top-level one over the scene's own primitives and the instances; the unbounded
-    /// primitives of all of them in one [`Unbounded`] list.
+    /// primitives of all of them in one `Unbounded` list.
     pub fn build(scene: &Scene) -> Bvh {
         let objects: Vec<Arc<Bvh>> = scene
             .objects
@@ -360,7 +360,7 @@ fn scene_kinds(scene: &Scene) -> Vec<(Kind, usize)> {
 }
 
 /// The leaves test triangles with the watertight test, four at a time with lanes
-/// bit-identical to the one-triangle test ([`agreement`] checks it).
+/// bit-identical to the one-triangle test (`agreement` checks it).
 impl Accel for Bvh {
     #[inline(always)]
     fn exact_triangle_hits(&self) -> bool {

@@ -38,7 +38,7 @@ use std::sync::{Arc, Mutex};
 /// Immutable once built, and `Send + Sync`: queries run from any number of threads.
 /// Dropping it releases the scene (then frees the primitive data its user-geometry
 /// callbacks read), then its hold on the device, which the process shares
-/// ([`shared_device`]).
+/// (`shared_device`).
 #[derive(Debug)]
 pub struct EmbreeAccel {
     // Fields drop in declaration order: the scene before the device.

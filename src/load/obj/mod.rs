@@ -115,7 +115,7 @@
 //! - t = 1 − `d` (`d` from `d`, else 1 − `Tr`, else 1): a material with `d` < 1
 //!   transmits, whatever its illumination model.
 //! - ior = `Ni`, or 1 when absent or outside 0.001–1000 (many exporters write `Ni 0`;
-//!   the range is [`range::IOR_RANGE`]); a transmissive material with such an `Ni` gets
+//!   the range is `range::IOR_RANGE`); a transmissive material with such an `Ni` gets
 //!   a warning.
 //! - priority = 0.
 //!
@@ -141,7 +141,7 @@
 //! radius of a sphere around the box):
 //!
 //! - The camera looks at `c` from `c + d · (0, sin 15°, cos 15°)`: on the +z side,
-//!   15° above the centre, with up = +y, a 40° field of view ([`Camera::angle_deg`]),
+//!   15° above the centre, with up = +y, a 40° field of view (`Camera::angle_deg`),
 //!   hither 0 and 512 × 512 pixels. `d = 1.05 · r / sin 20°`: the sphere fits inside
 //!   the 40° cone of view with 5 % to spare.
 //! - One white point light, intensity (1, 1, 1), no attenuation, at
@@ -269,7 +269,7 @@ pub fn load(path: &Path) -> Result<Scene, LoadError> {
 /// (gzip-compressed, UTF-16), `path:line:col: …` at the first malformed statement (see
 /// the module documentation). A leading UTF-8 byte-order mark is skipped, and bytes
 /// that are not UTF-8 are replaced, which leaves line numbers intact (see
-/// [`super::text`]). Problems with material libraries are warnings, not errors.
+/// `super::text`). Problems with material libraries are warnings, not errors.
 pub fn load_geometry(path: &Path) -> Result<ObjData, LoadError> {
     load_geometry_at(path, Origin::At(DVec3::ZERO))
 }

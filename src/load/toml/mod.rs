@@ -3,7 +3,7 @@
 //! included NFF files, groups, instances and CSG), each with a material and a list of
 //! transforms. The reference is `docs/scene-format.md`.
 //!
-//! Reading happens in two steps: TOML text into the [`format`] structures (serde, with
+//! Reading happens in two steps: TOML text into the [`format`](mod@format) structures (serde, with
 //! the span of every value kept), then those into a [`Scene`] (the `build` module),
 //! which resolves names, applies defaults and transforms, and checks everything the
 //! types cannot. Errors of both steps carry the file, line and column of the offending

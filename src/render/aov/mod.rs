@@ -1,7 +1,7 @@
 //! Output variables (AOVs): per pixel, besides its colour, what the eye rays first hit
 //! (distance, shading normal, albedo, point, primitive id) and what the pixel cost
 //! (rays cast, the deepest of them, nanoseconds), gathered by an
-//! [`AovRecorder`](recorder::AovRecorder) from the renderer's own tracer while it
+//! `AovRecorder` from the renderer's own tracer while it
 //! renders the colour, which comes out as a plain render's, bit for bit.
 //!
 //! A pixel's first-hit values are the mean over its samples that hit a surface (the

@@ -2,8 +2,8 @@
 //! what each hit and where that primitive was defined, each term of the light at each
 //! hit, the reflection and refraction weights, and what each ray brings back.
 //!
-//! The tree is recorded from the renderer's own tracer ([`super::whitted`]) by an
-//! [`ExplainRecorder`](recorder::ExplainRecorder): the pixel is traced by the code that
+//! The tree is recorded from the renderer's own tracer (`super::whitted`) by an
+//! `ExplainRecorder`: the pixel is traced by the code that
 //! renders it, through the same tile of eye rays (cast together, as a render casts
 //! them), so the value it ends with is the film's value bit for bit. [`text`] prints
 //! the tree for people; the types here serialise to the JSON of `--json`
