@@ -524,7 +524,7 @@ fn two_pass_without_specular_paths_shows_the_radiosity_solution() {
     )
     .unwrap();
     let view = radiosity::render_view(&scene, &accel, &sol, 16, 16, 1);
-    let mut settings = crate::RenderSettings::for_scene(&scene);
+    let mut settings = crate::render::RenderSettings::for_scene(&scene);
     settings.width = 16;
     settings.height = 16;
     let (film, stats) = crate::render::render_with_gi(&scene, &accel, &settings, Some(&sol), None);
