@@ -1,0 +1,198 @@
+//! Triangulation of planar, possibly concave, simple polygons in 3-D (NFF `p`/`pp`, OBJ
+//! faces, the scene format's polygons and meshes).
+//!
+//! The polygon's plane normal comes from Newell's method (robust for any vertex order
+//! and for concave or slightly non-planar input), the vertices are projected onto the
+//! coordinate plane most perpendicular to it, and the projected polygon is cut by ear
+//! clipping in double precision. Every output triangle keeps the polygon's winding:
+//! its `(p1 − p0) × (p2 − p0)`, computed in `f32` as the intersectors do, points the
+//! same way as the Newell normal. Zero-area ears (collinear or spike vertices) are
+//! removed without emitting a triangle.
+//!
+//! Ear clipping never emits a triangle outside a simple polygon. For input that is not
+//! simple (self-intersecting), or when rounding hides every ear, the clipper falls back
+//! to cutting a convex corner so that it always terminates.
+//!
+//! The parts: [`ring`] (the projected vertices, their links and the orientation tests)
+//! and [`clip`] (the walk that cuts ears).
+
+mod clip;
+mod ring;
+#[cfg(test)]
+mod tests;
+
+use crate::math::{DVec3, Vec3};
+use ring::{COLLINEAR_REL, Ring};
+
+/// Why a polygon has no triangulation.
+#[derive(Clone, Copy, Debug, PartialEq, Eq, thiserror::Error)]
+pub enum PolygonError {
+    /// Fewer than three distinct vertices after removing consecutive duplicates (and a
+    /// closing vertex equal to the first).
+    #[error("polygon has {distinct} distinct vertices (at least 3 needed)")]
+    TooFewVertices {
+        /// Number of distinct vertices found.
+        distinct: usize,
+    },
+    /// All vertices are collinear (or the polygon's area is otherwise zero): there is no
+    /// plane and nothing to see.
+    #[error("polygon has zero area")]
+    ZeroArea,
+}
+
+/// Reusable ear clipper: keeps its scratch buffers between polygons, so a loader can
+/// triangulate thousands of polygons without allocating for each.
+#[derive(Debug, Default)]
+pub struct Triangulator {
+    /// Indices into the input of the distinct vertices.
+    idx: Vec<usize>,
+    /// The distinct vertices, projected and linked.
+    ring: Ring,
+    /// Triangles over distinct-vertex indices.
+    tris: Vec<[usize; 3]>,
+}
+
+/// Triangulate one polygon; see [`Triangulator::triangulate`].
+pub fn triangulate(points: &[Vec3]) -> Result<Vec<[usize; 3]>, PolygonError> {
+    let mut out = Vec::new();
+    Triangulator::default().triangulate(points, &mut out)?;
+    Ok(out)
+}
+
+/// The Newell normal of a polygon (twice its vector area), not normalised, computed in
+/// `f64` relative to the first vertex. Zero for fewer than three points.
+pub fn newell_normal(points: &[Vec3]) -> DVec3 {
+    let Some(first) = points.first() else {
+        return DVec3::ZERO;
+    };
+    let o = first.as_dvec3();
+    let mut n = DVec3::ZERO;
+    let mut prev = DVec3::ZERO;
+    for p in &points[1..] {
+        let q = p.as_dvec3() - o;
+        n += prev.cross(q);
+        prev = q;
+    }
+    n
+}
+
+impl Triangulator {
+    /// A triangulator with empty buffers.
+    pub fn new() -> Self {
+        Self::default()
+    }
+
+    /// Triangulate the polygon `points` (in order, closed implicitly) into `out`
+    /// (cleared first) as triples of indices into `points`.
+    ///
+    /// Consecutive duplicate vertices, and a last vertex equal to the first, are
+    /// ignored. Triangles and convex quadrilaterals take a fast path; anything else
+    /// goes through ear clipping, `O(n²)` for `n` vertices.
+    /// Triangles too thin to have a nonzero normal in `f32` are left out.
+    ///
+    /// # Errors
+    /// [`PolygonError::TooFewVertices`] with fewer than 3 distinct vertices,
+    /// [`PolygonError::ZeroArea`] when the polygon (or every triangle of it) has no area.
+    pub fn triangulate(
+        &mut self,
+        points: &[Vec3],
+        out: &mut Vec<[usize; 3]>,
+    ) -> Result<(), PolygonError> {
+        out.clear();
+        self.distinct(points);
+        let n = self.idx.len();
+        if n < 3 {
+            return Err(PolygonError::TooFewVertices { distinct: n });
+        }
+        let normal = self.project(points)?;
+        self.cut();
+        let unit = normal.as_vec3();
+        for t in &self.tris {
+            let [a, b, c] = t.map(|i| self.idx[i]);
+            // The triangle as the intersectors will see it: drop it if its f32 normal
+            // vanishes or (a sub-ulp sliver) turns against the polygon's.
+            let ng = (points[b] - points[a]).cross(points[c] - points[a]);
+            if ng.dot(unit) > 0.0 {
+                out.push([a, b, c]);
+            }
+        }
+        if out.is_empty() {
+            return Err(PolygonError::ZeroArea);
+        }
+        Ok(())
+    }
+
+    /// The indices of the distinct vertices into `idx`: consecutive duplicates and
+    /// copies of the first vertex at the end left out.
+    fn distinct(&mut self, points: &[Vec3]) {
+        self.idx.clear();
+        for (i, p) in points.iter().enumerate() {
+            if self.idx.last().is_none_or(|&l| points[l] != *p) {
+                self.idx.push(i);
+            }
+        }
+        while let [first, .., last] = self.idx[..] {
+            if points[first] != points[last] {
+                break;
+            }
+            self.idx.pop();
+        }
+    }
+
+    /// Project the distinct vertices into the ring and link it; the unit Newell normal.
+    fn project(&mut self, points: &[Vec3]) -> Result<DVec3, PolygonError> {
+        // Newell normal and scale, relative to the first distinct vertex.
+        let o = points[self.idx[0]].as_dvec3();
+        let mut normal = DVec3::ZERO;
+        let mut scale2 = 0.0f64;
+        let mut prev = DVec3::ZERO;
+        for &i in &self.idx[1..] {
+            let q = points[i].as_dvec3() - o;
+            normal += prev.cross(q);
+            scale2 = scale2.max(q.length_squared());
+            prev = q;
+        }
+        let len = normal.length();
+        // Also rejects NaN (non-finite input).
+        if len.is_nan() || len <= COLLINEAR_REL * scale2 {
+            return Err(PolygonError::ZeroArea);
+        }
+
+        // Project onto the plane of the two axes other than the dominant one, in cyclic
+        // order, so that the projected signed area has the sign of `normal[k]`.
+        let k = normal.abs().max_position();
+        let (u, v) = ((k + 1) % 3, (k + 2) % 3);
+        let sign = if normal[k] < 0.0 { -1.0 } else { 1.0 };
+        self.ring.xy.clear();
+        for &i in &self.idx {
+            let q = points[i].as_dvec3() - o;
+            self.ring.xy.push([q[u], q[v]]);
+        }
+        self.ring.link(sign);
+        Ok(normal / len)
+    }
+
+    /// Cut the ring into triangles over distinct-vertex indices, into `tris`.
+    fn cut(&mut self) {
+        self.tris.clear();
+        let n = self.ring.xy.len();
+        let r = &self.ring;
+        if n == 3 {
+            self.tris.push([0, 1, 2]);
+        } else if n == 4 && (0..4).all(|i| r.corner((i + 3) % 4, i, (i + 1) % 4) > 0.0) {
+            // Convex quadrilateral: cut along the shorter diagonal.
+            if dist2(r.xy[0], r.xy[2]) <= dist2(r.xy[1], r.xy[3]) {
+                self.tris.extend([[0, 1, 2], [0, 2, 3]]);
+            } else {
+                self.tris.extend([[1, 2, 3], [1, 3, 0]]);
+            }
+        } else {
+            clip::clip_ears(&mut self.ring, &mut self.tris);
+        }
+    }
+}
+
+#[inline]
+fn dist2(a: [f64; 2], b: [f64; 2]) -> f64 {
+    (a[0] - b[0]).powi(2) + (a[1] - b[1]).powi(2)
+}
