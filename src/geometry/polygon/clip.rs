@@ -5,33 +5,41 @@
 //! After each cut the walk moves on past the ear's far neighbour: spreading the cuts
 //! round the polygon avoids long fans of slivers, and on a convex polygon yields
 //! triangles that halve in number and double in size from one round to the next, which
-//! a bounding volume hierarchy separates well. Each ear test scans every remaining
-//! vertex, so the whole costs `O(n²)`.
+//! a bounding volume hierarchy separates well. The ear test is [`Blockers::block_ear`];
+//! everything else a step does costs a constant, so a convex polygon, whose ear tests
+//! cost a constant too, is cut in linear time.
 
+use super::blockers::Blockers;
 use super::ring::Ring;
 
 /// Cut the linked ring into triangles (indices into the ring), appended to `tris`.
-pub(super) fn clip_ears(ring: &mut Ring, tris: &mut Vec<[usize; 3]>) {
+/// Every step of the walk adds one to `steps`.
+pub(super) fn clip_ears(
+    ring: &mut Ring,
+    blockers: &mut Blockers,
+    tris: &mut Vec<[usize; 3]>,
+    steps: &mut u64,
+) {
     let mut remaining = ring.xy.len();
     let mut i = 0;
     let mut stall = 0;
     while remaining > 3 {
+        *steps += 1;
         let (a, c) = (ring.prev[i], ring.next[i]);
         let turn = ring.corner(a, i, c);
         if turn == 0.0 {
             // Collinear or a spike: no area to cover, drop the vertex.
-            ring.unlink(i);
+            remove(ring, blockers, i);
             remaining -= 1;
             stall = 0;
             i = a;
             continue;
         }
-        if turn > 0.0 && is_ear(ring, a, i, c) {
+        if turn > 0.0 && blockers.block_ear(ring, a, i, c).is_none() {
             tris.push([a, i, c]);
-            ring.unlink(i);
+            remove(ring, blockers, i);
             remaining -= 1;
             stall = 0;
-            // Skipping a vertex spreads the cuts and avoids long fans of slivers.
             i = ring.next[c];
             continue;
         }
@@ -39,13 +47,13 @@ pub(super) fn clip_ears(ring: &mut Ring, tris: &mut Vec<[usize; 3]>) {
         stall += 1;
         if stall > remaining {
             // No ear: the polygon is not simple, or rounding hides every ear.
-            let Some(j) = sharpest_convex(ring, i, remaining) else {
+            let Some(j) = sharpest_convex(ring, i, remaining, steps) else {
                 // Nothing convex is left: what remains has no positive area.
                 return;
             };
             tris.push([ring.prev[j], j, ring.next[j]]);
             i = ring.next[j];
-            ring.unlink(j);
+            remove(ring, blockers, j);
             remaining -= 1;
             stall = 0;
         }
@@ -56,22 +64,19 @@ pub(super) fn clip_ears(ring: &mut Ring, tris: &mut Vec<[usize; 3]>) {
     }
 }
 
-/// Whether the convex corner `a b c` is an ear: no remaining reflex (or flat) vertex
-/// lies inside or on the triangle.
-fn is_ear(ring: &Ring, a: usize, b: usize, c: usize) -> bool {
-    let mut p = ring.next[c];
-    while p != a {
-        if ring.in_triangle(a, b, c, p) && ring.blocks(p) {
-            return false;
-        }
-        p = ring.next[p];
-    }
-    true
+/// Take vertex `i` out of the ring and tell the index, whose view of its two
+/// neighbours' corners changes.
+fn remove(ring: &mut Ring, blockers: &mut Blockers, i: usize) {
+    let (a, c) = (ring.prev[i], ring.next[i]);
+    ring.unlink(i);
+    blockers.removed(i);
+    blockers.changed(ring, a);
+    blockers.changed(ring, c);
 }
 
 /// The remaining vertex with the most convex corner, the first of equals going round
 /// from `i`; none if no corner is convex.
-fn sharpest_convex(ring: &Ring, i: usize, remaining: usize) -> Option<usize> {
+fn sharpest_convex(ring: &Ring, i: usize, remaining: usize, steps: &mut u64) -> Option<usize> {
     let mut best: Option<(usize, f64)> = None;
     let mut j = i;
     for _ in 0..remaining {
@@ -81,5 +86,6 @@ fn sharpest_convex(ring: &Ring, i: usize, remaining: usize) -> Option<usize> {
         }
         j = ring.next[j];
     }
+    *steps += remaining as u64;
     best.map(|(j, _)| j)
 }

@@ -23,19 +23,23 @@ pub(super) struct Ring {
     /// Circular doubly linked list over the remaining vertices.
     pub prev: Vec<usize>,
     pub next: Vec<usize>,
+    /// Whether each vertex is still in the list.
+    pub alive: Vec<bool>,
     /// `1` or `-1`: the sign that makes the polygon's winding counterclockwise.
     pub sign: f64,
 }
 
 impl Ring {
-    /// Link all of `xy` in order, with the winding sign `sign`.
+    /// Link all of `xy` in order, every vertex alive, with the winding sign `sign`.
     pub fn link(&mut self, sign: f64) {
         let n = self.xy.len();
         self.sign = sign;
         self.prev.clear();
         self.next.clear();
+        self.alive.clear();
         self.prev.extend((0..n).map(|i| (i + n - 1) % n));
         self.next.extend((0..n).map(|i| (i + 1) % n));
+        self.alive.resize(n, true);
     }
 
     /// Orientation of corner `b` (between `a` and `c`) with the polygon's winding made
@@ -82,6 +86,7 @@ impl Ring {
         let (a, c) = (self.prev[i], self.next[i]);
         self.next[a] = c;
         self.prev[c] = a;
+        self.alive[i] = false;
     }
 }
 

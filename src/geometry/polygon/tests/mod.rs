@@ -1,9 +1,12 @@
-//! The triangulator's tests: what every triangulation must satisfy (this file) and
-//! that the triangles are those of the ear clipper as it was before it was split into
-//! files (`same`), on the polygons of `shapes`.
+//! The triangulator's tests: what every triangulation must satisfy (this file), that
+//! the triangles are those of the quadratic clipper it replaced (`same`), and that
+//! large polygons cost little work and are tiled exactly (`scale`), on the polygons of
+//! `shapes`, checked in floating point here and exactly by `cover`.
 
+mod cover;
 mod reference;
 mod same;
+mod scale;
 mod shapes;
 
 use super::*;

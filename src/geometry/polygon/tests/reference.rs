@@ -1,7 +1,7 @@
-//! The ear clipper as it was before it was split into files: every ear test scans the
-//! whole remaining polygon, `O(n²)`. Kept, unchanged but for its name, as the oracle
-//! the tests compare [`super::super::Triangulator`] with: the two must give the same
-//! triangles for every input.
+//! The ear clipper as it was before its ear test was indexed: every ear test scans
+//! the whole remaining polygon, `O(n²)`. Kept, unchanged but for its name, as the
+//! oracle the tests compare [`super::super::Triangulator`] with: the two must give the
+//! same triangles for every input.
 
 use super::super::PolygonError;
 use crate::math::{DVec3, Vec3};

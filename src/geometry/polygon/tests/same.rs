@@ -1,6 +1,6 @@
-//! The triangulator gives exactly the triangles of the ear clipper as it was
-//! (`reference`), for simple polygons, degenerate ones and self-intersecting ones
-//! alike: the images of existing scenes depend on them.
+//! The triangulator gives exactly the triangles of the quadratic ear clipper it
+//! replaced (`reference`), for simple polygons, degenerate ones and self-intersecting
+//! ones alike: the images of existing scenes depend on them.
 
 use super::super::{PolygonError, Triangulator};
 use super::reference::Reference;
@@ -33,6 +33,12 @@ fn the_test_shapes() {
         gear(12, 0.5, 1.0),
         comb(20),
         spiral(6),
+        exact_star(2000, 0.5),
+        exact_star(600, 0.98),
+        exact_spiky_star(12, 3),
+        exact_comb(20, 1000),
+        exact_spiral(4, 150),
+        farey(12),
     ] {
         assert_same(&p);
         assert_same(&transform(&p));
@@ -40,6 +46,13 @@ fn the_test_shapes() {
         r.reverse();
         assert_same(&r);
     }
+}
+
+#[test]
+fn a_regular_polygon_rounded_to_f32() {
+    // The curvature of a circle of 20 000 vertices is below f32's resolution: rounding
+    // makes about half the corners reflex.
+    assert_same(&regular(20_000, 1.0));
 }
 
 /// A polygon on a small integer grid: collinear, repeated and crossing edges galore.
@@ -54,6 +67,14 @@ fn lattice_polygon(max: i32, len: std::ops::Range<usize>) -> impl Strategy<Value
 proptest! {
     #[test]
     fn small_lattice_polygons(p in lattice_polygon(6, 3..24)) {
+        let [new, old] = both(&p);
+        prop_assert_eq!(new, old);
+    }
+
+    /// Long random polygons on a finer grid: many reflex vertices, so the index of
+    /// blockers is rebuilt as the ring shrinks.
+    #[test]
+    fn long_lattice_polygons(p in lattice_polygon(64, 100..1200)) {
         let [new, old] = both(&p);
         prop_assert_eq!(new, old);
     }

@@ -1,7 +1,15 @@
-//! Test polygons: regular polygons, the SPD's gear outline, combs and spirals.
+//! Test polygons: regular polygons, the SPD's gear outline, combs, spirals, stars and
+//! large convex lattice polygons. The `exact_` shapes lie in the plane z = 0 on a
+//! dyadic grid that `f32` holds exactly, so that `cover` can check them in integers.
 
 use crate::math::Vec3;
 use std::f32::consts::TAU;
+
+/// Round to a multiple of 2⁻ᵇⁱᵗˢ: exact in `f32` below 2²⁴⁻ᵇⁱᵗˢ in magnitude.
+fn snap(v: f64, bits: i32) -> f32 {
+    let s = 2f64.powi(bits);
+    ((v * s).round() / s) as f32
+}
 
 pub fn regular(n: usize, r: f32) -> Vec<Vec3> {
     (0..n)
@@ -92,4 +100,142 @@ pub fn spiral(turns: usize) -> Vec<Vec3> {
         })
         .collect();
     left.chain(right.into_iter().rev()).collect()
+}
+
+/// A star of `n` vertices (`n` even) alternating between radius 1 and `inner`, on a
+/// grid of 2⁻¹⁸.
+pub fn exact_star(n: usize, inner: f64) -> Vec<Vec3> {
+    (0..n)
+        .map(|i| {
+            let a = std::f64::consts::TAU * i as f64 / n as f64;
+            let r = if i % 2 == 0 { 1.0 } else { inner };
+            Vec3::new(snap(r * a.cos(), 18), snap(r * a.sin(), 18), 0.0)
+        })
+        .collect()
+}
+
+/// A star whose inner vertices are those of `farey(m)` doubled (strictly convex, as no
+/// circle of that many vertices is in f32) and whose points are spikes `h` times as
+/// high as the edge under them is long.
+pub fn exact_spiky_star(m: i64, h: i64) -> Vec<Vec3> {
+    let inner: Vec<[i64; 2]> = farey_points(m)
+        .iter()
+        .map(|p| [2 * p[0], 2 * p[1]])
+        .collect();
+    let mut v = Vec::with_capacity(2 * inner.len());
+    for (i, &a) in inner.iter().enumerate() {
+        let b = inner[(i + 1) % inner.len()];
+        let d = [(b[0] - a[0]) / 2, (b[1] - a[1]) / 2];
+        // Outwards from the counterclockwise polygon: the edge turned clockwise.
+        let tip = [a[0] + d[0] + h * d[1], a[1] + d[1] - h * d[0]];
+        v.extend([a, tip]);
+    }
+    to_vec3(&v)
+}
+
+/// A comb: a bar whose top is a lattice chain sagging in the middle (slopes from −1 to
+/// 1, strictly increasing, so its vertices are reflex), with a tooth of height
+/// `height` over the middle of each of its edges. `2k + 3` vertices for a chain of `k`
+/// edges (`k ≈ 1.2 m²`).
+pub fn exact_comb(m: i64, height: i64) -> Vec<Vec3> {
+    let mut dirs: Vec<[i64; 2]> = Vec::new();
+    for p in 1..=m {
+        for q in -p..=p {
+            if gcd(p, q.abs()) == 1 {
+                dirs.push([p, q]);
+            }
+        }
+    }
+    dirs.sort_by(|a, b| (a[1] * b[0]).cmp(&(b[1] * a[0])));
+    let mut chain = vec![[0i64, 0i64]];
+    for d in &dirs {
+        let [x, y] = chain[chain.len() - 1];
+        chain.push([x + 2 * d[0], y + 2 * d[1]]);
+    }
+    let bottom = chain.iter().map(|p| p[1]).min().unwrap_or(0) - 7919;
+    let right = chain[chain.len() - 1][0];
+    let mut v = vec![[0, bottom], [right, bottom]];
+    for (k, d) in dirs.iter().enumerate().rev() {
+        let b = chain[k + 1];
+        v.push(b);
+        v.push([b[0] - d[0], b[1] - d[1] + height]);
+    }
+    v.push(chain[0]);
+    // Centred, to stay within f32's exact integers.
+    let v: Vec<[i64; 2]> = v.iter().map(|p| [p[0] - right / 2, p[1]]).collect();
+    to_vec3(&v)
+}
+
+/// A corridor of width ½ along an Archimedean spiral (radius 1 + θ/2π at its outer
+/// wall), `turns` times round with `per_turn` vertices per wall and turn, on a grid of
+/// 2⁻¹⁶ (exact in f32 below 256).
+pub fn exact_spiral(turns: usize, per_turn: usize) -> Vec<Vec3> {
+    let k = turns * per_turn;
+    let wall = |i: usize, inset: f64| {
+        let a = std::f64::consts::TAU * i as f64 / per_turn as f64;
+        let r = 1.0 + a / std::f64::consts::TAU - inset;
+        Vec3::new(snap(r * a.cos(), 16), snap(r * a.sin(), 16), 0.0)
+    };
+    let outer = (0..=k).map(|i| wall(i, 0.0));
+    let inner = (0..=k).rev().map(|i| wall(i, 0.5));
+    outer.chain(inner).collect()
+}
+
+fn gcd(mut a: i64, mut b: i64) -> i64 {
+    while b != 0 {
+        (a, b) = (b, a % b);
+    }
+    a
+}
+
+/// The vertices of a strictly convex lattice polygon, counterclockwise: its edges are
+/// the primitive integer vectors of coordinates at most `m` in magnitude, in order of
+/// angle (`≈ 2.4 m²` vertices).
+fn farey_points(m: i64) -> Vec<[i64; 2]> {
+    let mut dirs: Vec<(i64, i64)> = Vec::new();
+    for p in 1..=m {
+        for q in 0..=m {
+            if gcd(p, q) == 1 {
+                dirs.extend([(p, q), (-q, p), (-p, -q), (q, -p)]);
+            }
+        }
+    }
+    dirs.sort_by(|a, b| {
+        let angle = |d: &(i64, i64)| (d.1 as f64).atan2(d.0 as f64);
+        angle(a).total_cmp(&angle(b))
+    });
+    let mut at = (0i64, 0i64);
+    let mut v = Vec::with_capacity(dirs.len());
+    for (dx, dy) in dirs {
+        v.push(at);
+        at = (at.0 + dx, at.1 + dy);
+    }
+    assert_eq!(at, (0, 0), "the edges close the polygon");
+    let n = v.len() as i64;
+    let centre = (
+        v.iter().map(|p| p.0).sum::<i64>() / n,
+        v.iter().map(|p| p.1).sum::<i64>() / n,
+    );
+    v.into_iter()
+        .map(|(x, y)| [x - centre.0, y - centre.1])
+        .collect()
+}
+
+/// [`farey_points`] as a polygon.
+pub fn farey(m: i64) -> Vec<Vec3> {
+    to_vec3(&farey_points(m))
+}
+
+/// Integer points as vertices in the plane z = 0 (exact below 2²⁴).
+fn to_vec3(points: &[[i64; 2]]) -> Vec<Vec3> {
+    points
+        .iter()
+        .map(|p| {
+            assert!(
+                p[0].abs() < 1 << 24 && p[1].abs() < 1 << 24,
+                "{p:?} is not exact in f32"
+            );
+            Vec3::new(p[0] as f32, p[1] as f32, 0.0)
+        })
+        .collect()
 }

@@ -1,0 +1,39 @@
+//! Large polygons: the work of a triangulation (steps of the walk, nodes and vertices
+//! the ear tests look at) grows as `n log n` with the vertex count, and the triangles
+//! tile the polygon exactly. Work, not time, is asserted, so the tests hold on any
+//! machine and in a debug build.
+
+use super::super::Triangulator;
+use super::cover::assert_tiles;
+use super::shapes::*;
+use crate::math::Vec3;
+
+/// Triangulate `points`: the triangles and the work done.
+fn run(points: &[Vec3]) -> (Vec<[usize; 3]>, u64) {
+    let mut t = Triangulator::new();
+    let mut out = Vec::new();
+    t.triangulate(points, &mut out).expect("a triangulation");
+    (out, t.work())
+}
+
+/// Assert `work` is at most `k · n · log₂ n` for the `n` vertices of `points`.
+fn assert_n_log_n(name: &str, points: &[Vec3], work: u64, k: u64) {
+    let n = points.len() as u64;
+    let log = n.ilog2() as u64;
+    assert!(
+        work <= k * n * log,
+        "{name}: {work} units of work for {n} vertices, more than {k} n log₂ n"
+    );
+}
+
+#[test]
+fn concave_100k_vertices() {
+    let shapes = [("star", exact_spiky_star(143, 3))];
+    for (name, p) in shapes {
+        assert!(p.len() >= 100_000, "{name}: {}", p.len());
+        let (tris, work) = run(&p);
+        assert_eq!(tris.len(), p.len() - 2, "{name}");
+        assert_tiles(&p, &tris);
+        assert_n_log_n(name, &p, work, 16);
+    }
+}
