@@ -13,12 +13,14 @@
 //! simple (self-intersecting), or when rounding hides every ear, the clipper falls back
 //! to cutting a convex corner so that it always terminates.
 //!
-//! Cutting a polygon of `n` vertices costs `O(n)` plus, for each ear test, the reflex
-//! and flat vertices near the ear: linear for a convex polygon. The parts: [`ring`]
-//! (the projected vertices, their links and the orientation tests), [`clip`] (the walk
-//! that cuts ears), [`blockers`] (the ear test, from an index of the reflex and flat
-//! vertices, the only ones that can fail it) and [`tree`] (that index's spatial
-//! structure).
+//! Cutting a polygon of `n` vertices costs `O(n log n)` for polygons as they come, and
+//! `O(n)` for a convex one (a worst case remains quadratic: a walk that finds no ear for
+//! long, on input that is not simple). The parts: [`ring`] (the projected vertices,
+//! their links and the orientation tests), [`clip`] (the walk that cuts ears),
+//! [`shortcut`] (its jumps past vertices where it has nothing to do, with the
+//! [`witness`]es that show a convex vertex is not an ear), [`blockers`] (the ear test,
+//! from an index of the reflex and flat vertices, the only ones that can fail it) and
+//! [`tree`] (that index's spatial structure).
 //!
 //! The triangles are exactly those of the plain quadratic ear clipper this replaced, so
 //! that scenes render as they did (the tests compare the two).
@@ -26,13 +28,16 @@
 mod blockers;
 mod clip;
 mod ring;
+mod shortcut;
 #[cfg(test)]
 mod tests;
 mod tree;
+mod witness;
 
 use crate::math::{DVec3, Vec3};
 use blockers::Blockers;
 use ring::{COLLINEAR_REL, Ring};
+use shortcut::Shortcut;
 
 /// Why a polygon has no triangulation.
 #[derive(Clone, Copy, Debug, PartialEq, Eq, thiserror::Error)]
@@ -60,6 +65,8 @@ pub struct Triangulator {
     ring: Ring,
     /// The index of the ring's reflex and flat vertices.
     blockers: Blockers,
+    /// The walk's jumps past vertices where it has nothing to do.
+    shortcut: Shortcut,
     /// Triangles over distinct-vertex indices.
     tris: Vec<[usize; 3]>,
     /// Steps of the walk in the last triangulation.
@@ -101,8 +108,8 @@ impl Triangulator {
     ///
     /// Consecutive duplicate vertices, and a last vertex equal to the first, are
     /// ignored. Triangles and convex quadrilaterals take a fast path; anything else
-    /// goes through ear clipping: `O(n)` for `n` vertices plus, per ear test, the
-    /// reflex vertices near the ear.
+    /// goes through ear clipping: `O(n log n)` for `n` vertices (see the module
+    /// documentation).
     /// Triangles too thin to have a nonzero normal in `f32` are left out.
     ///
     /// # Errors
@@ -204,20 +211,25 @@ impl Triangulator {
             }
         } else {
             self.blockers.build(&self.ring);
-            clip::clip_ears(
-                &mut self.ring,
-                &mut self.blockers,
-                &mut self.tris,
-                &mut self.steps,
-            );
+            self.shortcut.reset(n);
+            let clipper = clip::Clipper {
+                ring: &mut self.ring,
+                blockers: &mut self.blockers,
+                shortcut: &mut self.shortcut,
+                tris: &mut self.tris,
+                steps: &mut self.steps,
+            };
+            clipper.run();
         }
     }
 
-    /// What the last triangulation cost: steps of the walk, and corners, nodes and
-    /// vertices the ear tests and their index looked at.
+    /// What the last triangulation cost: steps of the walk, corners, nodes and
+    /// vertices the ear tests and their index looked at, and the shortcut's set
+    /// operations (each counted as the logarithm of the vertex count).
     #[cfg(test)]
     fn work(&self) -> u64 {
-        self.steps + self.blockers.work
+        let log = (self.ring.xy.len().max(2) as u64).ilog2() as u64;
+        self.steps + self.blockers.work + self.shortcut.work * log
     }
 }
 

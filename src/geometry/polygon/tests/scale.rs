@@ -28,8 +28,11 @@ fn assert_n_log_n(name: &str, points: &[Vec3], work: u64, k: u64) {
 
 #[test]
 fn concave_100k_vertices() {
-    let shapes = [("star", exact_spiky_star(143, 3))];
-    for (name, p) in shapes {
+    for (name, p) in [
+        ("star", exact_spiky_star(143, 3)),
+        ("comb", exact_comb(287, 1 << 20)),
+        ("spiral", exact_spiral(200, 250)),
+    ] {
         assert!(p.len() >= 100_000, "{name}: {}", p.len());
         let (tris, work) = run(&p);
         assert_eq!(tris.len(), p.len() - 2, "{name}");
