@@ -15,6 +15,12 @@ use super::blockers::Blockers;
 use super::ring::Ring;
 use super::shortcut::Shortcut;
 
+/// Where the walk starts and how many vertices the ring has.
+pub(super) struct Walk {
+    pub start: usize,
+    pub remaining: usize,
+}
+
 /// The walk's state and what it works with.
 pub(super) struct Clipper<'a> {
     pub ring: &'a mut Ring,
@@ -28,9 +34,11 @@ pub(super) struct Clipper<'a> {
 
 impl Clipper<'_> {
     /// Cut the linked ring into triangles.
-    pub fn run(mut self) {
-        let mut remaining = self.ring.xy.len();
-        let mut i = 0;
+    pub fn run(mut self, walk: Walk) {
+        let Walk {
+            start: mut i,
+            mut remaining,
+        } = walk;
         let mut stall = 0;
         while remaining > 3 {
             *self.steps += 1;

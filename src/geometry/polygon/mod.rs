@@ -13,20 +13,25 @@
 //! simple (self-intersecting), or when rounding hides every ear, the clipper falls back
 //! to cutting a convex corner so that it always terminates.
 //!
-//! Cutting a polygon of `n` vertices costs `O(n log n)` for polygons as they come, and
-//! `O(n)` for a convex one (a worst case remains quadratic: a walk that finds no ear for
-//! long, on input that is not simple). The parts: [`ring`] (the projected vertices,
-//! their links and the orientation tests), [`clip`] (the walk that cuts ears),
-//! [`shortcut`] (its jumps past vertices where it has nothing to do, with the
-//! [`witness`]es that show a convex vertex is not an ear), [`blockers`] (the ear test,
-//! from an index of the reflex and flat vertices, the only ones that can fail it) and
-//! [`tree`] (that index's spatial structure).
+//! Cutting a polygon of `n` vertices costs `O(n)` when it is convex and, for a concave
+//! one, `O(n log n)` for polygons as they come (a worst case remains quadratic: a walk
+//! that finds no ear for long, on input that is not simple, or a vertex that many
+//! blockers in turn keep from being an ear). The parts: [`ring`] (the
+//! projected vertices, their links and the orientation tests), [`convex`] (the
+//! convexity check, and the straight vertices a convex polygon loses before it is cut),
+//! [`clip`] (the walk that cuts ears), [`shortcut`] (its jumps past vertices where it
+//! has nothing to do, with the [`witness`]es that show a convex vertex is not an ear),
+//! [`blockers`] (the ear test, from an index of the reflex and flat vertices, the only
+//! ones that can fail it) and [`tree`] (that index's spatial structure).
 //!
 //! The triangles are exactly those of the plain quadratic ear clipper this replaced, so
-//! that scenes render as they did (the tests compare the two).
+//! that scenes render as they did (the tests compare the two), but for a convex polygon
+//! with vertices exactly on its edges: those vertices add no area and are left out, where
+//! the old clipper dropped them one at a time and fanned long slivers out of one vertex.
 
 mod blockers;
 mod clip;
+mod convex;
 mod ring;
 mod shortcut;
 #[cfg(test)]
@@ -69,7 +74,7 @@ pub struct Triangulator {
     shortcut: Shortcut,
     /// Triangles over distinct-vertex indices.
     tris: Vec<[usize; 3]>,
-    /// Steps of the walk in the last triangulation.
+    /// Corners tested and steps of the walk in the last triangulation.
     steps: u64,
 }
 
@@ -108,7 +113,8 @@ impl Triangulator {
     ///
     /// Consecutive duplicate vertices, and a last vertex equal to the first, are
     /// ignored. Triangles and convex quadrilaterals take a fast path; anything else
-    /// goes through ear clipping: `O(n log n)` for `n` vertices (see the module
+    /// goes through ear clipping: `O(n)` for a convex polygon of `n` vertices, and for
+    /// a concave one `O(n log n)` for polygons as they come (see the module
     /// documentation).
     /// Triangles too thin to have a nonzero normal in `f32` are left out.
     ///
@@ -210,22 +216,37 @@ impl Triangulator {
                 self.tris.extend([[1, 2, 3], [1, 3, 0]]);
             }
         } else {
-            self.blockers.build(&self.ring);
-            self.shortcut.reset(n);
-            let clipper = clip::Clipper {
-                ring: &mut self.ring,
-                blockers: &mut self.blockers,
-                shortcut: &mut self.shortcut,
-                tris: &mut self.tris,
-                steps: &mut self.steps,
-            };
-            clipper.run();
+            self.clip();
         }
     }
 
-    /// What the last triangulation cost: steps of the walk, corners, nodes and
-    /// vertices the ear tests and their index looked at, and the shortcut's set
-    /// operations (each counted as the logarithm of the vertex count).
+    /// Ear clipping into `tris`, after a convex ring has lost its straight vertices.
+    fn clip(&mut self) {
+        let n = self.ring.xy.len();
+        // The convexity check, and the straight vertices' removal, each look at every
+        // corner.
+        self.steps += n as u64;
+        let (start, remaining) = if convex::is_convex(&self.ring) {
+            self.steps += n as u64;
+            convex::drop_straight(&mut self.ring)
+        } else {
+            (0, n)
+        };
+        self.blockers.build(&self.ring);
+        self.shortcut.reset(n);
+        let clipper = clip::Clipper {
+            ring: &mut self.ring,
+            blockers: &mut self.blockers,
+            shortcut: &mut self.shortcut,
+            tris: &mut self.tris,
+            steps: &mut self.steps,
+        };
+        clipper.run(clip::Walk { start, remaining });
+    }
+
+    /// What the last triangulation cost: corners tested, steps of the walk, corners,
+    /// nodes and vertices the ear tests and their index looked at, and the shortcut's
+    /// set operations (each counted as the logarithm of the vertex count).
     #[cfg(test)]
     fn work(&self) -> u64 {
         let log = (self.ring.xy.len().max(2) as u64).ilog2() as u64;

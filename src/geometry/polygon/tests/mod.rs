@@ -1,6 +1,6 @@
 //! The triangulator's tests: what every triangulation must satisfy (this file), that
 //! the triangles are those of the quadratic clipper it replaced (`same`), and that
-//! large polygons cost little work and are tiled exactly (`scale`), on the polygons of
+//! large polygons cost linear work and are tiled exactly (`scale`), on the polygons of
 //! `shapes`, checked in floating point here and exactly by `cover`.
 
 mod cover;
@@ -218,6 +218,32 @@ fn collinear_vertices_are_dropped() {
 }
 
 #[test]
+fn a_convex_polygon_loses_its_straight_vertices() {
+    // A square with a vertex in the middle of each side: two triangles over its
+    // corners, as for the square alone.
+    let p: Vec<Vec3> = [
+        (0., 0.),
+        (1., 0.),
+        (2., 0.),
+        (2., 1.),
+        (2., 2.),
+        (1., 2.),
+        (0., 2.),
+        (0., 1.),
+    ]
+    .iter()
+    .map(|&(x, y)| Vec3::new(x, y, 0.0))
+    .collect();
+    let tris = triangulate(&p).unwrap();
+    assert_eq!(tris.len(), 2);
+    assert!(tris.iter().flatten().all(|&i| i % 2 == 0), "{tris:?}");
+    check(&p, &tris);
+    // A triangle with a vertex on one side: the triangle.
+    let p = [Vec3::ZERO, Vec3::X, Vec3::new(2.0, 0.0, 0.0), Vec3::Y];
+    assert_eq!(triangulate(&p).unwrap(), vec![[3, 0, 2]]);
+}
+
+#[test]
 fn duplicates_removed() {
     let a = Vec3::ZERO;
     let b = Vec3::X;
@@ -297,6 +323,27 @@ fn self_intersecting_input_terminates() {
 }
 
 proptest! {
+    /// Convex lattice polygons with vertices along their edges, started anywhere and
+    /// either way round: their corners alone are cut, and tile them exactly.
+    #[test]
+    fn convex_with_straight_vertices(
+        m in 1i64..6,
+        k in 1usize..5,
+        start in 0usize..1000,
+        clockwise in any::<bool>(),
+    ) {
+        let corners = shapes::farey(m);
+        let mut p = shapes::subdivided(&corners, k);
+        let s = start % p.len();
+        p.rotate_left(s);
+        if clockwise {
+            p.reverse();
+        }
+        let tris = triangulate(&p).unwrap();
+        prop_assert_eq!(tris.len(), corners.len() - 2);
+        cover::assert_tiles(&p, &tris);
+    }
+
     /// Random star-shaped polygons (random radius at increasing angles, so always
     /// simple), in a random plane.
     #[test]

@@ -239,3 +239,16 @@ fn to_vec3(points: &[[i64; 2]]) -> Vec<Vec3> {
         })
         .collect()
 }
+
+/// `points` (integer coordinates) scaled by `k` with `k − 1` evenly spaced points
+/// inserted along each edge: a polygon of the same shape with collinear vertices.
+pub fn subdivided(points: &[Vec3], k: usize) -> Vec<Vec3> {
+    let mut v = Vec::with_capacity(points.len() * k);
+    for (i, &p) in points.iter().enumerate() {
+        let q = points[(i + 1) % points.len()];
+        for s in 0..k {
+            v.push(p * k as f32 + (q - p) * s as f32);
+        }
+    }
+    v
+}
