@@ -92,6 +92,6 @@ impl Ring {
 
 /// Signed doubled area of `a b p` with the winding made counterclockwise.
 #[inline]
-pub(super) fn orient(sign: f64, a: [f64; 2], b: [f64; 2], p: [f64; 2]) -> f64 {
+fn orient(sign: f64, a: [f64; 2], b: [f64; 2], p: [f64; 2]) -> f64 {
     sign * ((b[0] - a[0]) * (p[1] - a[1]) - (b[1] - a[1]) * (p[0] - a[0]))
 }
