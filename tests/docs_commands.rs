@@ -69,6 +69,10 @@ const PARSE_ONLY: &[(&str, &str)] = &[
         "large.obj",
         "needs the files the texture_assets example writes",
     ),
+    (
+        "circle.nff",
+        "needs the file the big_polygon example writes",
+    ),
 ];
 
 /// What the scratch folder holds of the repository: the files of these that git
