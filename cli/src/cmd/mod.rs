@@ -10,6 +10,8 @@ mod bench;
 mod compare;
 #[cfg(test)]
 mod docs_commands;
+#[cfg(test)]
+mod docs_scan;
 mod error;
 mod eta;
 mod explain;
