@@ -230,7 +230,7 @@ fn tiles_merge_bit_identical_to_the_full_render() {
                 for i in 0..n {
                     let p = format!("part{i}.exr");
                     let tile = format!("{i}/{n}");
-                    let o = emray(d, &[&base[..], &["--tile", &tile, "-o", &p]].concat());
+                    let o = emray(d, &[&base[..], &["--band", &tile, "-o", &p]].concat());
                     assert!(o.status.success(), "{}", stderr(&o));
                     parts.push(p);
                 }

@@ -206,8 +206,8 @@ fn input_errors_exit_1_with_one_line_and_write_nothing() {
             "emray: error: a.nff: crop 0,50,0,10 is not inside the 40x30 image",
         ),
         (
-            vec!["render", "a.nff", "--tile", "0/31", "-o", "x.exr"],
-            "emray: error: a.nff: --tile leaves no rows for this part of a 30-row image",
+            vec!["render", "a.nff", "--band", "0/31", "-o", "x.exr"],
+            "emray: error: a.nff: --band leaves no rows for this part of a 30-row image",
         ),
         (
             vec!["render", "a.nff", "--max-memory", "1K"],
@@ -275,7 +275,7 @@ fn batch_usage_errors_exit_2_before_any_job() {
 }
 
 #[test]
-fn an_out_of_range_tile_is_called_a_tile_and_a_shard_a_shard() {
+fn an_out_of_range_band_is_called_a_band_and_a_shard_a_shard() {
     let dir = tempfile::tempdir().unwrap();
     std::fs::write(dir.path().join("a.nff"), SCENE).unwrap();
     let o = emray(
@@ -284,7 +284,7 @@ fn an_out_of_range_tile_is_called_a_tile_and_a_shard_a_shard() {
     );
     assert_eq!(o.status.code(), Some(2));
     let e = stderr(&o);
-    assert!(e.contains("tile '4/4': need 0 <= I < N"), "{e}");
+    assert!(e.contains("band '4/4': need 0 <= I < N"), "{e}");
     assert!(!e.contains("shard"), "{e}");
     let o = emray(dir.path(), &["batch", "a.nff", "--shard", "4/4"]);
     assert_eq!(o.status.code(), Some(2));
@@ -305,7 +305,7 @@ fn help_names_every_scene_format_and_counts_parts_from_zero() {
         "{render}"
     );
     assert!(
-        render.contains("horizontal bands (I counts from 0: 0 ≤ I < N)"),
+        render.contains("horizontal bands of rows (I counts from 0: 0 ≤ I < N)"),
         "{render}"
     );
     let batch = help(&["batch", "--help"]);

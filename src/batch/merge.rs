@@ -1,4 +1,4 @@
-//! Parts of one image rendered apart (`emray render --tile I/N` or `--crop`) and put
+//! Parts of one image rendered apart (`emray render --band I/N` or `--crop`) and put
 //! back together: each part is an EXR whose data window is its region and which
 //! carries a hash of the scene and the settings; [`merge`] checks that the parts come
 //! from one render and cover the image exactly once.
@@ -19,7 +19,7 @@ pub enum MergeError {
     Read(String),
     /// An EXR that is not a part (no hash).
     #[error(
-        "{}: not a part (no {} attribute; render it with --tile or --crop)",
+        "{}: not a part (no {} attribute; render it with --band or --crop)",
         path.display(), HASH_ATTRIBUTE
     )]
     NotAPart {

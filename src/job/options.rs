@@ -259,19 +259,20 @@ pub struct RenderOptions {
     )]
     #[serde(skip_serializing_if = "Vec::is_empty")]
     pub heatmap: Vec<String>,
-    /// Render only band I of N horizontal bands (I counts from 0: 0 ≤ I < N), to an EXR
-    /// part for `emray merge`.
+    /// Render only band I of N horizontal bands of rows (I counts from 0: 0 ≤ I < N),
+    /// to an EXR part for `emray merge` (`--tile`, its former name, is taken too).
     #[cfg_attr(
         feature = "cli",
         arg(
             long,
             value_name = "I/N",
+            visible_alias = "tile",
             conflicts_with = "crop",
             help_heading = "Parts"
         )
     )]
-    #[serde(skip_serializing_if = "Option::is_none")]
-    pub tile: Option<Band>,
+    #[serde(skip_serializing_if = "Option::is_none", alias = "tile")]
+    pub band: Option<Band>,
     /// Render only columns x0..x1 and rows y0..y1 (half-open), to an EXR part.
     #[cfg_attr(
         feature = "cli",
@@ -416,7 +417,7 @@ mod tests {
             encoding: Some(Encoding::Linear),
             aov: Some("depth,id".parse().unwrap()),
             heatmap: vec!["time".into(), "t.png".into()],
-            tile: Some("1/4".parse().unwrap()),
+            band: Some("1/4".parse().unwrap()),
             crop: Some("0,8,0,4".parse().unwrap()),
             max_memory: Some("2G".parse().unwrap()),
             embree_quality: Some(EmbreeQuality::High),

@@ -286,9 +286,9 @@ impl Job {
                 image.display()
             ));
         }
-        if (options.tile.is_some() || options.crop.is_some()) && format != Format::Exr {
+        if (options.band.is_some() || options.crop.is_some()) && format != Format::Exr {
             return bad(format!(
-                "--tile and --crop write an EXR part (for emray merge), not '{}'",
+                "--band and --crop write an EXR part (for emray merge), not '{}'",
                 image.display()
             ));
         }

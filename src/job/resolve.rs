@@ -52,7 +52,7 @@ pub enum OptionsError {
         height: u32,
     },
     /// More bands than rows: this band has none.
-    #[error("--tile leaves no rows for this part of a {height}-row image (use fewer tiles)")]
+    #[error("--band leaves no rows for this part of a {height}-row image (use fewer bands)")]
     EmptyTile {
         /// Image height.
         height: u32,
@@ -255,13 +255,13 @@ impl RenderOptions {
                  --reference or --aa adaptive",
             );
         }
-        if self.tile.is_some() || self.crop.is_some() {
+        if self.band.is_some() || self.crop.is_some() {
             if reference {
-                return conflict("--reference renders whole images: not with --tile or --crop");
+                return conflict("--reference renders whole images: not with --band or --crop");
             }
             if self.gi.is_some() {
                 // Each part would solve the radiosity on its own; the hash does not cover it.
-                return conflict("--gi renders whole images: not with --tile or --crop");
+                return conflict("--gi renders whole images: not with --band or --crop");
             }
         }
         Ok(())
@@ -362,9 +362,9 @@ impl RenderOptions {
         Ok(s)
     }
 
-    /// The region of a `width × height` image that `tile` or `crop` asks for.
+    /// The region of a `width × height` image that `band` or `crop` asks for.
     fn region(&self, width: u32, height: u32) -> Result<Option<Region>, OptionsError> {
-        if let Some(Band { index, count }) = self.tile {
+        if let Some(Band { index, count }) = self.band {
             let band = Region::band(index, count, width, height);
             if band.height() == 0 {
                 return Err(OptionsError::EmptyTile { height });
@@ -449,10 +449,10 @@ mod tests {
     }
 
     #[test]
-    fn tiles_and_crops_become_regions_or_clear_errors() {
-        let part = |tile: Option<&str>, crop: Option<&str>| {
+    fn bands_and_crops_become_regions_or_clear_errors() {
+        let part = |band: Option<&str>, crop: Option<&str>| {
             RenderOptions {
-                tile: tile.map(|t| t.parse().unwrap()),
+                band: band.map(|t| t.parse().unwrap()),
                 crop: crop.map(|c| c.parse().unwrap()),
                 ..RenderOptions::default()
             }
@@ -465,7 +465,7 @@ mod tests {
         );
         assert_eq!(
             part(Some("0/31"), None).unwrap_err().to_string(),
-            "--tile leaves no rows for this part of a 30-row image (use fewer tiles)"
+            "--band leaves no rows for this part of a 30-row image (use fewer bands)"
         );
         let inside = Region {
             x0: 1,

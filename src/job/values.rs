@@ -75,7 +75,7 @@ impl fmt::Display for Res {
 as_text!(Res);
 
 /// `I/N`: part `I` of `N`, counting from 0 (`0 <= I < N`): a band of image rows
-/// (`tile`), or a shard of a batch.
+/// (`band`), or a shard of a batch.
 #[derive(Clone, Copy, Debug, PartialEq, Eq)]
 pub struct Band {
     /// Which part, from 0.
@@ -85,7 +85,7 @@ pub struct Band {
 }
 
 impl Band {
-    /// Parse `I/N` with `0 <= I < N`; `what` (`tile`, `shard`) names it in errors.
+    /// Parse `I/N` with `0 <= I < N`; `what` (`band`, `shard`) names it in errors.
     pub fn parse(what: &str, s: &str) -> Result<Band, String> {
         let (i, n) = s
             .split_once('/')
@@ -108,7 +108,7 @@ impl Band {
 impl FromStr for Band {
     type Err = String;
     fn from_str(s: &str) -> Result<Band, String> {
-        Band::parse("tile", s)
+        Band::parse("band", s)
     }
 }
 
@@ -247,7 +247,7 @@ mod tests {
         assert_eq!("2/5".parse::<Band>(), Ok(Band { index: 2, count: 5 }));
         assert_eq!(
             "4/4".parse::<Band>().unwrap_err(),
-            "tile '4/4': need 0 <= I < N"
+            "band '4/4': need 0 <= I < N"
         );
         assert_eq!(
             Band::parse("shard", "5/5").unwrap_err(),

@@ -1,4 +1,4 @@
-//! `emray merge`: stitch the parts rendered with `render --tile` or `--crop` into the
+//! `emray merge`: stitch the parts rendered with `render --band` or `--crop` into the
 //! whole image, with the output variables they were rendered with (`--aov`).
 
 use super::args::LogArgs;
@@ -10,7 +10,7 @@ use std::path::PathBuf;
 /// `emray merge`.
 #[derive(clap::Args, Debug, Clone)]
 pub struct Args {
-    /// The parts (EXR files from `render --tile` or `--crop`).
+    /// The parts (EXR files from `render --band` or `--crop`).
     #[arg(required = true, value_name = "PART.exr")]
     pub parts: Vec<PathBuf>,
     /// The whole image (.exr or .png).

@@ -50,7 +50,7 @@ pub enum Command {
     Gen(generate::Args),
     /// Render many scenes: failures isolated, resumable, split into shards.
     Batch(batch::Args),
-    /// Stitch parts rendered with `render --tile` or `--crop` into the whole image.
+    /// Stitch parts rendered with `render --band` or `--crop` into the whole image.
     Merge(merge::Args),
     /// Benchmark suite: SPD scenes on both backends, 1 and all threads, raw casting,
     /// Tachyon as a peer; markdown to standard output.

@@ -86,9 +86,9 @@ fn plan(args: &Args) -> Result<Vec<Job>, job::JobError> {
         s => s.iter().cloned().map(SceneSource::File).collect(),
     };
     let o = &args.options;
-    if (o.tile.is_some() || o.crop.is_some()) && sources.len() != 1 {
+    if (o.band.is_some() || o.crop.is_some()) && sources.len() != 1 {
         return Err(job::JobError::Outputs(
-            "--tile and --crop render one scene".into(),
+            "--band and --crop render one scene".into(),
         ));
     }
     let mut jobs = job::plan(sources, args.output.as_deref(), o)?;
