@@ -56,25 +56,6 @@ impl Cone {
         self.height
     }
 
-    /// Bounds of the two end disks, widened by a few ulps.
-    pub fn bounds(&self) -> Aabb {
-        let w = self.axis;
-        // Half-extent of a disk of radius r with normal w along axis i: r·√(1 − w_i²).
-        let k = (Vec3::ONE - w * w).max(Vec3::ZERO);
-        let k = Vec3::new(k.x.sqrt(), k.y.sqrt(), k.z.sqrt());
-        let eb = k * self.base_radius;
-        let ea = k * self.apex_radius;
-        let b = Aabb::from_points(self.base - eb, self.base + eb)
-            .union(&Aabb::from_points(self.apex - ea, self.apex + ea));
-        let slack = (b.min.abs().max(b.max.abs())
-            + Vec3::splat(self.base_radius.max(self.apex_radius)))
-            * gamma(4);
-        Aabb {
-            min: b.min - slack,
-            max: b.max + slack,
-        }
-    }
-
     /// The ray's quadratic (see [`ConeQuadratic`]) for the ray re-based at
     /// `org + t₀·dir`, the point of the ray nearest the base centre.
     ///
@@ -186,11 +167,32 @@ impl Cone {
         }
         None
     }
+}
+
+impl Intersect for Cone {
+    /// Bounds of the two end disks, widened by a few ulps.
+    fn bounds(&self) -> Aabb {
+        let w = self.axis;
+        // Half-extent of a disk of radius r with normal w along axis i: r·√(1 − w_i²).
+        let k = (Vec3::ONE - w * w).max(Vec3::ZERO);
+        let k = Vec3::new(k.x.sqrt(), k.y.sqrt(), k.z.sqrt());
+        let eb = k * self.base_radius;
+        let ea = k * self.apex_radius;
+        let b = Aabb::from_points(self.base - eb, self.base + eb)
+            .union(&Aabb::from_points(self.apex - ea, self.apex + ea));
+        let slack = (b.min.abs().max(b.max.abs())
+            + Vec3::splat(self.base_radius.max(self.apex_radius)))
+            * gamma(4);
+        Aabb {
+            min: b.min - slack,
+            max: b.max + slack,
+        }
+    }
 
     /// The nearest hit in `(ray.tmin, ray.tmax)`. `u` is the axial fraction from base
     /// (0) to apex (1).
     #[inline]
-    pub fn intersect(&self, ray: &Ray) -> Option<ShapeHit> {
+    fn intersect(&self, ray: &Ray) -> Option<ShapeHit> {
         let (t, u) = self.first(ray)?;
         Some(ShapeHit {
             t,
@@ -202,14 +204,15 @@ impl Cone {
 
     /// Whether a hit lies in `(ray.tmin, ray.tmax)`.
     #[inline]
-    pub fn occluded(&self, ray: &Ray) -> bool {
+    fn occluded(&self, ray: &Ray) -> bool {
         self.first(ray).is_some()
     }
 
     /// The hit point refined by one re-intersection from `o + t·d` (the remaining root
     /// is tiny, so its relative error no longer matters), with an error bound that
     /// scales with the cone's coordinates.
-    pub fn surface(&self, ray: &Ray, t: f32) -> SurfacePoint {
+    fn surface(&self, ray: &Ray, hit: &ShapeHit) -> SurfacePoint {
+        let t = hit.t;
         let p0 = ray.at(t);
         let local = Ray {
             org: p0,
@@ -237,23 +240,6 @@ impl Cone {
             err: Vec3::splat(scale * gamma(32)),
             ng,
         }
-    }
-}
-
-impl Intersect for Cone {
-    fn bounds(&self) -> Aabb {
-        Cone::bounds(self)
-    }
-    #[inline]
-    fn intersect(&self, ray: &Ray) -> Option<ShapeHit> {
-        Cone::intersect(self, ray)
-    }
-    #[inline]
-    fn occluded(&self, ray: &Ray) -> bool {
-        Cone::occluded(self, ray)
-    }
-    fn surface(&self, ray: &Ray, hit: &ShapeHit) -> SurfacePoint {
-        Cone::surface(self, ray, hit.t)
     }
 }
 

@@ -76,38 +76,6 @@ impl Plane {
         Some((-self.distance(ray.org.as_dvec3()) / den, den))
     }
 
-    /// The hit in `(ray.tmin, ray.tmax)`, if any; `ng` is the unit normal.
-    #[inline]
-    pub fn intersect(&self, ray: &Ray) -> Option<ShapeHit> {
-        let (t, _) = self.crossing(ray)?;
-        let t = t as f32;
-        (t > ray.tmin && t < ray.tmax).then_some(ShapeHit {
-            t,
-            u: 0.0,
-            v: 0.0,
-            ng: self.n32,
-        })
-    }
-
-    /// The hit point projected onto the plane in f64, rounded to f32, with the bound of
-    /// that rounding (plus the f64 projection's own error).
-    pub fn surface(&self, ray: &Ray, hit: &ShapeHit) -> SurfacePoint {
-        let mut p = ray.org.as_dvec3() + ray.dir.as_dvec3() * hit.t as f64;
-        if !p.is_finite() {
-            p = ray.org.as_dvec3();
-        }
-        for _ in 0..2 {
-            p -= self.n * self.distance(p);
-        }
-        let delta = gamma64(8) * (p.abs().dot(self.n.abs()) + self.d.abs() + p.abs().max_element());
-        let p32 = p.as_vec3();
-        SurfacePoint {
-            p: p32,
-            err: rounding_err(p32, delta),
-            ng: self.n32,
-        }
-    }
-
     /// The half-space's span of the whole line: a half-line, the whole line (parallel,
     /// inside) or nothing (parallel, outside). Infinite ends have a zero normal.
     pub fn spans(&self, ray: &Ray, out: &mut Spans) {
@@ -140,12 +108,37 @@ impl Intersect for Plane {
     fn bounds(&self) -> Aabb {
         Aabb::INFINITE
     }
+
+    /// The hit in `(ray.tmin, ray.tmax)`, if any; `ng` is the unit normal.
     #[inline]
     fn intersect(&self, ray: &Ray) -> Option<ShapeHit> {
-        Plane::intersect(self, ray)
+        let (t, _) = self.crossing(ray)?;
+        let t = t as f32;
+        (t > ray.tmin && t < ray.tmax).then_some(ShapeHit {
+            t,
+            u: 0.0,
+            v: 0.0,
+            ng: self.n32,
+        })
     }
+
+    /// The hit point projected onto the plane in f64, rounded to f32, with the bound of
+    /// that rounding (plus the f64 projection's own error).
     fn surface(&self, ray: &Ray, hit: &ShapeHit) -> SurfacePoint {
-        Plane::surface(self, ray, hit)
+        let mut p = ray.org.as_dvec3() + ray.dir.as_dvec3() * hit.t as f64;
+        if !p.is_finite() {
+            p = ray.org.as_dvec3();
+        }
+        for _ in 0..2 {
+            p -= self.n * self.distance(p);
+        }
+        let delta = gamma64(8) * (p.abs().dot(self.n.abs()) + self.d.abs() + p.abs().max_element());
+        let p32 = p.as_vec3();
+        SurfacePoint {
+            p: p32,
+            err: rounding_err(p32, delta),
+            ng: self.n32,
+        }
     }
 }
 

@@ -483,12 +483,6 @@ impl Quadric {
         self.bounded
     }
 
-    /// Conservative bounds: the clip box, intersected with the ellipsoid's exact box
-    /// (rounded outwards) for ellipsoids; [`Aabb::INFINITE`] when unbounded.
-    pub fn bounds(&self) -> Aabb {
-        self.bounds
-    }
-
     /// The world-space coefficients `[a, b, c, d, e, f, g, h, i, j]`, up to the positive
     /// factor the constructor scaled them by.
     pub fn coefficients(&self) -> [f64; 10] {
@@ -744,140 +738,6 @@ impl Quadric {
         None
     }
 
-    /// The nearest hit in `(ray.tmin, ray.tmax)`, from either side; `ng` is the unit
-    /// gradient of `F` (outwards).
-    pub fn intersect(&self, ray: &Ray) -> Option<ShapeHit> {
-        let (t, p, d, exit) = self.first(ray)?;
-        Some(ShapeHit {
-            t,
-            u: 0.0,
-            v: 0.0,
-            ng: outward_or_dir(self.half_grad(p), d, exit),
-        })
-    }
-
-    /// Whether a hit lies in `(ray.tmin, ray.tmax)`.
-    pub fn occluded(&self, ray: &Ray) -> bool {
-        self.first(ray).is_some()
-    }
-
-    /// The hit point put back onto the surface in f64 (re-solved along the ray within
-    /// the rounding of `t`, then projected along the gradient line, where `F` is an
-    /// exact quadratic), rounded to f32, with the bound of that rounding plus the f64
-    /// point's proven distance from the surface.
-    ///
-    /// For a clipped quadric's span end on a box face (normal `±x`, `±y` or `±z`, as
-    /// [`Quadric::spans`] reports them, and the point within the rounding of `t` of that
-    /// face) the point is put on the face exactly instead.
-    pub fn surface(&self, ray: &Ray, hit: &ShapeHit) -> SurfacePoint {
-        if let Some(sp) = self.cap_point(ray, hit.t, hit.ng) {
-            return sp;
-        }
-        let d = ray.dir.as_dvec3();
-        let mut p = ray.org.as_dvec3() - self.origin + d * hit.t as f64;
-        let p0 = p;
-        // First back onto the ray's own crossing: the root of F(p + s·d̂) nearest 0, if
-        // it is within the rounding of t (then it is the f64 root intersect() found).
-        let dl = d.length();
-        if dl > 0.0 {
-            let u = d / dl;
-            let (a, b, c) = (u.dot(self.m * u), self.half_grad(p).dot(u), self.f_local(p));
-            let disc = b * b - a * c;
-            let s = if a == 0.0 || disc >= 0.0 {
-                let qq = -(b + disc.max(0.0).sqrt().copysign(b));
-                c / qq
-            } else {
-                f64::NAN
-            };
-            let t_ulp = (hit.t.abs() * f32::EPSILON) as f64 * dl;
-            if s.abs() <= 4.0 * t_ulp {
-                p += u * s;
-            }
-        }
-        // Then along the normal (usually nothing is left to do): one step, more only when
-        // t was far off (a ray from millions of sizes away, whose f32 t is coarse) and the
-        // gradient turns along the way. more only when t was far off (a ray from millions of sizes
-        // away, whose f32 t is coarse) and the gradient turns along the way.
-        for _ in 0..16 {
-            let g = self.half_grad(p);
-            let f = self.f_local(p);
-            if f == 0.0 || !f.is_finite() || !g.is_finite() {
-                break;
-            }
-            // Along a unit direction u, F(p + s·u) = f + 2(g·u)·s + (uᵀMu)·s² exactly:
-            // step to its root nearest 0. The gradient's direction first; where that line
-            // misses the surface (near a cone's apex), an eigenvector whose eigenvalue has
-            // the sign opposite to f, along which a root always exists.
-            let gl = g.length();
-            let gh = g / gl;
-            let kappa = gh.dot(self.m * gh);
-            let disc = gl * gl - kappa * f;
-            let (u, b, a, disc) = if gl > 0.0 && disc >= 0.0 {
-                (gh, gl, kappa, disc)
-            } else {
-                let (u, mu) = if f > 0.0 {
-                    (self.v_neg, -self.lam_neg)
-                } else {
-                    (self.v_pos, self.lam_pos)
-                };
-                let b = g.dot(u);
-                (u, b, mu, b * b - mu * f)
-            };
-            if disc.is_nan() || disc < 0.0 || (a == 0.0 && b == 0.0) {
-                break;
-            }
-            let qq = -(b + disc.sqrt().copysign(b));
-            let s = f / qq;
-            if !s.is_finite() {
-                break;
-            }
-            p += u * s;
-            if s.abs() <= 1e-17 * p.abs().max_element() {
-                break;
-            }
-        }
-        if !p.is_finite() {
-            p = p0;
-        }
-        // Proven distance from p to the surface, with φ ≥ |F(p)| (rounding included):
-        // * 2φ/|∇F| along the gradient when |∇F|² ≥ 8λφ (λ ≥ |eigenvalues|): the
-        //   exact quadratic F(p + s·u) = F + s∇F·u + s²uᵀMu changes sign on that segment;
-        // * √(φ/|μ|) along an eigenvector whose eigenvalue μ has the opposite sign to F
-        //   (the bound that survives at a cone's apex, where ∇F vanishes).
-        let f = self.f_local(p);
-        let phi = f.abs() + self.f_err(p);
-        let grad = 2.0 * self.half_grad(p).length();
-        let lam = 2.0 * self.m_norm;
-        let along_grad = if grad * grad >= 8.0 * lam * phi {
-            2.0 * phi / grad
-        } else {
-            f64::INFINITY
-        };
-        let mu = if f > 0.0 { self.lam_neg } else { self.lam_pos };
-        let along_eigen = if mu > 0.0 {
-            (phi / (0.99 * mu)).sqrt()
-        } else {
-            f64::INFINITY
-        };
-        let mut delta = along_grad.min(along_eigen);
-        if !delta.is_finite() {
-            // Not near the surface at all (a t this quadric never reported).
-            delta = 1e-6 * (d.length() * (hit.t as f64).abs() + p.length());
-        }
-        let pw = self.origin + p;
-        let delta = delta + gamma64(4) * (pw.abs().max_element() + p.abs().max_element());
-        let p32 = pw.as_vec3();
-        let ng = unit_f32(self.half_grad(p))
-            .or_else(|| hit.ng.try_normalize())
-            .or_else(|| (-ray.dir).try_normalize())
-            .unwrap_or(Vec3::Z);
-        SurfacePoint {
-            p: p32,
-            err: rounding_err(p32, delta),
-            ng,
-        }
-    }
-
     /// The surface point for a span end on a face of the clip box: `ng` is that face's
     /// normal (exactly `±x`, `±y` or `±z`, as [`Quadric::spans`] reports it) and the
     /// point `o + t·d` is within the rounding of `t` of the face's plane.
@@ -987,19 +847,144 @@ fn pack(m: DMat3, l: DVec3, j: f64) -> [f64; 10] {
 }
 
 impl Intersect for Quadric {
+    /// Conservative bounds: the clip box, intersected with the ellipsoid's exact box
+    /// (rounded outwards) for ellipsoids; [`Aabb::INFINITE`] when unbounded.
     fn bounds(&self) -> Aabb {
-        Quadric::bounds(self)
+        self.bounds
     }
-    #[inline]
+
+    /// The nearest hit in `(ray.tmin, ray.tmax)`, from either side; `ng` is the unit
+    /// gradient of `F` (outwards).
     fn intersect(&self, ray: &Ray) -> Option<ShapeHit> {
-        Quadric::intersect(self, ray)
+        let (t, p, d, exit) = self.first(ray)?;
+        Some(ShapeHit {
+            t,
+            u: 0.0,
+            v: 0.0,
+            ng: outward_or_dir(self.half_grad(p), d, exit),
+        })
     }
-    #[inline]
+
+    /// Whether a hit lies in `(ray.tmin, ray.tmax)`.
     fn occluded(&self, ray: &Ray) -> bool {
-        Quadric::occluded(self, ray)
+        self.first(ray).is_some()
     }
+
+    /// The hit point put back onto the surface in f64 (re-solved along the ray within
+    /// the rounding of `t`, then projected along the gradient line, where `F` is an
+    /// exact quadratic), rounded to f32, with the bound of that rounding plus the f64
+    /// point's proven distance from the surface.
+    ///
+    /// For a clipped quadric's span end on a box face (normal `±x`, `±y` or `±z`, as
+    /// [`Quadric::spans`] reports them, and the point within the rounding of `t` of that
+    /// face) the point is put on the face exactly instead.
     fn surface(&self, ray: &Ray, hit: &ShapeHit) -> SurfacePoint {
-        Quadric::surface(self, ray, hit)
+        if let Some(sp) = self.cap_point(ray, hit.t, hit.ng) {
+            return sp;
+        }
+        let d = ray.dir.as_dvec3();
+        let mut p = ray.org.as_dvec3() - self.origin + d * hit.t as f64;
+        let p0 = p;
+        // First back onto the ray's own crossing: the root of F(p + s·d̂) nearest 0, if
+        // it is within the rounding of t (then it is the f64 root intersect() found).
+        let dl = d.length();
+        if dl > 0.0 {
+            let u = d / dl;
+            let (a, b, c) = (u.dot(self.m * u), self.half_grad(p).dot(u), self.f_local(p));
+            let disc = b * b - a * c;
+            let s = if a == 0.0 || disc >= 0.0 {
+                let qq = -(b + disc.max(0.0).sqrt().copysign(b));
+                c / qq
+            } else {
+                f64::NAN
+            };
+            let t_ulp = (hit.t.abs() * f32::EPSILON) as f64 * dl;
+            if s.abs() <= 4.0 * t_ulp {
+                p += u * s;
+            }
+        }
+        // Then along the normal (usually nothing is left to do): one step, more only when
+        // t was far off (a ray from millions of sizes away, whose f32 t is coarse) and the
+        // gradient turns along the way. more only when t was far off (a ray from millions of sizes
+        // away, whose f32 t is coarse) and the gradient turns along the way.
+        for _ in 0..16 {
+            let g = self.half_grad(p);
+            let f = self.f_local(p);
+            if f == 0.0 || !f.is_finite() || !g.is_finite() {
+                break;
+            }
+            // Along a unit direction u, F(p + s·u) = f + 2(g·u)·s + (uᵀMu)·s² exactly:
+            // step to its root nearest 0. The gradient's direction first; where that line
+            // misses the surface (near a cone's apex), an eigenvector whose eigenvalue has
+            // the sign opposite to f, along which a root always exists.
+            let gl = g.length();
+            let gh = g / gl;
+            let kappa = gh.dot(self.m * gh);
+            let disc = gl * gl - kappa * f;
+            let (u, b, a, disc) = if gl > 0.0 && disc >= 0.0 {
+                (gh, gl, kappa, disc)
+            } else {
+                let (u, mu) = if f > 0.0 {
+                    (self.v_neg, -self.lam_neg)
+                } else {
+                    (self.v_pos, self.lam_pos)
+                };
+                let b = g.dot(u);
+                (u, b, mu, b * b - mu * f)
+            };
+            if disc.is_nan() || disc < 0.0 || (a == 0.0 && b == 0.0) {
+                break;
+            }
+            let qq = -(b + disc.sqrt().copysign(b));
+            let s = f / qq;
+            if !s.is_finite() {
+                break;
+            }
+            p += u * s;
+            if s.abs() <= 1e-17 * p.abs().max_element() {
+                break;
+            }
+        }
+        if !p.is_finite() {
+            p = p0;
+        }
+        // Proven distance from p to the surface, with φ ≥ |F(p)| (rounding included):
+        // * 2φ/|∇F| along the gradient when |∇F|² ≥ 8λφ (λ ≥ |eigenvalues|): the
+        //   exact quadratic F(p + s·u) = F + s∇F·u + s²uᵀMu changes sign on that segment;
+        // * √(φ/|μ|) along an eigenvector whose eigenvalue μ has the opposite sign to F
+        //   (the bound that survives at a cone's apex, where ∇F vanishes).
+        let f = self.f_local(p);
+        let phi = f.abs() + self.f_err(p);
+        let grad = 2.0 * self.half_grad(p).length();
+        let lam = 2.0 * self.m_norm;
+        let along_grad = if grad * grad >= 8.0 * lam * phi {
+            2.0 * phi / grad
+        } else {
+            f64::INFINITY
+        };
+        let mu = if f > 0.0 { self.lam_neg } else { self.lam_pos };
+        let along_eigen = if mu > 0.0 {
+            (phi / (0.99 * mu)).sqrt()
+        } else {
+            f64::INFINITY
+        };
+        let mut delta = along_grad.min(along_eigen);
+        if !delta.is_finite() {
+            // Not near the surface at all (a t this quadric never reported).
+            delta = 1e-6 * (d.length() * (hit.t as f64).abs() + p.length());
+        }
+        let pw = self.origin + p;
+        let delta = delta + gamma64(4) * (pw.abs().max_element() + p.abs().max_element());
+        let p32 = pw.as_vec3();
+        let ng = unit_f32(self.half_grad(p))
+            .or_else(|| hit.ng.try_normalize())
+            .or_else(|| (-ray.dir).try_normalize())
+            .unwrap_or(Vec3::Z);
+        SurfacePoint {
+            p: p32,
+            err: rounding_err(p32, delta),
+            ng,
+        }
     }
 }
 

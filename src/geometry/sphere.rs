@@ -29,16 +29,6 @@ impl Sphere {
         }
     }
 
-    /// Bounds, widened by a few ulps.
-    pub fn bounds(&self) -> Aabb {
-        let r = Vec3::splat(self.radius * (1.0 + gamma(2)));
-        let slack = self.center.abs() * gamma(2);
-        Aabb {
-            min: self.center - r - slack,
-            max: self.center + r + slack,
-        }
-    }
-
     /// The (entry, exit) roots of the ray's quadratic, or `None` on a miss
     /// (Haines et al., Ray Tracing Gems ch. 7: the discriminant from the distance between
     /// the centre and the line, which does not cancel).
@@ -58,10 +48,22 @@ impl Sphere {
         // a > 0, so the entry root is the smaller one.
         Some(quadratic_roots(a, b, c, disc))
     }
+}
+
+impl Intersect for Sphere {
+    /// Bounds, widened by a few ulps.
+    fn bounds(&self) -> Aabb {
+        let r = Vec3::splat(self.radius * (1.0 + gamma(2)));
+        let slack = self.center.abs() * gamma(2);
+        Aabb {
+            min: self.center - r - slack,
+            max: self.center + r + slack,
+        }
+    }
 
     /// The nearest hit in `(ray.tmin, ray.tmax)`.
     #[inline]
-    pub fn intersect(&self, ray: &Ray) -> Option<ShapeHit> {
+    fn intersect(&self, ray: &Ray) -> Option<ShapeHit> {
         let (t0, t1) = self.roots(ray)?;
         let t = if !self.inside_only && t0 > ray.tmin && t0 < ray.tmax {
             t0
@@ -81,7 +83,7 @@ impl Sphere {
 
     /// Whether a hit lies in `(ray.tmin, ray.tmax)`.
     #[inline]
-    pub fn occluded(&self, ray: &Ray) -> bool {
+    fn occluded(&self, ray: &Ray) -> bool {
         match self.roots(ray) {
             Some((t0, t1)) => {
                 (!self.inside_only && t0 > ray.tmin && t0 < ray.tmax)
@@ -92,8 +94,8 @@ impl Sphere {
     }
 
     /// The hit point reprojected onto the sphere, with its error bound (pbrt §6.8.5).
-    pub fn surface(&self, ray: &Ray, t: f32) -> SurfacePoint {
-        let mut local = ray.at(t) - self.center;
+    fn surface(&self, ray: &Ray, hit: &ShapeHit) -> SurfacePoint {
+        let mut local = ray.at(hit.t) - self.center;
         let len = local.length();
         if len > 0.0 {
             local *= self.radius / len;
@@ -106,23 +108,6 @@ impl Sphere {
             -ray.dir.normalize()
         };
         SurfacePoint { p, err, ng }
-    }
-}
-
-impl Intersect for Sphere {
-    fn bounds(&self) -> Aabb {
-        Sphere::bounds(self)
-    }
-    #[inline]
-    fn intersect(&self, ray: &Ray) -> Option<ShapeHit> {
-        Sphere::intersect(self, ray)
-    }
-    #[inline]
-    fn occluded(&self, ray: &Ray) -> bool {
-        Sphere::occluded(self, ray)
-    }
-    fn surface(&self, ray: &Ray, hit: &ShapeHit) -> SurfacePoint {
-        Sphere::surface(self, ray, hit.t)
     }
 }
 

@@ -131,12 +131,6 @@ impl Torus {
         (self.ex.as_vec3(), self.ey.as_vec3(), self.axis.as_vec3())
     }
 
-    /// Conservative bounds: the box of the centre circle grown by the tube radius,
-    /// rounded outwards.
-    pub fn bounds(&self) -> Aabb {
-        self.bounds
-    }
-
     /// `(ρ − R)² + z² − r²` at world point `p`: negative inside, positive outside.
     pub fn value(&self, p: DVec3) -> f64 {
         let l = self.local(p - self.center);
@@ -303,98 +297,6 @@ impl Torus {
         None
     }
 
-    /// The nearest hit in `(ray.tmin, ray.tmax)`, from either side; `ng` is the unit
-    /// outward normal.
-    pub fn intersect(&self, ray: &Ray) -> Option<ShapeHit> {
-        let (line, t, s, exit) = self.first(ray)?;
-        let (ng, u, v) = self.at(&line, s, exit);
-        Some(ShapeHit { t, u, v, ng })
-    }
-
-    /// Whether a hit lies in `(ray.tmin, ray.tmax)`.
-    pub fn occluded(&self, ray: &Ray) -> bool {
-        self.first(ray).is_some()
-    }
-
-    /// The hit point put back onto the torus in f64 (re-solved along the ray within the
-    /// rounding of `t`, then projected to the nearest point of the tube's circle in the
-    /// point's meridian plane, or for a spindle torus whose projection would cross the
-    /// axis to the cusp where the surface meets it), rounded to f32, with the bound of
-    /// that rounding plus the f64 error.
-    pub fn surface(&self, ray: &Ray, hit: &ShapeHit) -> SurfacePoint {
-        let d = ray.dir.as_dvec3();
-        let p0 = ray.org.as_dvec3() + d * hit.t as f64;
-        let p0 = if p0.is_finite() { p0 } else { self.center };
-        let (rr, r) = (self.major, self.minor);
-        // First back onto the ray's own crossing, if it is within the rounding of t:
-        // Newton on the signed distance along the ray (its gradient is the unit normal).
-        let mut q = self.local(p0 - self.center);
-        let dl = d.length();
-        if dl > 0.0 {
-            let u = self.local(d / dl);
-            let t_ulp = (hit.t.abs() * f32::EPSILON) as f64 * dl;
-            let mut x = q;
-            let mut moved = 0.0f64;
-            for _ in 0..4 {
-                let rho = x.x.hypot(x.y);
-                let (a, z) = (rho - rr, x.z);
-                let dist = a.hypot(z);
-                if rho == 0.0 || dist == 0.0 {
-                    break;
-                }
-                let n = DVec3::new(a * x.x / (rho * dist), a * x.y / (rho * dist), z / dist);
-                let step = (dist - r) / n.dot(u);
-                if !step.is_finite() {
-                    break;
-                }
-                x -= u * step;
-                moved -= step;
-                if step.abs() <= 1e-17 * (rr + r) {
-                    break;
-                }
-            }
-            if x.is_finite() && moved.abs() <= 4.0 * t_ulp {
-                q = x;
-            }
-        }
-        let rho = q.x.hypot(q.y);
-        // The meridian half-plane through q (any one on the axis).
-        let radial = if rho > 0.0 {
-            DVec3::new(q.x / rho, q.y / rho, 0.0)
-        } else {
-            DVec3::X
-        };
-        // Meridian coordinates relative to the tube's centre circle.
-        let (a, z) = (rho - rr, q.z);
-        let dist = a.hypot(z);
-        let (pa, pz, na, nz) = if dist > 0.0 {
-            let (na, nz) = (a / dist, z / dist);
-            if rr + r * na >= 0.0 {
-                (r * na, r * nz, na, nz)
-            } else {
-                // A spindle torus's tube circle crosses the axis: its end is the cusp,
-                // where the outside is the dimple along the axis.
-                let zc = (r * r - rr * rr).max(0.0).sqrt().copysign(z);
-                (-rr, zc, 0.0, 1.0f64.copysign(z))
-            }
-        } else {
-            (r, 0.0, 1.0, 0.0)
-        };
-        let local = radial * (rr + pa) + DVec3::new(0.0, 0.0, pz);
-        let p = self.center + self.world(local);
-        let scale = self.center.abs().max_element() + rr + r;
-        let delta = gamma64(16) * (scale + p.abs().max_element());
-        let ng = unit_f32(self.world(radial * na + DVec3::new(0.0, 0.0, nz)))
-            .or_else(|| hit.ng.try_normalize())
-            .unwrap_or(Vec3::Z);
-        let p32 = p.as_vec3();
-        SurfacePoint {
-            p: p32,
-            err: rounding_err(p32, delta),
-            ng,
-        }
-    }
-
     /// The solid's spans along the whole line of `ray` (at most two).
     pub fn spans(&self, ray: &Ray, out: &mut Spans) {
         let Some(line) = self.line(ray) else {
@@ -477,17 +379,102 @@ fn bracket_root(
 }
 
 impl Intersect for Torus {
+    /// Conservative bounds: the box of the centre circle grown by the tube radius,
+    /// rounded outwards.
     fn bounds(&self) -> Aabb {
-        Torus::bounds(self)
+        self.bounds
     }
+
+    /// The nearest hit in `(ray.tmin, ray.tmax)`, from either side; `ng` is the unit
+    /// outward normal.
     fn intersect(&self, ray: &Ray) -> Option<ShapeHit> {
-        Torus::intersect(self, ray)
+        let (line, t, s, exit) = self.first(ray)?;
+        let (ng, u, v) = self.at(&line, s, exit);
+        Some(ShapeHit { t, u, v, ng })
     }
+
+    /// Whether a hit lies in `(ray.tmin, ray.tmax)`.
     fn occluded(&self, ray: &Ray) -> bool {
-        Torus::occluded(self, ray)
+        self.first(ray).is_some()
     }
+
+    /// The hit point put back onto the torus in f64 (re-solved along the ray within the
+    /// rounding of `t`, then projected to the nearest point of the tube's circle in the
+    /// point's meridian plane, or for a spindle torus whose projection would cross the
+    /// axis to the cusp where the surface meets it), rounded to f32, with the bound of
+    /// that rounding plus the f64 error.
     fn surface(&self, ray: &Ray, hit: &ShapeHit) -> SurfacePoint {
-        Torus::surface(self, ray, hit)
+        let d = ray.dir.as_dvec3();
+        let p0 = ray.org.as_dvec3() + d * hit.t as f64;
+        let p0 = if p0.is_finite() { p0 } else { self.center };
+        let (rr, r) = (self.major, self.minor);
+        // First back onto the ray's own crossing, if it is within the rounding of t:
+        // Newton on the signed distance along the ray (its gradient is the unit normal).
+        let mut q = self.local(p0 - self.center);
+        let dl = d.length();
+        if dl > 0.0 {
+            let u = self.local(d / dl);
+            let t_ulp = (hit.t.abs() * f32::EPSILON) as f64 * dl;
+            let mut x = q;
+            let mut moved = 0.0f64;
+            for _ in 0..4 {
+                let rho = x.x.hypot(x.y);
+                let (a, z) = (rho - rr, x.z);
+                let dist = a.hypot(z);
+                if rho == 0.0 || dist == 0.0 {
+                    break;
+                }
+                let n = DVec3::new(a * x.x / (rho * dist), a * x.y / (rho * dist), z / dist);
+                let step = (dist - r) / n.dot(u);
+                if !step.is_finite() {
+                    break;
+                }
+                x -= u * step;
+                moved -= step;
+                if step.abs() <= 1e-17 * (rr + r) {
+                    break;
+                }
+            }
+            if x.is_finite() && moved.abs() <= 4.0 * t_ulp {
+                q = x;
+            }
+        }
+        let rho = q.x.hypot(q.y);
+        // The meridian half-plane through q (any one on the axis).
+        let radial = if rho > 0.0 {
+            DVec3::new(q.x / rho, q.y / rho, 0.0)
+        } else {
+            DVec3::X
+        };
+        // Meridian coordinates relative to the tube's centre circle.
+        let (a, z) = (rho - rr, q.z);
+        let dist = a.hypot(z);
+        let (pa, pz, na, nz) = if dist > 0.0 {
+            let (na, nz) = (a / dist, z / dist);
+            if rr + r * na >= 0.0 {
+                (r * na, r * nz, na, nz)
+            } else {
+                // A spindle torus's tube circle crosses the axis: its end is the cusp,
+                // where the outside is the dimple along the axis.
+                let zc = (r * r - rr * rr).max(0.0).sqrt().copysign(z);
+                (-rr, zc, 0.0, 1.0f64.copysign(z))
+            }
+        } else {
+            (r, 0.0, 1.0, 0.0)
+        };
+        let local = radial * (rr + pa) + DVec3::new(0.0, 0.0, pz);
+        let p = self.center + self.world(local);
+        let scale = self.center.abs().max_element() + rr + r;
+        let delta = gamma64(16) * (scale + p.abs().max_element());
+        let ng = unit_f32(self.world(radial * na + DVec3::new(0.0, 0.0, nz)))
+            .or_else(|| hit.ng.try_normalize())
+            .unwrap_or(Vec3::Z);
+        let p32 = p.as_vec3();
+        SurfacePoint {
+            p: p32,
+            err: rounding_err(p32, delta),
+            ng,
+        }
     }
 }
 
