@@ -11,7 +11,7 @@
 //! and runs the same test against `[−h, h]`.
 
 use super::param::box_param;
-use super::{Intersect, Param, Primitive, ShapeError, ShapeHit, Solid, Span, Spans, SurfacePoint};
+use super::{Intersect, Param, Primitive, ShapeError, ShapeHit, Span, Spans, SurfacePoint};
 use crate::math::{Aabb, Ray, Vec3, gamma};
 use glam::{DMat3, DQuat, Mat3, Quat};
 
@@ -215,23 +215,6 @@ impl Intersect for AaBox {
             err: p.abs() * gamma(2),
             ng: axis_vec(i, if top { 1.0 } else { -1.0 }),
         }
-    }
-}
-
-impl Solid for AaBox {
-    fn spans(&self, ray: &Ray, out: &mut Spans) {
-        if let Some((a, b)) = self.ends(ray) {
-            out.push(Span {
-                t_in: a.t,
-                n_in: axis_vec(a.axis, a.sign),
-                t_out: b.t,
-                n_out: axis_vec(b.axis, b.sign),
-            });
-        }
-    }
-
-    fn contains(&self, p: Vec3) -> bool {
-        p.cmpge(self.min).all() && p.cmple(self.max).all()
     }
 }
 
@@ -441,34 +424,26 @@ impl Intersect for OBox {
     }
 }
 
-impl Solid for OBox {
+impl Primitive for AaBox {
+    fn is_solid(&self) -> bool {
+        true
+    }
+
     fn spans(&self, ray: &Ray, out: &mut Spans) {
-        if let Some((m, a, b)) = self.ends(ray) {
+        if let Some((a, b)) = self.ends(ray) {
             out.push(Span {
                 t_in: a.t,
-                n_in: m.col(a.axis) * a.sign,
+                n_in: axis_vec(a.axis, a.sign),
                 t_out: b.t,
-                n_out: m.col(b.axis) * b.sign,
+                n_out: axis_vec(b.axis, b.sign),
             });
         }
     }
 
     fn contains(&self, p: Vec3) -> bool {
-        let y = Self::to_local(&self.matrix(), p - self.center);
-        y.abs().cmple(self.half).all()
+        p.cmpge(self.min).all() && p.cmple(self.max).all()
     }
-}
 
-impl Primitive for AaBox {
-    fn is_solid(&self) -> bool {
-        true
-    }
-    fn spans(&self, ray: &Ray, out: &mut Spans) {
-        Solid::spans(self, ray, out)
-    }
-    fn contains(&self, p: Vec3) -> bool {
-        Solid::contains(self, p)
-    }
     fn param(&self, p: Vec3, ng: Vec3) -> Param {
         let (min, max) = (self.min(), self.max());
         box_param(
@@ -485,12 +460,23 @@ impl Primitive for OBox {
     fn is_solid(&self) -> bool {
         true
     }
+
     fn spans(&self, ray: &Ray, out: &mut Spans) {
-        Solid::spans(self, ray, out)
+        if let Some((m, a, b)) = self.ends(ray) {
+            out.push(Span {
+                t_in: a.t,
+                n_in: m.col(a.axis) * a.sign,
+                t_out: b.t,
+                n_out: m.col(b.axis) * b.sign,
+            });
+        }
     }
+
     fn contains(&self, p: Vec3) -> bool {
-        Solid::contains(self, p)
+        let y = Self::to_local(&self.matrix(), p - self.center);
+        y.abs().cmple(self.half).all()
     }
+
     fn param(&self, p: Vec3, ng: Vec3) -> Param {
         box_param(p, ng, self.center(), self.half_extents(), self.axes())
     }

@@ -18,8 +18,8 @@
 
 use super::param::{axis_frame, cylindrical};
 use super::{
-    Intersect, Param, Primitive, ShapeError, ShapeHit, Solid, Span, Spans, SurfacePoint,
-    diff_of_products, quadratic_roots,
+    Intersect, Param, Primitive, ShapeError, ShapeHit, Span, Spans, SurfacePoint, diff_of_products,
+    quadratic_roots,
 };
 use crate::math::{Aabb, DVec3, Frame, Ray, Vec3, gamma};
 use glam::Vec2;
@@ -630,7 +630,18 @@ impl Intersect for CappedCone {
     }
 }
 
-impl Solid for CappedCone {
+impl CappedCone {
+    /// Whether both ends have the same radius: a (closed) cylinder.
+    pub fn is_cylinder(&self) -> bool {
+        self.base_radius == self.top_radius
+    }
+}
+
+impl Primitive for CappedCone {
+    fn is_solid(&self) -> bool {
+        true
+    }
+
     fn spans(&self, ray: &Ray, out: &mut Spans) {
         if let Some(s) = self.stretch(ray) {
             out.push(Span {
@@ -651,17 +662,10 @@ impl Solid for CappedCone {
         let r = self.base_radius + self.slope * s;
         (q - self.axis * s).length_squared() <= r * r
     }
-}
-
-impl CappedCone {
-    /// Whether both ends have the same radius: a (closed) cylinder.
-    pub fn is_cylinder(&self) -> bool {
-        self.base_radius == self.top_radius
-    }
 
     /// The cylindrical parameterisation on the side, a disk onto `[0, 1]²` on the caps
     /// (`ng` the unit outward normal tells them apart).
-    pub fn param(&self, p: Vec3, ng: Vec3) -> Param {
+    fn param(&self, p: Vec3, ng: Vec3) -> Param {
         let axis = self.axis();
         let h = (p - self.base()).dot(axis);
         let on_cap = ng.dot(axis).abs() > 0.999
@@ -689,21 +693,6 @@ impl CappedCone {
             dpdu: e1 * (su * 2.0 * r),
             dpdv: e2 * (2.0 * r),
         }
-    }
-}
-
-impl Primitive for CappedCone {
-    fn is_solid(&self) -> bool {
-        true
-    }
-    fn spans(&self, ray: &Ray, out: &mut Spans) {
-        Solid::spans(self, ray, out)
-    }
-    fn contains(&self, p: Vec3) -> bool {
-        Solid::contains(self, p)
-    }
-    fn param(&self, p: Vec3, ng: Vec3) -> Param {
-        CappedCone::param(self, p, ng)
     }
 }
 

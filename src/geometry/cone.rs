@@ -1,5 +1,5 @@
 use super::param::cylindrical;
-use super::{Intersect, Param, Primitive, ShapeHit, Spans, SurfacePoint, quadratic_roots_f64};
+use super::{Intersect, Param, Primitive, ShapeHit, SurfacePoint, quadratic_roots_f64};
 use crate::math::{Aabb, Ray, Vec3, gamma};
 
 /// NFF's open cone or cylinder: the lateral surface between a base disk and an apex
@@ -248,25 +248,14 @@ impl Cone {
     pub fn is_cylinder(&self) -> bool {
         self.base_radius == self.apex_radius
     }
-
-    /// The cylindrical parameterisation at `p`.
-    pub fn param(&self, p: Vec3) -> Param {
-        let slope = (self.apex_radius - self.base_radius) / self.height();
-        cylindrical(p, self.base, self.axis(), self.height(), slope)
-    }
 }
 
-/// An open surface: not a CSG operand, no inside.
+/// An open surface: not a CSG operand, no inside (the defaults).
 impl Primitive for Cone {
-    fn is_solid(&self) -> bool {
-        false
-    }
-    fn spans(&self, _ray: &Ray, _out: &mut Spans) {}
-    fn contains(&self, _p: Vec3) -> bool {
-        false
-    }
+    /// The cylindrical parameterisation at `p`.
     fn param(&self, p: Vec3, _ng: Vec3) -> Param {
-        Cone::param(self, p)
+        let slope = (self.apex_radius - self.base_radius) / self.height();
+        cylindrical(p, self.base, self.axis(), self.height(), slope)
     }
 }
 

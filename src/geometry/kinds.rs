@@ -8,13 +8,13 @@
 //! their visitor in [`crate::scene`].
 //!
 //! Adding an analytic primitive therefore means: its own file (the type with its
-//! [`Intersect`], [`Primitive`] and, for a closed solid, [`Solid`](super::Solid)
-//! impls: bounds, hits, the accurate surface point and the texture parameterisation)
+//! [`Intersect`] and [`Primitive`] impls: bounds, hits, the accurate surface point, the
+//! texture parameterisation and, for a closed solid, its inside)
 //! plus one row in the table. Triangles are not in the table: Embree intersects them
 //! natively and they carry vertex normals, texture coordinates and quads, so the store
 //! keeps them apart; they are [`Kind::Triangle`], geometry id 0.
 
-use super::{Intersect, Param, ShapeHit, Spans, SurfacePoint};
+use super::{Intersect, Param, Primitive, ShapeHit, Spans, SurfacePoint};
 use crate::math::{Aabb, Ray, Vec3};
 use std::sync::Arc;
 
@@ -50,29 +50,6 @@ macro_rules! for_each_kind {
     };
 }
 pub(crate) use for_each_kind;
-
-/// What every analytic primitive provides beyond [`Intersect`]: whether it is a closed
-/// solid and the solid's spans (for CSG), its texture parameterisation, and the
-/// material of a hit. Each kind implements it in its own file.
-pub trait Primitive: Intersect {
-    /// Whether this is a closed solid, usable as a CSG operand.
-    fn is_solid(&self) -> bool;
-    /// Append the spans of the whole line inside the solid, as
-    /// [`Solid::spans`](super::Solid::spans) does (nothing for open surfaces).
-    fn spans(&self, ray: &Ray, out: &mut Spans);
-    /// Whether `p` is inside the solid (false for open surfaces).
-    fn contains(&self, p: Vec3) -> bool;
-    /// The texture coordinates and tangents at `p`, a point on the primitive with unit
-    /// outward geometric normal `ng` (see [`Param`]).
-    fn param(&self, p: Vec3, ng: Vec3) -> Param;
-    /// The material of `hit`, given `own`, the primitive's material in the store: `own`
-    /// unless a part of the primitive has its own (a CSG leaf).
-    #[inline]
-    fn material(&self, hit: &ShapeHit, own: u32) -> u32 {
-        let _ = hit;
-        own
-    }
-}
 
 /// One analytic kind's stored type (a row of the kinds table): a [`Primitive`] with
 /// its [`Kind`], convertible into a [`Shape`], shareable with the backends' threads.

@@ -7,8 +7,8 @@
 //! used by the tests to bound the f32 error.
 //!
 //! The primitive kinds are listed once, in the table behind [`Kind`] and [`Shape`]:
-//! adding an analytic primitive means its own file (the type and its [`Intersect`],
-//! [`Primitive`] and [`Solid`] impls) plus one row in that table.
+//! adding an analytic primitive means its own file (the type and its [`Intersect`] and
+//! [`Primitive`] impls) plus one row in that table.
 
 pub mod bezier;
 mod boxes;
@@ -34,7 +34,7 @@ pub use cone::Cone;
 pub use csg::{Csg, CsgOp, CsgTree};
 pub use error::ShapeError;
 pub(crate) use kinds::for_each_kind;
-pub use kinds::{Analytic, Kind, Primitive, Shape};
+pub use kinds::{Analytic, Kind, Shape};
 pub use param::{Param, QuadUv, inverse_bilinear};
 pub use plane::Plane;
 pub use polyhedron::{MAX_PLANES, Polyhedron};
@@ -103,13 +103,43 @@ pub struct Span {
 /// A short list of spans, sorted by `t_in` and disjoint; inline up to four.
 pub type Spans = smallvec::SmallVec<[Span; 4]>;
 
-/// A closed solid usable in CSG: it can list every stretch of a line inside it.
-pub trait Solid: Intersect {
+/// What a scene primitive adds to the ray queries of [`Intersect`]: its texture
+/// parameterisation, the material of a hit and, for a closed solid, its inside (what CSG
+/// combines). Each kind implements it in its own file; the defaults are those of an open
+/// surface (no inside: not a CSG operand, no spans, contains nothing), which the closed
+/// solids override.
+pub trait Primitive: Intersect {
+    /// The texture coordinates and tangents at `p`, a point on the primitive with unit
+    /// outward geometric normal `ng` (see [`Param`]).
+    fn param(&self, p: Vec3, ng: Vec3) -> Param;
+
+    /// The material of `hit`, given `own`, the primitive's material in the store: `own`
+    /// unless a part of the primitive has its own (a CSG leaf).
+    #[inline]
+    fn material(&self, hit: &ShapeHit, own: u32) -> u32 {
+        let _ = hit;
+        own
+    }
+
+    /// Whether this is a closed solid, usable as a CSG operand (false: an open
+    /// surface).
+    fn is_solid(&self) -> bool {
+        false
+    }
+
     /// Append to `out`, sorted and disjoint, every span where the whole line
-    /// `ray.org + t·ray.dir`, `t ∈ (−∞, ∞)`, is inside the solid (ignoring `tmin`/`tmax`).
-    fn spans(&self, ray: &Ray, out: &mut Spans);
-    /// Whether point `p` is inside (boundary points may go either way).
-    fn contains(&self, p: Vec3) -> bool;
+    /// `ray.org + t·ray.dir`, `t ∈ (−∞, ∞)`, is inside the solid (ignoring
+    /// `tmin`/`tmax`); nothing for an open surface.
+    fn spans(&self, ray: &Ray, out: &mut Spans) {
+        let _ = (ray, out);
+    }
+
+    /// Whether point `p` is inside the solid (boundary points may go either way); false
+    /// for an open surface.
+    fn contains(&self, p: Vec3) -> bool {
+        let _ = p;
+        false
+    }
 }
 
 /// `a·b − c·d` without cancellation: both products are exact in f64 (24 + 24 bits of

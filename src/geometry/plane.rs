@@ -5,7 +5,7 @@
 //! the surface point are rounded to f32.
 
 use super::quadric::{check_finite, gamma64, rounding_err, unit_axis};
-use super::{Intersect, Param, Primitive, ShapeError, ShapeHit, Solid, Span, Spans, SurfacePoint};
+use super::{Intersect, Param, Primitive, ShapeError, ShapeHit, Span, Spans, SurfacePoint};
 use crate::math::{Aabb, DVec3, Ray, Vec3};
 
 /// An infinite plane `n·x = d` (unit `n`); as a solid, the half-space `n·x ≤ d`, so the
@@ -75,33 +75,6 @@ impl Plane {
         }
         Some((-self.distance(ray.org.as_dvec3()) / den, den))
     }
-
-    /// The half-space's span of the whole line: a half-line, the whole line (parallel,
-    /// inside) or nothing (parallel, outside). Infinite ends have a zero normal.
-    pub fn spans(&self, ray: &Ray, out: &mut Spans) {
-        if !(ray.org.is_finite() && ray.dir.is_finite()) || ray.dir == Vec3::ZERO {
-            return;
-        }
-        let (t_in, n_in, t_out, n_out) = match self.crossing(ray) {
-            Some((t, den)) if den > 0.0 => (f32::NEG_INFINITY, Vec3::ZERO, t as f32, self.n32),
-            Some((t, _)) => (t as f32, self.n32, f32::INFINITY, Vec3::ZERO),
-            None if self.distance(ray.org.as_dvec3()) <= 0.0 => {
-                (f32::NEG_INFINITY, Vec3::ZERO, f32::INFINITY, Vec3::ZERO)
-            }
-            None => return,
-        };
-        out.push(Span {
-            t_in,
-            n_in,
-            t_out,
-            n_out,
-        });
-    }
-
-    /// Whether `p` is in the half-space `n·x ≤ d`.
-    pub fn contains(&self, p: Vec3) -> bool {
-        self.distance(p.as_dvec3()) <= 0.0
-    }
 }
 
 impl Intersect for Plane {
@@ -142,26 +115,39 @@ impl Intersect for Plane {
     }
 }
 
-impl Solid for Plane {
-    fn spans(&self, ray: &Ray, out: &mut Spans) {
-        Plane::spans(self, ray, out)
-    }
-    fn contains(&self, p: Vec3) -> bool {
-        Plane::contains(self, p)
-    }
-}
-
 impl Primitive for Plane {
     /// The half-space: unbounded, but usable to cut bounded solids.
     fn is_solid(&self) -> bool {
         true
     }
+
+    /// The half-space's span of the whole line: a half-line, the whole line (parallel,
+    /// inside) or nothing (parallel, outside). Infinite ends have a zero normal.
     fn spans(&self, ray: &Ray, out: &mut Spans) {
-        Solid::spans(self, ray, out)
+        if !(ray.org.is_finite() && ray.dir.is_finite()) || ray.dir == Vec3::ZERO {
+            return;
+        }
+        let (t_in, n_in, t_out, n_out) = match self.crossing(ray) {
+            Some((t, den)) if den > 0.0 => (f32::NEG_INFINITY, Vec3::ZERO, t as f32, self.n32),
+            Some((t, _)) => (t as f32, self.n32, f32::INFINITY, Vec3::ZERO),
+            None if self.distance(ray.org.as_dvec3()) <= 0.0 => {
+                (f32::NEG_INFINITY, Vec3::ZERO, f32::INFINITY, Vec3::ZERO)
+            }
+            None => return,
+        };
+        out.push(Span {
+            t_in,
+            n_in,
+            t_out,
+            n_out,
+        });
     }
+
+    /// Whether `p` is in the half-space `n·x ≤ d`.
     fn contains(&self, p: Vec3) -> bool {
-        Solid::contains(self, p)
+        self.distance(p.as_dvec3()) <= 0.0
     }
+
     /// The planar parameterisation about the normal ([`Param::planar`]).
     fn param(&self, p: Vec3, ng: Vec3) -> Param {
         Param::planar(p, ng)

@@ -11,7 +11,7 @@
 //! world origin keeps offsets of its own size and a ray starting near it evaluates them
 //! without cancellation.
 
-use super::{Intersect, Param, Primitive, ShapeError, ShapeHit, Solid, Span, Spans, SurfacePoint};
+use super::{Intersect, Param, Primitive, ShapeError, ShapeHit, Span, Spans, SurfacePoint};
 use crate::math::{Aabb, DVec3, Ray, Vec3, gamma, next_float_down, next_float_up};
 
 /// The most planes a polyhedron may have (validation enumerates plane triples).
@@ -563,7 +563,11 @@ impl Intersect for Polyhedron {
     }
 }
 
-impl Solid for Polyhedron {
+impl Primitive for Polyhedron {
+    fn is_solid(&self) -> bool {
+        true
+    }
+
     fn spans(&self, ray: &Ray, out: &mut Spans) {
         if let Some((t_in, i_in, t_out, i_out)) = self.stretch(ray) {
             out.push(Span {
@@ -579,18 +583,7 @@ impl Solid for Polyhedron {
         let o = p - self.origin();
         self.planes.iter().all(|pl| pl.n.dot(o) <= pl.d)
     }
-}
 
-impl Primitive for Polyhedron {
-    fn is_solid(&self) -> bool {
-        true
-    }
-    fn spans(&self, ray: &Ray, out: &mut Spans) {
-        Solid::spans(self, ray, out)
-    }
-    fn contains(&self, p: Vec3) -> bool {
-        Solid::contains(self, p)
-    }
     /// The planar parameterisation about the normal ([`Param::planar`]).
     fn param(&self, p: Vec3, ng: Vec3) -> Param {
         Param::planar(p, ng)

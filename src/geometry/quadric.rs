@@ -32,7 +32,7 @@
 //!
 //! Only the results (`t`, normals, points) are rounded to f32.
 
-use super::{Intersect, Param, Primitive, ShapeError, ShapeHit, Solid, Span, Spans, SurfacePoint};
+use super::{Intersect, Param, Primitive, ShapeError, ShapeHit, Span, Spans, SurfacePoint};
 use crate::math::{Aabb, DVec3, Ray, Vec3, next_float_down, next_float_up};
 use glam::DMat3;
 
@@ -329,7 +329,7 @@ impl LineRoots {
 /// numerics).
 ///
 /// The clip box keeps the part of the surface inside it (an open surface for
-/// [`Intersect`]); the solid is `{F ≤ 0} ∩ box`, so [`Solid::spans`] enters and leaves
+/// [`Intersect`]); the solid is `{F ≤ 0} ∩ box`, so [`Primitive::spans`] enters and leaves
 /// through the box faces where the box bounds it. `u` and `v` of hits are 0.
 #[derive(Clone, Copy, Debug, PartialEq)]
 pub struct Quadric {
@@ -768,66 +768,6 @@ impl Quadric {
             ng,
         })
     }
-
-    /// The solid's spans along the whole line of `ray`.
-    pub fn spans(&self, ray: &Ray, out: &mut Spans) {
-        let Some(lr) = self.roots(ray) else {
-            return;
-        };
-        let mut f_spans: smallvec::SmallVec<[(f64, Vec3, f64, Vec3); 2]> = Default::default();
-        let mut start = lr.inside_start.then_some((f64::NEG_INFINITY, Vec3::ZERO));
-        for x in lr.crossings() {
-            let t = lr.t0 + x.r;
-            let n = outward_or_dir(self.half_grad(lr.o + lr.d * x.r), lr.d, x.exit);
-            if x.exit {
-                if let Some((ts, ns)) = start.take() {
-                    f_spans.push((ts, ns, t, n));
-                }
-            } else {
-                start = Some((t, n));
-            }
-        }
-        if let Some((ts, ns)) = start {
-            f_spans.push((ts, ns, f64::INFINITY, Vec3::ZERO));
-        }
-        let window = match &self.clip {
-            Some(b) => match box_interval(b, ray.org.as_dvec3(), lr.d) {
-                Some(w) => w,
-                None => return,
-            },
-            None => (f64::NEG_INFINITY, Vec3::ZERO, f64::INFINITY, Vec3::ZERO),
-        };
-        for (t_in, n_in, t_out, n_out) in f_spans {
-            let (t_in, n_in) = if window.0 > t_in {
-                (window.0, window.1)
-            } else {
-                (t_in, n_in)
-            };
-            let (t_out, n_out) = if window.2 < t_out {
-                (window.2, window.3)
-            } else {
-                (t_out, n_out)
-            };
-            if t_in <= t_out {
-                out.push(Span {
-                    t_in: t_in as f32,
-                    n_in,
-                    t_out: t_out as f32,
-                    n_out,
-                });
-            }
-        }
-    }
-
-    /// Whether `p` is inside the solid (`F(p) ≤ 0` and in the clip box).
-    pub fn contains(&self, p: Vec3) -> bool {
-        let pd = p.as_dvec3();
-        let in_box = match &self.clip {
-            Some(b) => box_contains(b, pd),
-            None => true,
-        };
-        in_box && self.value(pd) <= 0.0
-    }
 }
 
 /// The coefficients of `α|p⊥|² + β(p·w)² + 2γ(p·w) + δ` (`p⊥` the part of `p`
@@ -988,26 +928,72 @@ impl Intersect for Quadric {
     }
 }
 
-impl Solid for Quadric {
-    fn spans(&self, ray: &Ray, out: &mut Spans) {
-        Quadric::spans(self, ray, out)
-    }
-    fn contains(&self, p: Vec3) -> bool {
-        Quadric::contains(self, p)
-    }
-}
-
 impl Primitive for Quadric {
     /// A solid where `{F ≤ 0}` is bounded (clipped, or an ellipsoid).
     fn is_solid(&self) -> bool {
         self.is_bounded()
     }
+
+    /// The solid's spans along the whole line of `ray`.
     fn spans(&self, ray: &Ray, out: &mut Spans) {
-        Solid::spans(self, ray, out)
+        let Some(lr) = self.roots(ray) else {
+            return;
+        };
+        let mut f_spans: smallvec::SmallVec<[(f64, Vec3, f64, Vec3); 2]> = Default::default();
+        let mut start = lr.inside_start.then_some((f64::NEG_INFINITY, Vec3::ZERO));
+        for x in lr.crossings() {
+            let t = lr.t0 + x.r;
+            let n = outward_or_dir(self.half_grad(lr.o + lr.d * x.r), lr.d, x.exit);
+            if x.exit {
+                if let Some((ts, ns)) = start.take() {
+                    f_spans.push((ts, ns, t, n));
+                }
+            } else {
+                start = Some((t, n));
+            }
+        }
+        if let Some((ts, ns)) = start {
+            f_spans.push((ts, ns, f64::INFINITY, Vec3::ZERO));
+        }
+        let window = match &self.clip {
+            Some(b) => match box_interval(b, ray.org.as_dvec3(), lr.d) {
+                Some(w) => w,
+                None => return,
+            },
+            None => (f64::NEG_INFINITY, Vec3::ZERO, f64::INFINITY, Vec3::ZERO),
+        };
+        for (t_in, n_in, t_out, n_out) in f_spans {
+            let (t_in, n_in) = if window.0 > t_in {
+                (window.0, window.1)
+            } else {
+                (t_in, n_in)
+            };
+            let (t_out, n_out) = if window.2 < t_out {
+                (window.2, window.3)
+            } else {
+                (t_out, n_out)
+            };
+            if t_in <= t_out {
+                out.push(Span {
+                    t_in: t_in as f32,
+                    n_in,
+                    t_out: t_out as f32,
+                    n_out,
+                });
+            }
+        }
     }
+
+    /// Whether `p` is inside the solid (`F(p) ≤ 0` and in the clip box).
     fn contains(&self, p: Vec3) -> bool {
-        Solid::contains(self, p)
+        let pd = p.as_dvec3();
+        let in_box = match &self.clip {
+            Some(b) => box_contains(b, pd),
+            None => true,
+        };
+        in_box && self.value(pd) <= 0.0
     }
+
     /// The planar parameterisation about the normal ([`Param::planar`]).
     fn param(&self, p: Vec3, ng: Vec3) -> Param {
         Param::planar(p, ng)

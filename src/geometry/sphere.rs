@@ -1,6 +1,6 @@
 use super::param::{MIN_SIN, turn};
 use super::{
-    Intersect, Param, Primitive, ShapeHit, Solid, Span, Spans, SurfacePoint, diff_of_products,
+    Intersect, Param, Primitive, ShapeHit, Span, Spans, SurfacePoint, diff_of_products,
     quadratic_roots,
 };
 use crate::math::{Aabb, Ray, Vec3, gamma};
@@ -111,7 +111,12 @@ impl Intersect for Sphere {
     }
 }
 
-impl Solid for Sphere {
+impl Primitive for Sphere {
+    /// A sphere is a solid unless only its inside is visible.
+    fn is_solid(&self) -> bool {
+        !self.inside_only
+    }
+
     fn spans(&self, ray: &Ray, out: &mut Spans) {
         if let Some((t0, t1)) = self.roots(ray) {
             if t0 <= t1 {
@@ -128,11 +133,9 @@ impl Solid for Sphere {
     fn contains(&self, p: Vec3) -> bool {
         (p - self.center).length_squared() <= self.radius * self.radius
     }
-}
 
-impl Sphere {
     /// The spherical parameterisation at `p` (see [`Param`]).
-    pub fn param(&self, p: Vec3) -> Param {
+    fn param(&self, p: Vec3, _ng: Vec3) -> Param {
         let q = ((p - self.center) / self.radius).clamp(Vec3::splat(-1.0), Vec3::splat(1.0));
         let phi = q.x.atan2(q.z);
         let u = turn(q.x, q.z);
@@ -148,21 +151,5 @@ impl Sphere {
             dpdu,
             dpdv,
         }
-    }
-}
-
-impl Primitive for Sphere {
-    /// A sphere is a solid unless only its inside is visible.
-    fn is_solid(&self) -> bool {
-        !self.inside_only
-    }
-    fn spans(&self, ray: &Ray, out: &mut Spans) {
-        Solid::spans(self, ray, out)
-    }
-    fn contains(&self, p: Vec3) -> bool {
-        Solid::contains(self, p)
-    }
-    fn param(&self, p: Vec3, _ng: Vec3) -> Param {
-        Sphere::param(self, p)
     }
 }

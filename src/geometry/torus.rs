@@ -30,7 +30,7 @@ use super::quadric::{
     aabb_out, check_finite, check_positive, gamma64, outward_or_dir, rounding_err, unit_axis,
     unit_f32,
 };
-use super::{Intersect, Param, Primitive, ShapeError, ShapeHit, Solid, Span, Spans, SurfacePoint};
+use super::{Intersect, Param, Primitive, ShapeError, ShapeHit, Span, Spans, SurfacePoint};
 use crate::math::{Aabb, DVec3, Ray, Vec3};
 use glam::Vec2;
 use std::f64::consts::TAU;
@@ -296,27 +296,6 @@ impl Torus {
         }
         None
     }
-
-    /// The solid's spans along the whole line of `ray` (at most two).
-    pub fn spans(&self, ray: &Ray, out: &mut Spans) {
-        let Some(line) = self.line(ray) else {
-            return;
-        };
-        for pair in line.xs[..line.n].chunks_exact(2) {
-            let (s_in, s_out) = (pair[0].0, pair[1].0);
-            out.push(Span {
-                t_in: self.t_of(&line, s_in) as f32,
-                n_in: self.at(&line, s_in, false).0,
-                t_out: self.t_of(&line, s_out) as f32,
-                n_out: self.at(&line, s_out, true).0,
-            });
-        }
-    }
-
-    /// Whether `p` is inside the solid.
-    pub fn contains(&self, p: Vec3) -> bool {
-        self.value(p.as_dvec3()) <= 0.0
-    }
 }
 
 /// `x` moved into `[0, 1)` by adding 1 to negative values.
@@ -478,18 +457,34 @@ impl Intersect for Torus {
     }
 }
 
-impl Solid for Torus {
-    fn spans(&self, ray: &Ray, out: &mut Spans) {
-        Torus::spans(self, ray, out)
+impl Primitive for Torus {
+    fn is_solid(&self) -> bool {
+        true
     }
-    fn contains(&self, p: Vec3) -> bool {
-        Torus::contains(self, p)
-    }
-}
 
-impl Torus {
+    /// The solid's spans along the whole line of `ray` (at most two).
+    fn spans(&self, ray: &Ray, out: &mut Spans) {
+        let Some(line) = self.line(ray) else {
+            return;
+        };
+        for pair in line.xs[..line.n].chunks_exact(2) {
+            let (s_in, s_out) = (pair[0].0, pair[1].0);
+            out.push(Span {
+                t_in: self.t_of(&line, s_in) as f32,
+                n_in: self.at(&line, s_in, false).0,
+                t_out: self.t_of(&line, s_out) as f32,
+                n_out: self.at(&line, s_out, true).0,
+            });
+        }
+    }
+
+    /// Whether `p` is inside the solid.
+    fn contains(&self, p: Vec3) -> bool {
+        self.value(p.as_dvec3()) <= 0.0
+    }
+
     /// The toroidal parameterisation at `p`.
-    pub fn param(&self, p: Vec3) -> Param {
+    fn param(&self, p: Vec3, _ng: Vec3) -> Param {
         let (ex, ey, a) = self.frame();
         let (big, small) = (self.major_radius(), self.minor_radius());
         let q = p - self.center();
@@ -506,21 +501,6 @@ impl Torus {
             dpdu: tangent * (std::f32::consts::TAU * (big + small * cs).max(MIN_SIN * small)),
             dpdv: (a * cs - radial * ss) * (std::f32::consts::TAU * small),
         }
-    }
-}
-
-impl Primitive for Torus {
-    fn is_solid(&self) -> bool {
-        true
-    }
-    fn spans(&self, ray: &Ray, out: &mut Spans) {
-        Solid::spans(self, ray, out)
-    }
-    fn contains(&self, p: Vec3) -> bool {
-        Solid::contains(self, p)
-    }
-    fn param(&self, p: Vec3, _ng: Vec3) -> Param {
-        Torus::param(self, p)
     }
 }
 
