@@ -11,36 +11,30 @@
 //! [`Primitive`] impls) plus one row in that table.
 
 pub mod bezier;
-mod boxes;
-mod capped;
-mod cone;
-pub mod csg;
 mod error;
 mod kinds;
 mod param;
-mod plane;
 pub mod polygon;
-mod polyhedron;
-mod quadric;
 pub mod reference;
-mod sphere;
-mod torus;
 mod triangle;
 mod triangle4;
 
-pub use boxes::{AaBox, OBox};
-pub use capped::CappedCone;
-pub use cone::Cone;
-pub use csg::{Csg, CsgOp, CsgTree};
+/// Declares the module of each analytic kind and re-exports its type, from the kinds
+/// table.
+macro_rules! kind_modules {
+    ($(($v:ident, $id:literal, $vis:vis mod $module:ident, $name:ident, $t:ty,
+        $($rest:tt)*)),* $(,)?) => {
+        $($vis mod $module; pub use $module::$name;)*
+    };
+}
+kinds::for_each_kind!(kind_modules);
+
+pub use csg::{CsgOp, CsgTree};
 pub use error::ShapeError;
-pub(crate) use kinds::for_each_kind;
 pub use kinds::{Analytic, Kind, Shape};
+pub(crate) use kinds::{for_each_kind, kind_rows};
 pub use param::{Param, QuadUv, inverse_bilinear};
-pub use plane::Plane;
-pub use polyhedron::{MAX_PLANES, Polyhedron};
-pub use quadric::Quadric;
-pub use sphere::Sphere;
-pub use torus::Torus;
+pub use polyhedron::MAX_PLANES;
 pub use triangle::{Triangle, WatertightRay};
 pub use triangle4::{Hits4, Triangle4, WatertightRay4};
 
