@@ -9,8 +9,9 @@
 //! (exact, for a nearby origin) difference of coordinates.
 
 use super::param::box_param;
-use super::{Intersect, Param, Primitive, ShapeError, ShapeHit, Span, Spans, SurfacePoint};
+use super::{Intersect, Param, Primitive, Shape, ShapeError, ShapeHit, Span, Spans, SurfacePoint};
 use crate::math::{Aabb, Ray, Vec3, gamma};
+use glam::DAffine3;
 
 /// One end of a line's stretch through a box: its parameter, the axis whose slab decided
 /// it and the sign of the outward normal along that axis.
@@ -244,6 +245,25 @@ impl Primitive for AaBox {
             (max - min) * 0.5,
             [Vec3::X, Vec3::Y, Vec3::Z],
         )
+    }
+
+    /// Axis-aligned stays axis-aligned under a diagonal linear part.
+    fn bake(&self, m: &DAffine3) -> Option<Shape> {
+        let l = m.matrix3;
+        let diagonal = l.x_axis.y == 0.0
+            && l.x_axis.z == 0.0
+            && l.y_axis.x == 0.0
+            && l.y_axis.z == 0.0
+            && l.z_axis.x == 0.0
+            && l.z_axis.y == 0.0;
+        if !diagonal {
+            return None;
+        }
+        let a = m.transform_point3(self.min().as_dvec3());
+        let c = m.transform_point3(self.max().as_dvec3());
+        AaBox::new(a.min(c).as_vec3(), a.max(c).as_vec3())
+            .ok()
+            .map(Shape::from)
     }
 }
 

@@ -18,11 +18,12 @@
 
 use super::param::{axis_frame, cylindrical};
 use super::{
-    Intersect, Param, Primitive, ShapeError, ShapeHit, Span, Spans, SurfacePoint, diff_of_products,
+    Intersect, Param, Primitive, Shape, ShapeError, ShapeHit, Span, Spans, SurfacePoint, diff_of_products,
     quadratic_roots,
 };
-use crate::math::{Aabb, DVec3, Frame, Ray, Vec3, gamma};
-use glam::Vec2;
+use crate::math::{Aabb, DVec3, Frame, Ray, Vec3, gamma, similarity_scale};
+use glam::{DAffine3, Vec2};
+use std::sync::Arc;
 use std::f32::consts::TAU;
 
 /// Which part of the surface an end of the line's stretch lies on.
@@ -693,6 +694,20 @@ impl Primitive for CappedCone {
             dpdu: e1 * (su * 2.0 * r),
             dpdv: e2 * (2.0 * r),
         }
+    }
+
+    /// Under a similarity: the base moved, the axis turned, the lengths scaled.
+    fn bake(&self, m: &DAffine3) -> Option<Shape> {
+        let k = similarity_scale(m)?;
+        CappedCone::new(
+            m.transform_point3(self.base().as_dvec3()).as_vec3(),
+            (m.matrix3 * self.axis().as_dvec3()).as_vec3(),
+            (self.height() as f64 * k) as f32,
+            (self.base_radius() as f64 * k) as f32,
+            (self.top_radius() as f64 * k) as f32,
+        )
+        .ok()
+        .map(|c| Arc::new(c).into())
     }
 }
 

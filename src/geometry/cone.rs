@@ -1,6 +1,7 @@
 use super::param::cylindrical;
-use super::{Intersect, Param, Primitive, ShapeHit, SurfacePoint, quadratic_roots_f64};
-use crate::math::{Aabb, Ray, Vec3, gamma};
+use super::{Intersect, Param, Primitive, Shape, ShapeHit, SurfacePoint, quadratic_roots_f64};
+use crate::math::{Aabb, Ray, Vec3, gamma, similarity_scale};
+use glam::DAffine3;
 
 /// NFF's open cone or cylinder: the lateral surface between a base disk and an apex
 /// disk, with no end caps. With `inside_only` (NFF's negative radii) only hits where the
@@ -256,6 +257,21 @@ impl Primitive for Cone {
     fn param(&self, p: Vec3, _ng: Vec3) -> Param {
         let slope = (self.apex_radius - self.base_radius) / self.height();
         cylindrical(p, self.base, self.axis(), self.height(), slope)
+    }
+
+    /// Under a similarity: the ends moved, the radii scaled.
+    fn bake(&self, m: &DAffine3) -> Option<Shape> {
+        let k = similarity_scale(m)?;
+        let sign = if self.inside_only { -1.0 } else { 1.0 };
+        Some(
+            Cone::new(
+                m.transform_point3(self.base.as_dvec3()).as_vec3(),
+                sign * (self.base_radius as f64 * k) as f32,
+                m.transform_point3(self.apex.as_dvec3()).as_vec3(),
+                sign * (self.apex_radius as f64 * k) as f32,
+            )
+            .into(),
+        )
     }
 }
 

@@ -16,6 +16,7 @@
 
 use super::{Intersect, Param, Primitive, ShapeHit, Spans, SurfacePoint};
 use crate::math::{Aabb, Ray, Vec3};
+use glam::DAffine3;
 use std::sync::Arc;
 
 /// Invoke the macro `$m` with the table of analytic kinds, one row per kind in
@@ -133,6 +134,9 @@ impl<T: Primitive + ?Sized> Primitive for Arc<T> {
     #[inline]
     fn material(&self, hit: &ShapeHit, own: u32) -> u32 {
         T::material(self, hit, own)
+    }
+    fn bake(&self, m: &DAffine3) -> Option<Shape> {
+        T::bake(self, m)
     }
 }
 
@@ -255,6 +259,12 @@ macro_rules! define_kinds {
             fn material(&self, hit: &ShapeHit, own: u32) -> u32 {
                 match self {
                     $(Shape::$v(s) => Primitive::material(s, hit, own),)*
+                }
+            }
+
+            fn bake(&self, m: &DAffine3) -> Option<Shape> {
+                match self {
+                    $(Shape::$v(s) => Primitive::bake(s, m),)*
                 }
             }
         }

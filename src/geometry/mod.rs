@@ -42,6 +42,7 @@ pub use triangle4::{Hits4, Triangle4, WatertightRay4};
 pub use crate::math::SurfacePoint;
 
 use crate::math::{Aabb, Ray, Vec3};
+use glam::DAffine3;
 
 /// What an intersector reports: the distance, two surface parameters and the
 /// (unnormalised) geometric normal, which for closed shapes points outwards.
@@ -133,6 +134,16 @@ pub trait Primitive: Intersect {
     fn contains(&self, p: Vec3) -> bool {
         let _ = p;
         false
+    }
+
+    /// This primitive under the affine map `m`, rewritten in final coordinates as a
+    /// primitive of the same kind when that is exact (a sphere under a similarity, a
+    /// polyhedron under any invertible map, ...). `None`, the default, when it is not:
+    /// a loader then places the primitive by an instance, or inside CSG by a transform
+    /// of its leaf.
+    fn bake(&self, m: &DAffine3) -> Option<Shape> {
+        let _ = m;
+        None
     }
 }
 

@@ -4,9 +4,10 @@
 
 use super::aabox::{EDGE_MARGIN, End, clamp_inside, face_uv, pick, slab};
 use super::param::box_param;
-use super::{Intersect, Param, Primitive, ShapeError, ShapeHit, Span, Spans, SurfacePoint};
-use crate::math::{Aabb, Ray, Vec3, gamma};
-use glam::{DMat3, DQuat, Mat3, Quat};
+use super::{Intersect, Param, Primitive, Shape, ShapeError, ShapeHit, Span, Spans, SurfacePoint};
+use crate::math::{Aabb, Ray, Vec3, gamma, similarity_scale};
+use glam::{DAffine3, DMat3, DQuat, Mat3, Quat};
+use std::sync::Arc;
 
 /// An oriented box: centre, half extents along its own three axes, and the rotation
 /// taking the world axes to the box's (its axes are the columns of
@@ -237,5 +238,18 @@ impl Primitive for OBox {
 
     fn param(&self, p: Vec3, ng: Vec3) -> Param {
         box_param(p, ng, self.center(), self.half_extents(), self.axes())
+    }
+
+    /// Under a similarity: the centre moved, the axes turned, the half extents scaled.
+    fn bake(&self, m: &DAffine3) -> Option<Shape> {
+        let k = similarity_scale(m)?;
+        let axes = self.axes().map(|a| ((m.matrix3 * a.as_dvec3()) / k).as_vec3());
+        OBox::from_axes(
+            m.transform_point3(self.center().as_dvec3()).as_vec3(),
+            (self.half_extents().as_dvec3() * k).as_vec3(),
+            axes,
+        )
+        .ok()
+        .map(|b| Arc::new(b).into())
     }
 }

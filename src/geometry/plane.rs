@@ -5,8 +5,9 @@
 //! the surface point are rounded to f32.
 
 use super::quadric::{check_finite, gamma64, rounding_err, unit_axis};
-use super::{Intersect, Param, Primitive, ShapeError, ShapeHit, Span, Spans, SurfacePoint};
+use super::{Intersect, Param, Primitive, Shape, ShapeError, ShapeHit, Span, Spans, SurfacePoint};
 use crate::math::{Aabb, DVec3, Ray, Vec3};
+use glam::DAffine3;
 
 /// An infinite plane `n·x = d` (unit `n`); as a solid, the half-space `n·x ≤ d`, so the
 /// outward normal is `n`. Its bounds are [`Aabb::INFINITE`]; `u` and `v` of hits are 0.
@@ -151,6 +152,17 @@ impl Primitive for Plane {
     /// The planar parameterisation about the normal ([`Param::planar`]).
     fn param(&self, p: Vec3, ng: Vec3) -> Param {
         Param::planar(p, ng)
+    }
+
+    /// Under any invertible map: a point of the plane moved, the normal by the inverse
+    /// transpose.
+    fn bake(&self, m: &DAffine3) -> Option<Shape> {
+        let n = self.normal().as_dvec3();
+        let point = m.transform_point3(n * self.offset());
+        let normal = m.matrix3.inverse().transpose() * n;
+        Plane::from_point_normal(point.as_vec3(), normal.as_vec3())
+            .ok()
+            .map(Shape::from)
     }
 }
 

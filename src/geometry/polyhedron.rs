@@ -11,8 +11,10 @@
 //! world origin keeps offsets of its own size and a ray starting near it evaluates them
 //! without cancellation.
 
-use super::{Intersect, Param, Primitive, ShapeError, ShapeHit, Span, Spans, SurfacePoint};
+use super::{Intersect, Param, Primitive, Shape, ShapeError, ShapeHit, Span, Spans, SurfacePoint};
 use crate::math::{Aabb, DVec3, Ray, Vec3, gamma, next_float_down, next_float_up};
+use glam::DAffine3;
+use std::sync::Arc;
 
 /// The most planes a polyhedron may have (validation enumerates plane triples).
 pub const MAX_PLANES: usize = 256;
@@ -587,6 +589,21 @@ impl Primitive for Polyhedron {
     /// The planar parameterisation about the normal ([`Param::planar`]).
     fn param(&self, p: Vec3, ng: Vec3) -> Param {
         Param::planar(p, ng)
+    }
+
+    /// Under any invertible map: the half-spaces n·x ≤ d map to n'·y ≤ d + n'·t with
+    /// n' = M⁻ᵀn.
+    fn bake(&self, m: &DAffine3) -> Option<Shape> {
+        let inv_t = m.matrix3.inverse().transpose();
+        let planes = self
+            .world_planes()
+            .into_iter()
+            .map(|(n, d)| {
+                let n2 = inv_t * n;
+                (n2.as_vec3(), (d + n2.dot(m.translation)) as f32)
+            })
+            .collect();
+        Polyhedron::new(planes).ok().map(|p| Arc::new(p).into())
     }
 }
 

@@ -32,9 +32,10 @@
 //!
 //! Only the results (`t`, normals, points) are rounded to f32.
 
-use super::{Intersect, Param, Primitive, ShapeError, ShapeHit, Span, Spans, SurfacePoint};
+use super::{Intersect, Param, Primitive, Shape, ShapeError, ShapeHit, Span, Spans, SurfacePoint};
 use crate::math::{Aabb, DVec3, Ray, Vec3, next_float_down, next_float_up};
-use glam::DMat3;
+use glam::{DAffine3, DMat3, DMat4};
+use std::sync::Arc;
 
 /// `n·u / (1 − n·u)` with `u = 2⁻⁵³`: the relative error bound of `n` f64 operations.
 pub(super) const fn gamma64(n: u32) -> f64 {
@@ -997,6 +998,40 @@ impl Primitive for Quadric {
     /// The planar parameterisation about the normal ([`Param::planar`]).
     fn param(&self, p: Vec3, ng: Vec3) -> Param {
         Param::planar(p, ng)
+    }
+
+    /// Unclipped, under any invertible map: F(L⁻¹(y − t)) about the origin t, the
+    /// coefficients through L⁻¹ alone. A clipped quadric does not bake (its clip box
+    /// would not stay a box).
+    fn bake(&self, m: &DAffine3) -> Option<Shape> {
+        if self.clip().is_some() {
+            return None;
+        }
+        let [a, b, c, d, e, f, g, h, i, j] = self.coefficients();
+        let qm =
+            DMat4::from_cols_array_2d(&[[a, d, e, g], [d, b, f, h], [e, f, c, i], [g, h, i, j]]);
+        let inv = DMat4::from_mat3(m.matrix3.inverse());
+        let r = inv.transpose() * qm * inv;
+        let k = |x: usize, y: usize| 0.5 * (r.col(x)[y] + r.col(y)[x]);
+        let coeffs = [
+            k(0, 0),
+            k(1, 1),
+            k(2, 2),
+            k(0, 1),
+            k(0, 2),
+            k(1, 2),
+            k(0, 3),
+            k(1, 3),
+            k(2, 3),
+            k(3, 3),
+        ];
+        let t = m.translation;
+        if !t.is_finite() {
+            return None;
+        }
+        Quadric::about(t.as_vec3(), coeffs, None)
+            .ok()
+            .map(|q| Arc::new(q).into())
     }
 }
 

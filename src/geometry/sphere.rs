@@ -1,9 +1,10 @@
 use super::param::{MIN_SIN, turn};
 use super::{
-    Intersect, Param, Primitive, ShapeHit, Span, Spans, SurfacePoint, diff_of_products,
+    Intersect, Param, Primitive, Shape, ShapeHit, Span, Spans, SurfacePoint, diff_of_products,
     quadratic_roots,
 };
-use crate::math::{Aabb, Ray, Vec3, gamma};
+use crate::math::{Aabb, Ray, Vec3, gamma, similarity_scale};
+use glam::DAffine3;
 use glam::Vec2;
 use std::f32::consts::{PI, TAU};
 
@@ -151,5 +152,43 @@ impl Primitive for Sphere {
             dpdu,
             dpdv,
         }
+    }
+
+    /// Under a similarity: the centre moved, the radius scaled.
+    fn bake(&self, m: &DAffine3) -> Option<Shape> {
+        let k = similarity_scale(m)?;
+        let r = (self.radius as f64 * k) as f32;
+        Some(
+            Sphere {
+                center: m.transform_point3(self.center.as_dvec3()).as_vec3(),
+                radius: r,
+                inside_only: self.inside_only,
+            }
+            .into(),
+        )
+    }
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+    use glam::DVec3;
+
+    #[test]
+    fn spheres_bake_under_similarities_only() {
+        let s = Shape::Sphere(Sphere::new(Vec3::new(1.0, 0.0, 0.0), 2.0));
+        let m = DAffine3::from_translation(DVec3::new(0.0, 5.0, 0.0))
+            * DAffine3::from_scale(DVec3::splat(3.0))
+            * DAffine3::from_axis_angle(DVec3::Z, std::f64::consts::FRAC_PI_2);
+        let Some(Shape::Sphere(b)) = s.bake(&m) else {
+            panic!("not baked")
+        };
+        assert!(
+            (b.center - Vec3::new(0.0, 8.0, 0.0)).length() < 1e-5,
+            "{}",
+            b.center
+        );
+        assert!((b.radius - 6.0).abs() < 1e-5);
+        assert!(s.bake(&DAffine3::from_scale(DVec3::new(1.0, 2.0, 3.0))).is_none());
     }
 }

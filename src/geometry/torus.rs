@@ -30,9 +30,10 @@ use super::quadric::{
     aabb_out, check_finite, check_positive, gamma64, outward_or_dir, rounding_err, unit_axis,
     unit_f32,
 };
-use super::{Intersect, Param, Primitive, ShapeError, ShapeHit, Span, Spans, SurfacePoint};
-use crate::math::{Aabb, DVec3, Ray, Vec3};
-use glam::Vec2;
+use super::{Intersect, Param, Primitive, Shape, ShapeError, ShapeHit, Span, Spans, SurfacePoint};
+use crate::math::{Aabb, DVec3, Ray, Vec3, similarity_scale};
+use glam::{DAffine3, Vec2};
+use std::sync::Arc;
 use std::f64::consts::TAU;
 
 /// A torus around `axis` through `center`: the circle of radius `major` in the plane
@@ -501,6 +502,19 @@ impl Primitive for Torus {
             dpdu: tangent * (std::f32::consts::TAU * (big + small * cs).max(MIN_SIN * small)),
             dpdv: (a * cs - radial * ss) * (std::f32::consts::TAU * small),
         }
+    }
+
+    /// Under a similarity: the centre moved, the axis turned, the radii scaled.
+    fn bake(&self, m: &DAffine3) -> Option<Shape> {
+        let k = similarity_scale(m)?;
+        Torus::new(
+            m.transform_point3(self.center().as_dvec3()).as_vec3(),
+            (m.matrix3 * self.axis().as_dvec3()).as_vec3(),
+            (self.major_radius() as f64 * k) as f32,
+            (self.minor_radius() as f64 * k) as f32,
+        )
+        .ok()
+        .map(|t| Arc::new(t).into())
     }
 }
 

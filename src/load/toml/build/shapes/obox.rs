@@ -2,12 +2,11 @@
 //! and its orientation, a `rotation` (a transform list of rotations) or three `axes`.
 
 use super::super::super::format::{ObjectDef, Spanned, TransformList};
-use super::super::transforms::similarity_scale;
 use super::super::types::Ty;
 use super::super::{Builder, R, f32v, v3};
 use super::{AnalyticType, At, from_constructor};
 use crate::geometry::{OBox, Shape};
-use crate::math::Vec3;
+use crate::math::{Vec3, similarity_scale};
 use glam::{DQuat, DVec3, Quat};
 use std::sync::Arc;
 
