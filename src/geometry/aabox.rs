@@ -9,6 +9,7 @@
 //! (exact, for a nearby origin) difference of coordinates.
 
 use super::param::box_param;
+use super::tessellate::{Tessellation, boxed};
 use super::{Intersect, Param, Primitive, Shape, ShapeError, ShapeHit, Span, Spans, SurfacePoint};
 use crate::math::{Aabb, Ray, Vec3, gamma};
 use glam::DAffine3;
@@ -264,6 +265,15 @@ impl Primitive for AaBox {
         AaBox::new(a.min(c).as_vec3(), a.max(c).as_vec3())
             .ok()
             .map(Shape::from)
+    }
+
+    /// Its six faces, exact.
+    fn tessellate(&self, _patch: f32) -> Option<Tessellation> {
+        Some(boxed(
+            (self.min() + self.max()) * 0.5,
+            (self.max() - self.min()) * 0.5,
+            [Vec3::X, Vec3::Y, Vec3::Z],
+        ))
     }
 }
 

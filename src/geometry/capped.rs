@@ -17,6 +17,7 @@
 //! linear or constant equation instead of dividing by zero.
 
 use super::param::{axis_frame, cylindrical};
+use super::tessellate::{Tessellation, revolution};
 use super::{
     Intersect, Param, Primitive, Shape, ShapeError, ShapeHit, Span, Spans, SurfacePoint, diff_of_products,
     quadratic_roots,
@@ -708,6 +709,18 @@ impl Primitive for CappedCone {
         )
         .ok()
         .map(|c| Arc::new(c).into())
+    }
+
+    /// The side on an angle × height grid, and the two caps.
+    fn tessellate(&self, patch: f32) -> Option<Tessellation> {
+        Some(revolution(
+            self.base(),
+            self.axis(),
+            self.height(),
+            (self.base_radius(), self.top_radius()),
+            patch,
+            true,
+        ))
     }
 }
 

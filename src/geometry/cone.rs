@@ -1,4 +1,5 @@
 use super::param::cylindrical;
+use super::tessellate::{Tessellation, flip, revolution};
 use super::{Intersect, Param, Primitive, Shape, ShapeHit, SurfacePoint, quadratic_roots_f64};
 use crate::math::{Aabb, Ray, Vec3, gamma, similarity_scale};
 use glam::DAffine3;
@@ -272,6 +273,21 @@ impl Primitive for Cone {
             )
             .into(),
         )
+    }
+
+    /// The lateral surface on an angle × height grid (its outside, or its inside when
+    /// only that is visible): an open surface, meshed on its front side.
+    fn tessellate(&self, patch: f32) -> Option<Tessellation> {
+        let mut t = revolution(
+            self.base,
+            self.axis(),
+            self.height(),
+            (self.base_radius.abs(), self.apex_radius.abs()),
+            patch,
+            false,
+        );
+        flip(&mut t.faces, self.inside_only);
+        Some(t)
     }
 }
 

@@ -14,7 +14,7 @@
 //! natively and they carry vertex normals, texture coordinates and quads, so the store
 //! keeps them apart; they are [`Kind::Triangle`], geometry id 0.
 
-use super::{Intersect, Param, Primitive, ShapeHit, Spans, SurfacePoint};
+use super::{Intersect, Param, Primitive, ShapeHit, Spans, SurfacePoint, Tessellation};
 use crate::math::{Aabb, Ray, Vec3};
 use glam::DAffine3;
 use std::sync::Arc;
@@ -137,6 +137,9 @@ impl<T: Primitive + ?Sized> Primitive for Arc<T> {
     }
     fn bake(&self, m: &DAffine3) -> Option<Shape> {
         T::bake(self, m)
+    }
+    fn tessellate(&self, patch: f32) -> Option<Tessellation> {
+        T::tessellate(self, patch)
     }
 }
 
@@ -265,6 +268,12 @@ macro_rules! define_kinds {
             fn bake(&self, m: &DAffine3) -> Option<Shape> {
                 match self {
                     $(Shape::$v(s) => Primitive::bake(s, m),)*
+                }
+            }
+
+            fn tessellate(&self, patch: f32) -> Option<Tessellation> {
+                match self {
+                    $(Shape::$v(s) => Primitive::tessellate(s, patch),)*
                 }
             }
         }

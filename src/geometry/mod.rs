@@ -16,6 +16,7 @@ mod kinds;
 mod param;
 pub mod polygon;
 pub mod reference;
+pub mod tessellate;
 mod triangle;
 mod triangle4;
 
@@ -35,6 +36,7 @@ pub use kinds::{Analytic, Kind, Shape};
 pub(crate) use kinds::{for_each_kind, kind_rows};
 pub use param::{Param, QuadUv, inverse_bilinear};
 pub use polyhedron::MAX_PLANES;
+pub use tessellate::Tessellation;
 pub use triangle::{Triangle, WatertightRay};
 pub use triangle4::{Hits4, Triangle4, WatertightRay4};
 
@@ -143,6 +145,16 @@ pub trait Primitive: Intersect {
     /// of its leaf.
     fn bake(&self, m: &DAffine3) -> Option<Shape> {
         let _ = m;
+        None
+    }
+
+    /// The primitive as convex planar faces for the radiosity mesh, curved surfaces on
+    /// a grid of cells about `patch` across (see [`tessellate`](mod@tessellate)).
+    /// `None`, the default, for a kind that is not meshed: it only occludes in the
+    /// radiosity pass, the Whitted renderer shades it, and the radiosity report counts
+    /// it among the primitives not meshed.
+    fn tessellate(&self, patch: f32) -> Option<Tessellation> {
+        let _ = patch;
         None
     }
 }

@@ -4,6 +4,7 @@
 
 use super::aabox::{EDGE_MARGIN, End, clamp_inside, face_uv, pick, slab};
 use super::param::box_param;
+use super::tessellate::{Tessellation, boxed};
 use super::{Intersect, Param, Primitive, Shape, ShapeError, ShapeHit, Span, Spans, SurfacePoint};
 use crate::math::{Aabb, Ray, Vec3, gamma, similarity_scale};
 use glam::{DAffine3, DMat3, DQuat, Mat3, Quat};
@@ -251,5 +252,10 @@ impl Primitive for OBox {
         )
         .ok()
         .map(|b| Arc::new(b).into())
+    }
+
+    /// Its six faces, exact.
+    fn tessellate(&self, _patch: f32) -> Option<Tessellation> {
+        Some(boxed(self.center(), self.half_extents(), self.axes()))
     }
 }

@@ -1,4 +1,5 @@
 use super::param::{MIN_SIN, turn};
+use super::tessellate::{Lookup, Tessellation, cells, flip, inscribed_depth, oriented};
 use super::{
     Intersect, Param, Primitive, Shape, ShapeHit, Span, Spans, SurfacePoint, diff_of_products,
     quadratic_roots,
@@ -166,6 +167,56 @@ impl Primitive for Sphere {
             }
             .into(),
         )
+    }
+
+    /// A sphere on a latitude–longitude grid of cells about `patch` across (at least
+    /// 16 × 8).
+    fn tessellate(&self, patch: f32) -> Option<Tessellation> {
+        let r = self.radius.abs();
+        let nu = cells(TAU * r, patch, 16, 256);
+        let nv = cells(PI * r, patch, 8, 128);
+        // Grid points, the seam and the poles computed once so shared corners are equal.
+        let point = |i: u32, j: u32| -> Vec3 {
+            if j == 0 {
+                return self.center - Vec3::Y * r;
+            }
+            if j == nv {
+                return self.center + Vec3::Y * r;
+            }
+            let theta = PI * (1.0 - j as f32 / nv as f32);
+            let phi = TAU * (i % nu) as f32 / nu as f32;
+            let (st, ct) = theta.sin_cos();
+            let (sp, cp) = phi.sin_cos();
+            self.center + Vec3::new(st * sp, ct, st * cp) * r
+        };
+        let mut faces = Vec::new();
+        let mut depth = Vec::new();
+        for j in 0..nv {
+            for i in 0..nu {
+                let poly = vec![
+                    point(i, j),
+                    point(i + 1, j),
+                    point(i + 1, j + 1),
+                    point(i, j + 1),
+                ];
+                let mid = poly.iter().copied().sum::<Vec3>() / 4.0 - self.center;
+                let f = oriented(poly, mid);
+                depth.push(inscribed_depth(&f, self.center, r));
+                faces.push(f);
+            }
+        }
+        flip(&mut faces, self.inside_only);
+        Some(Tessellation {
+            faces,
+            depth,
+            lookup: Lookup::Sphere {
+                center: self.center,
+                nu,
+                nv,
+            },
+            smooth: true,
+            open: false,
+        })
     }
 }
 

@@ -18,10 +18,11 @@ pub mod formfactor;
 pub mod hemicube;
 pub mod mesh;
 pub mod solver;
-pub mod tessellate;
 
 use crate::accel::{Accel, AccelError, BackendOptions, Hit, WithAccel};
 use crate::geometry::Kind;
+/// The tessellation of analytic shapes the mesh starts from, in `geometry`.
+pub use crate::geometry::tessellate;
 use crate::math::Vec3;
 use crate::render::color::srgb_encode;
 use crate::render::{Film, GlobalIllumination, gi};
