@@ -14,6 +14,8 @@ pub(super) const TYPE: AnalyticType = AnalyticType {
     name: "obox",
     keys: &["center", "size", "half_size", "rotation", "axes"],
     build,
+    #[cfg(test)]
+    example: "center = [0, 0, 0]\nsize = [1, 2, 3]",
 };
 
 fn build(b: &Builder<'_, '_>, node: &Spanned<ObjectDef>, ty: Ty, at: At) -> R<Shape> {
