@@ -1,18 +1,21 @@
 //! The primitive kinds, listed once.
 //!
 //! [`for_each_kind!`] holds the table of analytic kinds: one row per kind with its
-//! geometry id (the id both backends report in [`crate::Hit::geom_id`]), the type the
-//! scene stores, the name of its list in the store, its plural and singular names and
-//! its documentation. Every per-kind item is generated from that table: [`Kind`],
-//! [`Kind::ALL`], the names, [`Shape`] and its dispatch here, the store's lists and
-//! their visitor in [`crate::scene`].
+//! geometry id (the id both backends report in [`crate::Hit::geom_id`]), its module,
+//! the type the scene stores, the name of its list in the store, its plural and
+//! singular names and its documentation. Every per-kind item is generated from that
+//! table: the kinds' module declarations and re-exports in [`geometry`](super),
+//! [`Kind`], [`Kind::ALL`], the names, [`Shape`] and its dispatch of [`Intersect`] and
+//! [`Primitive`] here, the store's lists and their visitor in [`crate::scene`].
 //!
 //! Adding an analytic primitive therefore means: its own file (the type with its
 //! [`Intersect`] and [`Primitive`] impls: bounds, hits, the accurate surface point, the
-//! texture parameterisation and, for a closed solid, its inside)
-//! plus one row in the table. Triangles are not in the table: Embree intersects them
-//! natively and they carry vertex normals, texture coordinates and quads, so the store
-//! keeps them apart; they are [`Kind::Triangle`], geometry id 0.
+//! texture parameterisation and what applies of a solid's inside, baking and meshing)
+//! plus one row in the table; and, for the scene format, its object type in
+//! `load/toml/build/shapes/` (`docs/architecture.md` has the whole list). Triangles are
+//! not in the table: Embree intersects them natively and they carry vertex normals,
+//! texture coordinates and quads, so the store keeps them apart; they are
+//! [`Kind::Triangle`], geometry id 0.
 
 use super::{Intersect, Param, Primitive, ShapeHit, Spans, SurfacePoint, Tessellation};
 use crate::math::{Aabb, Ray, Vec3};

@@ -6,9 +6,12 @@
 //! Every intersector has a double-precision reference in [`reference`](mod@reference)
 //! used by the tests to bound the f32 error.
 //!
-//! The primitive kinds are listed once, in the table behind [`Kind`] and [`Shape`]:
-//! adding an analytic primitive means its own file (the type and its [`Intersect`] and
-//! [`Primitive`] impls) plus one row in that table.
+//! A primitive kind implements two traits in its own file: [`Intersect`], the ray
+//! queries, and [`Primitive`], what a scene primitive adds (texture parameterisation,
+//! material, a solid's inside, baking under a transform, meshing for radiosity). The
+//! kinds are listed once, in the table behind [`Kind`] and [`Shape`]
+//! (`for_each_kind!` in `kinds.rs`), which also declares their modules here:
+//! adding an analytic primitive means its own file plus one row in that table.
 
 pub mod bezier;
 mod error;
