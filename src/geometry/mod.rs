@@ -104,10 +104,11 @@ pub struct Span {
 pub type Spans = smallvec::SmallVec<[Span; 4]>;
 
 /// What a scene primitive adds to the ray queries of [`Intersect`]: its texture
-/// parameterisation, the material of a hit and, for a closed solid, its inside (what CSG
-/// combines). Each kind implements it in its own file; the defaults are those of an open
-/// surface (no inside: not a CSG operand, no spans, contains nothing), which the closed
-/// solids override.
+/// parameterisation, the material of a hit, for a closed solid its inside (what CSG
+/// combines), its exact rewriting under a transform and its faces for the radiosity
+/// mesh. Each kind implements it in its own file; the defaults are those of an open
+/// surface (no inside: not a CSG operand, no spans, contains nothing) that neither bakes
+/// nor is meshed, and each kind overrides what applies to it.
 pub trait Primitive: Intersect {
     /// The texture coordinates and tangents at `p`, a point on the primitive with unit
     /// outward geometric normal `ng` (see [`Param`]).
