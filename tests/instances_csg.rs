@@ -5,7 +5,7 @@
 
 use emray::Scene;
 use emray::accel::Backend;
-use emray::geometry::{Csg, CsgOp, CsgTree, Kind, Shape, Solid, Sphere, Triangle};
+use emray::geometry::{Csg, CsgOp, CsgTree, Kind, Primitive, Shape, Sphere, Triangle};
 use emray::job::render_scene;
 use emray::math::{Ray, Rng, Vec3, Xform};
 use emray::output::differing_pixels;

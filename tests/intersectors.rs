@@ -2,7 +2,7 @@
 //! grazing, from inside, tiny and huge sizes, far from the origin. Plus the robustness
 //! of spawned rays: a ray leaving a surface never re-hits it.
 
-use emray::geometry::{Cone, Sphere, Triangle, reference};
+use emray::geometry::{Cone, Intersect, Sphere, Triangle, reference};
 use emray::math::{DRay, DVec3, Ray, Vec3, offset_ray_origin};
 use proptest::prelude::*;
 
@@ -209,7 +209,7 @@ proptest! {
         let org = center + o * (3.0 * scale);
         let ray = Ray::new(org, center - org);
         let hit = s.intersect(&ray).expect("aimed at the centre");
-        let sp = s.surface(&ray, hit.t);
+        let sp = s.surface(&ray, &hit);
         let n = sp.ng;
         // Outward direction in the hemisphere of n.
         let wout = if out.dot(n) > 0.0 { out } else { -out };
@@ -332,7 +332,7 @@ proptest! {
         let org = target + perp * (3.0 * scale) + axis * (0.3 * scale);
         let ray = Ray::new(org, target - org);
         let Some(hit) = c.intersect(&ray) else { return Ok(()); };
-        let sp = c.surface(&ray, hit.t);
+        let sp = c.surface(&ray, &hit);
         let n = if sp.ng.dot(ray.dir) < 0.0 { sp.ng } else { -sp.ng };
         let wout = if w.dot(n) > 0.0 { w } else { -w };
         let po = offset_ray_origin(sp.p, sp.err, n, wout);

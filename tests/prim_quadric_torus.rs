@@ -18,7 +18,7 @@
 //!   `ERR_ULPS` ulps of the point's largest coordinate.
 
 use emray::geometry::reference::{quadric as rq, torus as rt};
-use emray::geometry::{Intersect, Plane, Quadric, ShapeHit, Solid, Spans, Sphere, Torus};
+use emray::geometry::{Intersect, Plane, Primitive, Quadric, ShapeHit, Spans, Sphere, Torus};
 use emray::math::{Aabb, DRay, DVec3, Ray, Vec3, offset_ray_origin};
 use proptest::prelude::*;
 
@@ -410,7 +410,7 @@ fn check_spawn(
 /// `1e-3 × size` of the surface (by `distance`) or within the f32 rounding of the span
 /// ends.
 fn check_contains(
-    solid: &dyn Solid,
+    solid: &dyn Primitive,
     ray: &DRay,
     spans: &Spans,
     ts: impl Iterator<Item = f64>,
@@ -849,7 +849,7 @@ proptest! {
 /// Rays that are not rays: NaN and infinite origins or directions, zero directions.
 #[test]
 fn non_finite_and_degenerate_rays_never_hit() {
-    let shapes: Vec<Box<dyn Solid>> = vec![
+    let shapes: Vec<Box<dyn Primitive>> = vec![
         Box::new(Quadric::sphere(Vec3::ZERO, 1.0).unwrap()),
         Box::new(Quadric::cylinder(Vec3::ZERO, Vec3::Z, 1.0).unwrap()),
         Box::new(

@@ -10,7 +10,7 @@
 //! the distance is ill-conditioned like a square root).
 
 use emray::geometry::reference::solids::{self as refs, Crossing};
-use emray::geometry::{AaBox, CappedCone, Intersect, OBox, Polyhedron, ShapeHit, Solid, Spans};
+use emray::geometry::{AaBox, CappedCone, Intersect, OBox, Polyhedron, Primitive, ShapeHit, Spans};
 use emray::math::{DRay, DVec3, Ray, Vec3, offset_ray_origin};
 use glam::Quat;
 use proptest::prelude::*;
@@ -78,7 +78,7 @@ enum AnySolid {
 }
 
 impl AnySolid {
-    fn get(&self) -> &dyn Solid {
+    fn get(&self) -> &dyn Primitive {
         match self {
             AnySolid::Cone(c) => c,
             AnySolid::Aa(b) => b,
@@ -925,7 +925,7 @@ fn approx(a: f32, b: f64, tol: f64) -> bool {
     (a as f64 - b).abs() <= tol * b.abs().max(1.0)
 }
 
-fn first_span(s: &dyn Solid, ray: &Ray) -> Option<(f32, Vec3, f32, Vec3)> {
+fn first_span(s: &dyn Primitive, ray: &Ray) -> Option<(f32, Vec3, f32, Vec3)> {
     let mut out = Spans::new();
     s.spans(ray, &mut out);
     out.first().map(|s| (s.t_in, s.n_in, s.t_out, s.n_out))
@@ -1145,7 +1145,7 @@ fn ultra_flat_cone_tells_side_from_base_by_the_point() {
 
 #[test]
 fn rays_from_inside_hit_the_exit() {
-    let solids: Vec<(Box<dyn Solid>, Vec3)> = vec![
+    let solids: Vec<(Box<dyn Primitive>, Vec3)> = vec![
         (Box::new(unit_cylinder()), Vec3::new(0.2, 0.1, 1.0)),
         (
             Box::new(CappedCone::new(Vec3::ZERO, Vec3::Z, 2.0, 1.0, 0.0).unwrap()),
@@ -1386,7 +1386,7 @@ fn prisms() {
 // ---------------------------------------------------------------------------------
 // Degenerate input.
 
-fn all_solids() -> Vec<Box<dyn Solid>> {
+fn all_solids() -> Vec<Box<dyn Primitive>> {
     vec![
         Box::new(unit_cylinder()),
         Box::new(CappedCone::new(Vec3::ZERO, Vec3::Z, 2.0, 0.0, 1.0).unwrap()),
@@ -1461,7 +1461,7 @@ fn rays_parallel_to_faces_and_origins_on_face_planes() {
         (-Vec3::Z, 0.0),
     ])
     .unwrap();
-    let solids: [&dyn Solid; 3] = [&aa, &ob, &poly];
+    let solids: [&dyn Primitive; 3] = [&aa, &ob, &poly];
     for s in solids {
         // In the plane x = 0 (a face plane), parallel to it: inside the closed slab.
         let r = Ray::new(Vec3::new(0.0, 0.5, -1.0), Vec3::Z);

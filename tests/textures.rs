@@ -6,7 +6,7 @@
 use emray::Hit;
 use emray::accel::Accel;
 use emray::accel::WithAccel;
-use emray::geometry::{Kind, Sphere, Triangle, inverse_bilinear};
+use emray::geometry::{Kind, Primitive, Sphere, Triangle, inverse_bilinear};
 use emray::job::render_scene;
 use emray::load::obj::{MISSING_TEXTURE, load_geometry};
 use emray::math::{Ray, Vec3};
@@ -255,7 +255,7 @@ fn bump_at_the_sphere_poles_is_finite() {
         scale: 16.0,
     };
     for p in [Vec3::Y, -Vec3::Y] {
-        let prm = sphere.param(p);
+        let prm = sphere.param(p, p);
         let n = bump_normal(&tex, 0.05, prm.uv, p, p, prm.dpdu, prm.dpdv);
         assert!(n.is_finite() && (n.length() - 1.0).abs() < 1e-5, "{n}");
     }

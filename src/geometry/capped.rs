@@ -17,12 +17,14 @@
 //! linear or constant equation instead of dividing by zero.
 
 use super::param::{axis_frame, cylindrical};
+use super::tessellate::{Tessellation, revolution};
 use super::{
-    Intersect, Param, Primitive, ShapeError, ShapeHit, Solid, Span, Spans, SurfacePoint,
-    diff_of_products, quadratic_roots,
+    Intersect, Param, Primitive, Shape, ShapeError, ShapeHit, Span, Spans, SurfacePoint, diff_of_products,
+    quadratic_roots,
 };
-use crate::math::{Aabb, DVec3, Frame, Ray, Vec3, gamma};
-use glam::Vec2;
+use crate::math::{Aabb, DVec3, Frame, Ray, Vec3, gamma, similarity_scale};
+use glam::{DAffine3, Vec2};
+use std::sync::Arc;
 use std::f32::consts::TAU;
 
 /// Which part of the surface an end of the line's stretch lies on.
@@ -630,7 +632,18 @@ impl Intersect for CappedCone {
     }
 }
 
-impl Solid for CappedCone {
+impl CappedCone {
+    /// Whether both ends have the same radius: a (closed) cylinder.
+    pub fn is_cylinder(&self) -> bool {
+        self.base_radius == self.top_radius
+    }
+}
+
+impl Primitive for CappedCone {
+    fn is_solid(&self) -> bool {
+        true
+    }
+
     fn spans(&self, ray: &Ray, out: &mut Spans) {
         if let Some(s) = self.stretch(ray) {
             out.push(Span {
@@ -651,17 +664,10 @@ impl Solid for CappedCone {
         let r = self.base_radius + self.slope * s;
         (q - self.axis * s).length_squared() <= r * r
     }
-}
-
-impl CappedCone {
-    /// Whether both ends have the same radius: a (closed) cylinder.
-    pub fn is_cylinder(&self) -> bool {
-        self.base_radius == self.top_radius
-    }
 
     /// The cylindrical parameterisation on the side, a disk onto `[0, 1]²` on the caps
     /// (`ng` the unit outward normal tells them apart).
-    pub fn param(&self, p: Vec3, ng: Vec3) -> Param {
+    fn param(&self, p: Vec3, ng: Vec3) -> Param {
         let axis = self.axis();
         let h = (p - self.base()).dot(axis);
         let on_cap = ng.dot(axis).abs() > 0.999
@@ -690,20 +696,31 @@ impl CappedCone {
             dpdv: e2 * (2.0 * r),
         }
     }
-}
 
-impl Primitive for CappedCone {
-    fn is_solid(&self) -> bool {
-        true
+    /// Under a similarity: the base moved, the axis turned, the lengths scaled.
+    fn bake(&self, m: &DAffine3) -> Option<Shape> {
+        let k = similarity_scale(m)?;
+        CappedCone::new(
+            m.transform_point3(self.base().as_dvec3()).as_vec3(),
+            (m.matrix3 * self.axis().as_dvec3()).as_vec3(),
+            (self.height() as f64 * k) as f32,
+            (self.base_radius() as f64 * k) as f32,
+            (self.top_radius() as f64 * k) as f32,
+        )
+        .ok()
+        .map(|c| Arc::new(c).into())
     }
-    fn spans(&self, ray: &Ray, out: &mut Spans) {
-        Solid::spans(self, ray, out)
-    }
-    fn contains(&self, p: Vec3) -> bool {
-        Solid::contains(self, p)
-    }
-    fn param(&self, p: Vec3, ng: Vec3) -> Param {
-        CappedCone::param(self, p, ng)
+
+    /// The side on an angle × height grid, and the two caps.
+    fn tessellate(&self, patch: f32) -> Option<Tessellation> {
+        Some(revolution(
+            self.base(),
+            self.axis(),
+            self.height(),
+            (self.base_radius(), self.top_radius()),
+            patch,
+            true,
+        ))
     }
 }
 

@@ -1,6 +1,8 @@
 use super::param::cylindrical;
-use super::{Intersect, Param, Primitive, ShapeHit, Spans, SurfacePoint, quadratic_roots_f64};
-use crate::math::{Aabb, Ray, Vec3, gamma};
+use super::tessellate::{Tessellation, flip, revolution};
+use super::{Intersect, Param, Primitive, Shape, ShapeHit, SurfacePoint, quadratic_roots_f64};
+use crate::math::{Aabb, Ray, Vec3, gamma, similarity_scale};
+use glam::DAffine3;
 
 /// NFF's open cone or cylinder: the lateral surface between a base disk and an apex
 /// disk, with no end caps. With `inside_only` (NFF's negative radii) only hits where the
@@ -54,25 +56,6 @@ impl Cone {
     /// Distance between the two end centres.
     pub fn height(&self) -> f32 {
         self.height
-    }
-
-    /// Bounds of the two end disks, widened by a few ulps.
-    pub fn bounds(&self) -> Aabb {
-        let w = self.axis;
-        // Half-extent of a disk of radius r with normal w along axis i: r·√(1 − w_i²).
-        let k = (Vec3::ONE - w * w).max(Vec3::ZERO);
-        let k = Vec3::new(k.x.sqrt(), k.y.sqrt(), k.z.sqrt());
-        let eb = k * self.base_radius;
-        let ea = k * self.apex_radius;
-        let b = Aabb::from_points(self.base - eb, self.base + eb)
-            .union(&Aabb::from_points(self.apex - ea, self.apex + ea));
-        let slack = (b.min.abs().max(b.max.abs())
-            + Vec3::splat(self.base_radius.max(self.apex_radius)))
-            * gamma(4);
-        Aabb {
-            min: b.min - slack,
-            max: b.max + slack,
-        }
     }
 
     /// The ray's quadratic (see [`ConeQuadratic`]) for the ray re-based at
@@ -186,11 +169,32 @@ impl Cone {
         }
         None
     }
+}
+
+impl Intersect for Cone {
+    /// Bounds of the two end disks, widened by a few ulps.
+    fn bounds(&self) -> Aabb {
+        let w = self.axis;
+        // Half-extent of a disk of radius r with normal w along axis i: r·√(1 − w_i²).
+        let k = (Vec3::ONE - w * w).max(Vec3::ZERO);
+        let k = Vec3::new(k.x.sqrt(), k.y.sqrt(), k.z.sqrt());
+        let eb = k * self.base_radius;
+        let ea = k * self.apex_radius;
+        let b = Aabb::from_points(self.base - eb, self.base + eb)
+            .union(&Aabb::from_points(self.apex - ea, self.apex + ea));
+        let slack = (b.min.abs().max(b.max.abs())
+            + Vec3::splat(self.base_radius.max(self.apex_radius)))
+            * gamma(4);
+        Aabb {
+            min: b.min - slack,
+            max: b.max + slack,
+        }
+    }
 
     /// The nearest hit in `(ray.tmin, ray.tmax)`. `u` is the axial fraction from base
     /// (0) to apex (1).
     #[inline]
-    pub fn intersect(&self, ray: &Ray) -> Option<ShapeHit> {
+    fn intersect(&self, ray: &Ray) -> Option<ShapeHit> {
         let (t, u) = self.first(ray)?;
         Some(ShapeHit {
             t,
@@ -202,14 +206,15 @@ impl Cone {
 
     /// Whether a hit lies in `(ray.tmin, ray.tmax)`.
     #[inline]
-    pub fn occluded(&self, ray: &Ray) -> bool {
+    fn occluded(&self, ray: &Ray) -> bool {
         self.first(ray).is_some()
     }
 
     /// The hit point refined by one re-intersection from `o + t·d` (the remaining root
     /// is tiny, so its relative error no longer matters), with an error bound that
     /// scales with the cone's coordinates.
-    pub fn surface(&self, ray: &Ray, t: f32) -> SurfacePoint {
+    fn surface(&self, ray: &Ray, hit: &ShapeHit) -> SurfacePoint {
+        let t = hit.t;
         let p0 = ray.at(t);
         let local = Ray {
             org: p0,
@@ -240,47 +245,49 @@ impl Cone {
     }
 }
 
-impl Intersect for Cone {
-    fn bounds(&self) -> Aabb {
-        Cone::bounds(self)
-    }
-    #[inline]
-    fn intersect(&self, ray: &Ray) -> Option<ShapeHit> {
-        Cone::intersect(self, ray)
-    }
-    #[inline]
-    fn occluded(&self, ray: &Ray) -> bool {
-        Cone::occluded(self, ray)
-    }
-    fn surface(&self, ray: &Ray, hit: &ShapeHit) -> SurfacePoint {
-        Cone::surface(self, ray, hit.t)
-    }
-}
-
 impl Cone {
     /// Whether both ends have the same radius: an open cylinder.
     pub fn is_cylinder(&self) -> bool {
         self.base_radius == self.apex_radius
     }
+}
 
+/// An open surface: not a CSG operand, no inside (the defaults).
+impl Primitive for Cone {
     /// The cylindrical parameterisation at `p`.
-    pub fn param(&self, p: Vec3) -> Param {
+    fn param(&self, p: Vec3, _ng: Vec3) -> Param {
         let slope = (self.apex_radius - self.base_radius) / self.height();
         cylindrical(p, self.base, self.axis(), self.height(), slope)
     }
-}
 
-/// An open surface: not a CSG operand, no inside.
-impl Primitive for Cone {
-    fn is_solid(&self) -> bool {
-        false
+    /// Under a similarity: the ends moved, the radii scaled.
+    fn bake(&self, m: &DAffine3) -> Option<Shape> {
+        let k = similarity_scale(m)?;
+        let sign = if self.inside_only { -1.0 } else { 1.0 };
+        Some(
+            Cone::new(
+                m.transform_point3(self.base.as_dvec3()).as_vec3(),
+                sign * (self.base_radius as f64 * k) as f32,
+                m.transform_point3(self.apex.as_dvec3()).as_vec3(),
+                sign * (self.apex_radius as f64 * k) as f32,
+            )
+            .into(),
+        )
     }
-    fn spans(&self, _ray: &Ray, _out: &mut Spans) {}
-    fn contains(&self, _p: Vec3) -> bool {
-        false
-    }
-    fn param(&self, p: Vec3, _ng: Vec3) -> Param {
-        Cone::param(self, p)
+
+    /// The lateral surface on an angle × height grid (its outside, or its inside when
+    /// only that is visible): an open surface, meshed on its front side.
+    fn tessellate(&self, patch: f32) -> Option<Tessellation> {
+        let mut t = revolution(
+            self.base,
+            self.axis(),
+            self.height(),
+            (self.base_radius.abs(), self.apex_radius.abs()),
+            patch,
+            false,
+        );
+        flip(&mut t.faces, self.inside_only);
+        Some(t)
     }
 }
 

@@ -8,9 +8,7 @@
 //! flip travel in the hit's `u`/`v` so that [`Csg::surface`] can ask the leaf for the
 //! accurate point.
 
-use super::{
-    Intersect, Param, Primitive, Shape, ShapeError, ShapeHit, Solid, Span, Spans, SurfacePoint,
-};
+use super::{Intersect, Param, Primitive, Shape, ShapeError, ShapeHit, Span, Spans, SurfacePoint};
 use crate::math::{Aabb, Ray, Vec3, Xform};
 use smallvec::SmallVec;
 
@@ -389,7 +387,11 @@ impl Intersect for Csg {
     }
 }
 
-impl Solid for Csg {
+impl Primitive for Csg {
+    fn is_solid(&self) -> bool {
+        true
+    }
+
     fn spans(&self, ray: &Ray, out: &mut Spans) {
         out.extend(self.evaluate(ray).iter().map(|(a, b)| Span {
             t_in: a.t,
@@ -420,18 +422,7 @@ impl Solid for Csg {
         }
         stack.pop().unwrap_or(false)
     }
-}
 
-impl Primitive for Csg {
-    fn is_solid(&self) -> bool {
-        true
-    }
-    fn spans(&self, ray: &Ray, out: &mut Spans) {
-        Solid::spans(self, ray, out)
-    }
-    fn contains(&self, p: Vec3) -> bool {
-        Solid::contains(self, p)
-    }
     /// The planar parameterisation about the normal ([`Param::planar`]).
     fn param(&self, p: Vec3, ng: Vec3) -> Param {
         Param::planar(p, ng)

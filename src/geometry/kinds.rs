@@ -1,78 +1,93 @@
 //! The primitive kinds, listed once.
 //!
 //! [`for_each_kind!`] holds the table of analytic kinds: one row per kind with its
-//! geometry id (the id both backends report in [`crate::Hit::geom_id`]), the type the
-//! scene stores, the name of its list in the store, its plural and singular names and
-//! its documentation. Every per-kind item is generated from that table: [`Kind`],
-//! [`Kind::ALL`], the names, [`Shape`] and its dispatch here, the store's lists and
-//! their visitor in [`crate::scene`].
+//! geometry id (the id both backends report in [`crate::Hit::geom_id`]), its module,
+//! the type the scene stores, the name of its list in the store, its plural and
+//! singular names and its documentation. Every per-kind item is generated from that
+//! table: the kinds' module declarations and re-exports in [`geometry`](super),
+//! [`Kind`], [`Kind::ALL`], the names, [`Shape`] and its dispatch of [`Intersect`] and
+//! [`Primitive`] here, the store's lists and their visitor in [`crate::scene`].
 //!
 //! Adding an analytic primitive therefore means: its own file (the type with its
-//! [`Intersect`], [`Primitive`] and, for a closed solid, [`Solid`](super::Solid)
-//! impls: bounds, hits, the accurate surface point and the texture parameterisation)
-//! plus one row in the table. Triangles are not in the table: Embree intersects them
-//! natively and they carry vertex normals, texture coordinates and quads, so the store
-//! keeps them apart; they are [`Kind::Triangle`], geometry id 0.
+//! [`Intersect`] and [`Primitive`] impls: bounds, hits, the accurate surface point, the
+//! texture parameterisation and what applies of a solid's inside, baking and meshing)
+//! plus one row in the table; and, for the scene format, its object type in
+//! `load/toml/build/shapes/` (`docs/architecture.md` has the whole list). Triangles are
+//! not in the table: Embree intersects them natively and they carry vertex normals,
+//! texture coordinates and quads, so the store keeps them apart; they are
+//! [`Kind::Triangle`], geometry id 0.
 
-use super::{Intersect, Param, ShapeHit, Spans, SurfacePoint};
+use super::{Intersect, Param, Primitive, ShapeHit, Spans, SurfacePoint, Tessellation};
 use crate::math::{Aabb, Ray, Vec3};
+use glam::DAffine3;
 use std::sync::Arc;
 
 /// Invoke the macro `$m` with the table of analytic kinds, one row per kind in
-/// geometry-id order:
+/// geometry-id order. A row of the table reads
 ///
-/// `(Variant, geometry id, stored type, store field, "plural", "singular", "doc")`
+/// `(Variant, geometry id, mod module, Type, store field, "plural", "singular", "doc")`
 ///
 /// - `Variant` names the [`Kind`] and [`Shape`] variants;
 /// - the geometry id is the [`Kind`] discriminant (1, 2, ...: 0 is the triangles);
-/// - the stored type is what [`Shape`] and the store hold (large shapes behind an
-///   [`Arc`], so that cloning a [`Shape`] stays cheap);
+/// - `mod module` is the kind's file in `src/geometry/`, which declares `Type` (`pub
+///   mod` to make the module itself public); `geometry` declares the module and
+///   re-exports the type from this row;
+/// - `Type` is what [`Shape`] and the store hold: the type itself, or `Arc<Type>` for
+///   a large one (so that cloning a [`Shape`] stays cheap);
 /// - the store field names the kind's list in [`crate::scene::Geometry`];
 /// - the plural name is used in statistics, the singular one in messages.
+///
+/// `$m` receives each row with the stored type spelled out as a path that resolves
+/// anywhere in the crate:
+///
+/// `(Variant, id, mod module, Type, stored type, field, "plural", "singular", "doc")`
 macro_rules! for_each_kind {
     ($m:ident) => {
-        $m! {
-            (Sphere, 1, Sphere, spheres, "spheres", "sphere", "Spheres (NFF `s`)."),
-            (Cone, 2, Cone, cones, "cones", "open cone", "Open cones and cylinders (NFF `c`)."),
-            (Csg, 3, Arc<Csg>, csg, "csg", "CSG solid", "Constructive solid geometry roots."),
-            (Quadric, 4, Arc<Quadric>, quadrics, "quadrics", "quadric",
+        $crate::geometry::kind_rows! { $m []
+            (Sphere, 1, mod sphere, Sphere, spheres, "spheres", "sphere", "Spheres (NFF `s`)."),
+            (Cone, 2, mod cone, Cone, cones, "cones", "open cone",
+                "Open cones and cylinders (NFF `c`)."),
+            (Csg, 3, pub mod csg, Arc<Csg>, csg, "csg", "CSG solid",
+                "Constructive solid geometry roots."),
+            (Quadric, 4, mod quadric, Arc<Quadric>, quadrics, "quadrics", "quadric",
                 "General quadrics, optionally clipped to a box."),
-            (CappedCone, 5, Arc<CappedCone>, capped_cones, "capped_cones", "capped cone",
-                "Capped (closed) cones and cylinders."),
-            (Box, 6, AaBox, boxes, "boxes", "box", "Axis-aligned boxes."),
-            (OBox, 7, Arc<OBox>, oriented_boxes, "oriented_boxes", "oriented box",
+            (CappedCone, 5, mod capped, Arc<CappedCone>, capped_cones, "capped_cones",
+                "capped cone", "Capped (closed) cones and cylinders."),
+            (Box, 6, mod aabox, AaBox, boxes, "boxes", "box", "Axis-aligned boxes."),
+            (OBox, 7, mod obox, Arc<OBox>, oriented_boxes, "oriented_boxes", "oriented box",
                 "Oriented boxes."),
-            (Polyhedron, 8, Arc<Polyhedron>, polyhedra, "polyhedra", "polyhedron",
-                "Convex polyhedra."),
-            (Plane, 9, Plane, planes, "planes", "plane", "Infinite planes."),
-            (Torus, 10, Arc<Torus>, tori, "tori", "torus", "Tori."),
+            (Polyhedron, 8, mod polyhedron, Arc<Polyhedron>, polyhedra, "polyhedra",
+                "polyhedron", "Convex polyhedra."),
+            (Plane, 9, mod plane, Plane, planes, "planes", "plane", "Infinite planes."),
+            (Torus, 10, mod torus, Arc<Torus>, tori, "tori", "torus", "Tori."),
         }
     };
 }
 pub(crate) use for_each_kind;
 
-/// What every analytic primitive provides beyond [`Intersect`]: whether it is a closed
-/// solid and the solid's spans (for CSG), its texture parameterisation, and the
-/// material of a hit. Each kind implements it in its own file.
-pub trait Primitive: Intersect {
-    /// Whether this is a closed solid, usable as a CSG operand.
-    fn is_solid(&self) -> bool;
-    /// Append the spans of the whole line inside the solid, as
-    /// [`Solid::spans`](super::Solid::spans) does (nothing for open surfaces).
-    fn spans(&self, ray: &Ray, out: &mut Spans);
-    /// Whether `p` is inside the solid (false for open surfaces).
-    fn contains(&self, p: Vec3) -> bool;
-    /// The texture coordinates and tangents at `p`, a point on the primitive with unit
-    /// outward geometric normal `ng` (see [`Param`]).
-    fn param(&self, p: Vec3, ng: Vec3) -> Param;
-    /// The material of `hit`, given `own`, the primitive's material in the store: `own`
-    /// unless a part of the primitive has its own (a CSG leaf).
-    #[inline]
-    fn material(&self, hit: &ShapeHit, own: u32) -> u32 {
-        let _ = hit;
-        own
-    }
+/// The rows of [`for_each_kind!`] one at a time into `[...]`, each with its stored type
+/// as a path, then all of them to `$m`.
+#[doc(hidden)]
+macro_rules! kind_rows {
+    ($m:ident [$($done:tt)*]) => {
+        $m! { $($done)* }
+    };
+    ($m:ident [$($done:tt)*]
+        ($v:ident, $id:literal, $vis:vis mod $module:ident, Arc<$t:ident>, $($rest:tt)*)
+        $(, $($more:tt)*)?) => {
+        $crate::geometry::kind_rows! { $m [$($done)*
+            ($v, $id, $vis mod $module, $t, ::std::sync::Arc<$crate::geometry::$t>, $($rest)*),]
+            $($($more)*)? }
+    };
+    ($m:ident [$($done:tt)*]
+        ($v:ident, $id:literal, $vis:vis mod $module:ident, $t:ident, $($rest:tt)*)
+        $(, $($more:tt)*)?) => {
+        $crate::geometry::kind_rows! { $m [$($done)*
+            ($v, $id, $vis mod $module, $t, $crate::geometry::$t, $($rest)*),]
+            $($($more)*)? }
+    };
 }
+pub(crate) use kind_rows;
 
 /// One analytic kind's stored type (a row of the kinds table): a [`Primitive`] with
 /// its [`Kind`], convertible into a [`Shape`], shareable with the backends' threads.
@@ -123,12 +138,18 @@ impl<T: Primitive + ?Sized> Primitive for Arc<T> {
     fn material(&self, hit: &ShapeHit, own: u32) -> u32 {
         T::material(self, hit, own)
     }
+    fn bake(&self, m: &DAffine3) -> Option<Shape> {
+        T::bake(self, m)
+    }
+    fn tessellate(&self, patch: f32) -> Option<Tessellation> {
+        T::tessellate(self, patch)
+    }
 }
 
 /// Generates [`Kind`], [`Shape`] and their per-kind code from the table.
 macro_rules! define_kinds {
-    ($(($v:ident, $id:literal, $t:ty, $field:ident, $plural:literal, $singular:literal,
-        $doc:literal)),* $(,)?) => {
+    ($(($v:ident, $id:literal, $vis:vis mod $module:ident, $name:ident, $t:ty, $field:ident,
+        $plural:literal, $singular:literal, $doc:literal)),* $(,)?) => {
         /// The primitive kinds. The discriminant is the geometry id both backends report
         /// in [`crate::Hit::geom_id`].
         #[derive(Clone, Copy, Debug, PartialEq, Eq, Hash, PartialOrd, Ord)]
@@ -246,11 +267,22 @@ macro_rules! define_kinds {
                     $(Shape::$v(s) => Primitive::material(s, hit, own),)*
                 }
             }
+
+            fn bake(&self, m: &DAffine3) -> Option<Shape> {
+                match self {
+                    $(Shape::$v(s) => Primitive::bake(s, m),)*
+                }
+            }
+
+            fn tessellate(&self, patch: f32) -> Option<Tessellation> {
+                match self {
+                    $(Shape::$v(s) => Primitive::tessellate(s, patch),)*
+                }
+            }
         }
     };
 }
 
-use super::{AaBox, CappedCone, Cone, Csg, OBox, Plane, Polyhedron, Quadric, Sphere, Torus};
 for_each_kind!(define_kinds);
 
 // The geometry id of every kind is its index in `Kind::ALL` (what `from_id` relies on).
@@ -280,22 +312,22 @@ impl Kind {
 #[cfg(test)]
 mod tests {
     use super::*;
+    use crate::geometry::{Sphere, Torus};
 
     #[test]
     fn ids_names_and_shapes_follow_the_table() {
-        assert_eq!(Kind::ALL.len(), 11);
         assert_eq!(Kind::Triangle as u32, 0);
         assert_eq!(Kind::Sphere as u32, 1);
         assert_eq!(Kind::Torus as u32, 10);
         for (i, k) in Kind::ALL.into_iter().enumerate() {
             assert_eq!(Kind::from_id(i as u32), Some(k));
         }
-        assert_eq!(Kind::from_id(11), None);
+        assert_eq!(Kind::from_id(Kind::ALL.len() as u32), None);
         assert_eq!(Kind::OBox.name(), "oriented_boxes");
         assert_eq!(Kind::Cone.singular(), "open cone");
         let s: Shape = Sphere::new(Vec3::ZERO, 1.0).into();
         assert_eq!(s.kind(), Kind::Sphere);
         assert_eq!(<Arc<Torus> as Analytic>::KIND, Kind::Torus);
-        assert_eq!(Kind::analytic().count(), 10);
+        assert_eq!(Kind::analytic().count(), Kind::ALL.len() - 1);
     }
 }

@@ -6,41 +6,40 @@
 //! Every intersector has a double-precision reference in [`reference`](mod@reference)
 //! used by the tests to bound the f32 error.
 //!
-//! The primitive kinds are listed once, in the table behind [`Kind`] and [`Shape`]:
-//! adding an analytic primitive means its own file (the type and its [`Intersect`],
-//! [`Primitive`] and [`Solid`] impls) plus one row in that table.
+//! A primitive kind implements two traits in its own file: [`Intersect`], the ray
+//! queries, and [`Primitive`], what a scene primitive adds (texture parameterisation,
+//! material, a solid's inside, baking under a transform, meshing for radiosity). The
+//! kinds are listed once, in the table behind [`Kind`] and [`Shape`]
+//! (`for_each_kind!` in `kinds.rs`), which also declares their modules here:
+//! adding an analytic primitive means its own file plus one row in that table.
 
 pub mod bezier;
-mod boxes;
-mod capped;
-mod cone;
-pub mod csg;
 mod error;
 mod kinds;
 mod param;
-mod plane;
 pub mod polygon;
-mod polyhedron;
-mod quadric;
 pub mod reference;
-mod sphere;
-mod torus;
+pub mod tessellate;
 mod triangle;
 mod triangle4;
 
-pub use boxes::{AaBox, OBox};
-pub use capped::CappedCone;
-pub use cone::Cone;
-pub use csg::{Csg, CsgOp, CsgTree};
+/// Declares the module of each analytic kind and re-exports its type, from the kinds
+/// table.
+macro_rules! kind_modules {
+    ($(($v:ident, $id:literal, $vis:vis mod $module:ident, $name:ident, $t:ty,
+        $($rest:tt)*)),* $(,)?) => {
+        $($vis mod $module; pub use $module::$name;)*
+    };
+}
+kinds::for_each_kind!(kind_modules);
+
+pub use csg::{CsgOp, CsgTree};
 pub use error::ShapeError;
-pub(crate) use kinds::for_each_kind;
-pub use kinds::{Analytic, Kind, Primitive, Shape};
+pub use kinds::{Analytic, Kind, Shape};
+pub(crate) use kinds::{for_each_kind, kind_rows};
 pub use param::{Param, QuadUv, inverse_bilinear};
-pub use plane::Plane;
-pub use polyhedron::{MAX_PLANES, Polyhedron};
-pub use quadric::Quadric;
-pub use sphere::Sphere;
-pub use torus::Torus;
+pub use polyhedron::MAX_PLANES;
+pub use tessellate::Tessellation;
 pub use triangle::{Triangle, WatertightRay};
 pub use triangle4::{Hits4, Triangle4, WatertightRay4};
 
@@ -48,6 +47,7 @@ pub use triangle4::{Hits4, Triangle4, WatertightRay4};
 pub use crate::math::SurfacePoint;
 
 use crate::math::{Aabb, Ray, Vec3};
+use glam::DAffine3;
 
 /// What an intersector reports: the distance, two surface parameters and the
 /// (unnormalised) geometric normal, which for closed shapes points outwards.
@@ -103,13 +103,64 @@ pub struct Span {
 /// A short list of spans, sorted by `t_in` and disjoint; inline up to four.
 pub type Spans = smallvec::SmallVec<[Span; 4]>;
 
-/// A closed solid usable in CSG: it can list every stretch of a line inside it.
-pub trait Solid: Intersect {
+/// What a scene primitive adds to the ray queries of [`Intersect`]: its texture
+/// parameterisation, the material of a hit, for a closed solid its inside (what CSG
+/// combines), its exact rewriting under a transform and its faces for the radiosity
+/// mesh. Each kind implements it in its own file; the defaults are those of an open
+/// surface (no inside: not a CSG operand, no spans, contains nothing) that neither bakes
+/// nor is meshed, and each kind overrides what applies to it.
+pub trait Primitive: Intersect {
+    /// The texture coordinates and tangents at `p`, a point on the primitive with unit
+    /// outward geometric normal `ng` (see [`Param`]).
+    fn param(&self, p: Vec3, ng: Vec3) -> Param;
+
+    /// The material of `hit`, given `own`, the primitive's material in the store: `own`
+    /// unless a part of the primitive has its own (a CSG leaf).
+    #[inline]
+    fn material(&self, hit: &ShapeHit, own: u32) -> u32 {
+        let _ = hit;
+        own
+    }
+
+    /// Whether this is a closed solid, usable as a CSG operand (false: an open
+    /// surface).
+    fn is_solid(&self) -> bool {
+        false
+    }
+
     /// Append to `out`, sorted and disjoint, every span where the whole line
-    /// `ray.org + t·ray.dir`, `t ∈ (−∞, ∞)`, is inside the solid (ignoring `tmin`/`tmax`).
-    fn spans(&self, ray: &Ray, out: &mut Spans);
-    /// Whether point `p` is inside (boundary points may go either way).
-    fn contains(&self, p: Vec3) -> bool;
+    /// `ray.org + t·ray.dir`, `t ∈ (−∞, ∞)`, is inside the solid (ignoring
+    /// `tmin`/`tmax`); nothing for an open surface.
+    fn spans(&self, ray: &Ray, out: &mut Spans) {
+        let _ = (ray, out);
+    }
+
+    /// Whether point `p` is inside the solid (boundary points may go either way); false
+    /// for an open surface.
+    fn contains(&self, p: Vec3) -> bool {
+        let _ = p;
+        false
+    }
+
+    /// This primitive under the affine map `m`, rewritten in final coordinates as a
+    /// primitive of the same kind when that is exact (a sphere under a similarity, a
+    /// polyhedron under any invertible map, ...). `None`, the default, when it is not:
+    /// a loader then places the primitive by an instance, or inside CSG by a transform
+    /// of its leaf.
+    fn bake(&self, m: &DAffine3) -> Option<Shape> {
+        let _ = m;
+        None
+    }
+
+    /// The primitive as convex planar faces for the radiosity mesh, curved surfaces on
+    /// a grid of cells about `patch` across (see [`tessellate`](mod@tessellate)).
+    /// `None`, the default, for a kind that is not meshed: it only occludes in the
+    /// radiosity pass, the Whitted renderer shades it, and the radiosity report counts
+    /// it among the primitives not meshed.
+    fn tessellate(&self, patch: f32) -> Option<Tessellation> {
+        let _ = patch;
+        None
+    }
 }
 
 /// `a·b − c·d` without cancellation: both products are exact in f64 (24 + 24 bits of

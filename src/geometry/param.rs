@@ -295,7 +295,7 @@ mod tests {
     #[test]
     fn sphere_uv_and_orientation() {
         let s = Sphere::new(Vec3::new(1.0, 2.0, 3.0), 2.0);
-        let at = |d: Vec3| s.param(s.center + d * 2.0);
+        let at = |d: Vec3| s.param(s.center + d * 2.0, d);
         let z = at(Vec3::Z);
         assert!((z.uv - Vec2::new(0.0, 0.5)).length() < 1e-6);
         let x = at(Vec3::X);
@@ -329,16 +329,16 @@ mod tests {
         let t = Torus::new(Vec3::ZERO, Vec3::Y, 2.0, 0.5).unwrap();
         let (ex, _, a) = t.frame();
         let outer = ex * 2.5;
-        let p = t.param(outer);
+        let p = t.param(outer, ex);
         assert!(p.uv.length() < 1e-6);
         assert_frame_outward(&p, ex);
         let top = ex * 2.0 + a * 0.5;
-        let p = t.param(top);
+        let p = t.param(top, a);
         assert!((p.uv.y - 0.25).abs() < 1e-6);
         assert_frame_outward(&p, a);
 
         let c = Cone::new(Vec3::ZERO, 1.0, Vec3::new(0.0, 0.0, 4.0), 1.0);
-        let p = c.param(Vec3::new(1.0, 0.0, 2.0));
+        let p = c.param(Vec3::new(1.0, 0.0, 2.0), Vec3::X);
         assert!((p.uv.y - 0.5).abs() < 1e-6);
         assert_frame_outward(&p, Vec3::X);
 

@@ -5,8 +5,9 @@
 //! the surface point are rounded to f32.
 
 use super::quadric::{check_finite, gamma64, rounding_err, unit_axis};
-use super::{Intersect, Param, Primitive, ShapeError, ShapeHit, Solid, Span, Spans, SurfacePoint};
+use super::{Intersect, Param, Primitive, Shape, ShapeError, ShapeHit, Span, Spans, SurfacePoint};
 use crate::math::{Aabb, DVec3, Ray, Vec3};
+use glam::DAffine3;
 
 /// An infinite plane `n·x = d` (unit `n`); as a solid, the half-space `n·x ≤ d`, so the
 /// outward normal is `n`. Its bounds are [`Aabb::INFINITE`]; `u` and `v` of hits are 0.
@@ -75,10 +76,16 @@ impl Plane {
         }
         Some((-self.distance(ray.org.as_dvec3()) / den, den))
     }
+}
+
+impl Intersect for Plane {
+    fn bounds(&self) -> Aabb {
+        Aabb::INFINITE
+    }
 
     /// The hit in `(ray.tmin, ray.tmax)`, if any; `ng` is the unit normal.
     #[inline]
-    pub fn intersect(&self, ray: &Ray) -> Option<ShapeHit> {
+    fn intersect(&self, ray: &Ray) -> Option<ShapeHit> {
         let (t, _) = self.crossing(ray)?;
         let t = t as f32;
         (t > ray.tmin && t < ray.tmax).then_some(ShapeHit {
@@ -91,7 +98,7 @@ impl Plane {
 
     /// The hit point projected onto the plane in f64, rounded to f32, with the bound of
     /// that rounding (plus the f64 projection's own error).
-    pub fn surface(&self, ray: &Ray, hit: &ShapeHit) -> SurfacePoint {
+    fn surface(&self, ray: &Ray, hit: &ShapeHit) -> SurfacePoint {
         let mut p = ray.org.as_dvec3() + ray.dir.as_dvec3() * hit.t as f64;
         if !p.is_finite() {
             p = ray.org.as_dvec3();
@@ -107,10 +114,17 @@ impl Plane {
             ng: self.n32,
         }
     }
+}
+
+impl Primitive for Plane {
+    /// The half-space: unbounded, but usable to cut bounded solids.
+    fn is_solid(&self) -> bool {
+        true
+    }
 
     /// The half-space's span of the whole line: a half-line, the whole line (parallel,
     /// inside) or nothing (parallel, outside). Infinite ends have a zero normal.
-    pub fn spans(&self, ray: &Ray, out: &mut Spans) {
+    fn spans(&self, ray: &Ray, out: &mut Spans) {
         if !(ray.org.is_finite() && ray.dir.is_finite()) || ray.dir == Vec3::ZERO {
             return;
         }
@@ -131,47 +145,24 @@ impl Plane {
     }
 
     /// Whether `p` is in the half-space `n·x ≤ d`.
-    pub fn contains(&self, p: Vec3) -> bool {
+    fn contains(&self, p: Vec3) -> bool {
         self.distance(p.as_dvec3()) <= 0.0
     }
-}
 
-impl Intersect for Plane {
-    fn bounds(&self) -> Aabb {
-        Aabb::INFINITE
-    }
-    #[inline]
-    fn intersect(&self, ray: &Ray) -> Option<ShapeHit> {
-        Plane::intersect(self, ray)
-    }
-    fn surface(&self, ray: &Ray, hit: &ShapeHit) -> SurfacePoint {
-        Plane::surface(self, ray, hit)
-    }
-}
-
-impl Solid for Plane {
-    fn spans(&self, ray: &Ray, out: &mut Spans) {
-        Plane::spans(self, ray, out)
-    }
-    fn contains(&self, p: Vec3) -> bool {
-        Plane::contains(self, p)
-    }
-}
-
-impl Primitive for Plane {
-    /// The half-space: unbounded, but usable to cut bounded solids.
-    fn is_solid(&self) -> bool {
-        true
-    }
-    fn spans(&self, ray: &Ray, out: &mut Spans) {
-        Solid::spans(self, ray, out)
-    }
-    fn contains(&self, p: Vec3) -> bool {
-        Solid::contains(self, p)
-    }
     /// The planar parameterisation about the normal ([`Param::planar`]).
     fn param(&self, p: Vec3, ng: Vec3) -> Param {
         Param::planar(p, ng)
+    }
+
+    /// Under any invertible map: a point of the plane moved, the normal by the inverse
+    /// transpose.
+    fn bake(&self, m: &DAffine3) -> Option<Shape> {
+        let n = self.normal().as_dvec3();
+        let point = m.transform_point3(n * self.offset());
+        let normal = m.matrix3.inverse().transpose() * n;
+        Plane::from_point_normal(point.as_vec3(), normal.as_vec3())
+            .ok()
+            .map(Shape::from)
     }
 }
 

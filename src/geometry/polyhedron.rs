@@ -11,8 +11,11 @@
 //! world origin keeps offsets of its own size and a ray starting near it evaluates them
 //! without cancellation.
 
-use super::{Intersect, Param, Primitive, ShapeError, ShapeHit, Solid, Span, Spans, SurfacePoint};
-use crate::math::{Aabb, DVec3, Ray, Vec3, gamma, next_float_down, next_float_up};
+use super::tessellate::{Lookup, Tessellation, oriented};
+use super::{Intersect, Param, Primitive, Shape, ShapeError, ShapeHit, Span, Spans, SurfacePoint};
+use crate::math::{Aabb, DVec3, Frame, Ray, Vec3, gamma, next_float_down, next_float_up};
+use glam::DAffine3;
+use std::sync::Arc;
 
 /// The most planes a polyhedron may have (validation enumerates plane triples).
 pub const MAX_PLANES: usize = 256;
@@ -563,7 +566,11 @@ impl Intersect for Polyhedron {
     }
 }
 
-impl Solid for Polyhedron {
+impl Primitive for Polyhedron {
+    fn is_solid(&self) -> bool {
+        true
+    }
+
     fn spans(&self, ray: &Ray, out: &mut Spans) {
         if let Some((t_in, i_in, t_out, i_out)) = self.stretch(ray) {
             out.push(Span {
@@ -579,21 +586,70 @@ impl Solid for Polyhedron {
         let o = p - self.origin();
         self.planes.iter().all(|pl| pl.n.dot(o) <= pl.d)
     }
-}
 
-impl Primitive for Polyhedron {
-    fn is_solid(&self) -> bool {
-        true
-    }
-    fn spans(&self, ray: &Ray, out: &mut Spans) {
-        Solid::spans(self, ray, out)
-    }
-    fn contains(&self, p: Vec3) -> bool {
-        Solid::contains(self, p)
-    }
     /// The planar parameterisation about the normal ([`Param::planar`]).
     fn param(&self, p: Vec3, ng: Vec3) -> Param {
         Param::planar(p, ng)
+    }
+
+    /// Under any invertible map: the half-spaces n·x ≤ d map to n'·y ≤ d + n'·t with
+    /// n' = M⁻ᵀn.
+    fn bake(&self, m: &DAffine3) -> Option<Shape> {
+        let inv_t = m.matrix3.inverse().transpose();
+        let planes = self
+            .world_planes()
+            .into_iter()
+            .map(|(n, d)| {
+                let n2 = inv_t * n;
+                (n2.as_vec3(), (d + n2.dot(m.translation)) as f32)
+            })
+            .collect();
+        Polyhedron::new(planes).ok().map(|p| Arc::new(p).into())
+    }
+
+    /// One face per plane that has at least three corners on it, exact.
+    fn tessellate(&self, _patch: f32) -> Option<Tessellation> {
+        let corners = self.vertices();
+        let size = corners
+            .iter()
+            .fold(0.0f64, |m, v| m.max((*v - corners[0]).length()));
+        let mut faces = Vec::new();
+        let mut planes = Vec::new();
+        for (n, d) in self.world_planes() {
+            let len = n.length();
+            let (n, d) = (n / len, d / len);
+            let on: Vec<_> = corners
+                .iter()
+                .filter(|v| (n.dot(**v) - d).abs() <= 1e-5 * size)
+                .collect();
+            if on.len() < 3 {
+                continue;
+            }
+            let centre = on.iter().copied().sum::<glam::DVec3>() / on.len() as f64;
+            let nf = Frame::from_z(n.as_vec3());
+            let (fx, fy) = (nf.x.as_dvec3(), nf.y.as_dvec3());
+            let mut ring: Vec<(f64, Vec3)> = on
+                .iter()
+                .map(|v| {
+                    let q = **v - centre;
+                    (q.dot(fy).atan2(q.dot(fx)), v.as_vec3())
+                })
+                .collect();
+            ring.sort_by(|a, b| a.0.total_cmp(&b.0));
+            let face = oriented(ring.into_iter().map(|x| x.1).collect(), n.as_vec3());
+            if face.is_empty() {
+                continue;
+            }
+            planes.push((n.as_vec3(), d as f32));
+            faces.push(face);
+        }
+        Some(Tessellation {
+            depth: vec![0.0; faces.len()],
+            faces,
+            lookup: Lookup::Planes(planes),
+            smooth: false,
+            open: false,
+        })
     }
 }
 

@@ -32,9 +32,10 @@
 //!
 //! Only the results (`t`, normals, points) are rounded to f32.
 
-use super::{Intersect, Param, Primitive, ShapeError, ShapeHit, Solid, Span, Spans, SurfacePoint};
+use super::{Intersect, Param, Primitive, Shape, ShapeError, ShapeHit, Span, Spans, SurfacePoint};
 use crate::math::{Aabb, DVec3, Ray, Vec3, next_float_down, next_float_up};
-use glam::DMat3;
+use glam::{DAffine3, DMat3, DMat4};
+use std::sync::Arc;
 
 /// `n·u / (1 − n·u)` with `u = 2⁻⁵³`: the relative error bound of `n` f64 operations.
 pub(super) const fn gamma64(n: u32) -> f64 {
@@ -329,7 +330,7 @@ impl LineRoots {
 /// numerics).
 ///
 /// The clip box keeps the part of the surface inside it (an open surface for
-/// [`Intersect`]); the solid is `{F ≤ 0} ∩ box`, so [`Solid::spans`] enters and leaves
+/// [`Intersect`]); the solid is `{F ≤ 0} ∩ box`, so [`Primitive::spans`] enters and leaves
 /// through the box faces where the box bounds it. `u` and `v` of hits are 0.
 #[derive(Clone, Copy, Debug, PartialEq)]
 pub struct Quadric {
@@ -481,12 +482,6 @@ impl Quadric {
     /// is finite, otherwise it is [`Aabb::INFINITE`].
     pub fn is_bounded(&self) -> bool {
         self.bounded
-    }
-
-    /// Conservative bounds: the clip box, intersected with the ellipsoid's exact box
-    /// (rounded outwards) for ellipsoids; [`Aabb::INFINITE`] when unbounded.
-    pub fn bounds(&self) -> Aabb {
-        self.bounds
     }
 
     /// The world-space coefficients `[a, b, c, d, e, f, g, h, i, j]`, up to the positive
@@ -744,9 +739,64 @@ impl Quadric {
         None
     }
 
+    /// The surface point for a span end on a face of the clip box: `ng` is that face's
+    /// normal (exactly `±x`, `±y` or `±z`, as [`Quadric::spans`] reports it) and the
+    /// point `o + t·d` is within the rounding of `t` of the face's plane.
+    fn cap_point(&self, ray: &Ray, t: f32, ng: Vec3) -> Option<SurfacePoint> {
+        let b = self.clip?;
+        let axis = (0..3).find(|&i| ng[i].abs() == 1.0)?;
+        if ng.length_squared() != 1.0 {
+            return None;
+        }
+        let face = if ng[axis] > 0.0 {
+            b.max[axis]
+        } else {
+            b.min[axis]
+        };
+        let pw = ray.org.as_dvec3() + ray.dir.as_dvec3() * t as f64;
+        let slack = (t.abs() * f32::EPSILON) as f64 * (ray.dir[axis] as f64).abs()
+            + gamma64(4) * (pw.abs().max_element() + ray.org.abs().max_element() as f64);
+        if !pw.is_finite() || (pw[axis] - face as f64).abs() > slack {
+            return None;
+        }
+        // On the face's plane exactly (its coordinate is an f32); the other coordinates
+        // are rounded once, and along the face that is all the error there is.
+        let mut p32 = pw.as_vec3();
+        p32[axis] = face;
+        Some(SurfacePoint {
+            p: p32,
+            err: rounding_err(p32, gamma64(4) * pw.abs().max_element()),
+            ng,
+        })
+    }
+}
+
+/// The coefficients of `α|p⊥|² + β(p·w)² + 2γ(p·w) + δ` (`p⊥` the part of `p`
+/// perpendicular to the unit axis `w`), i.e. `M = α(I − wwᵀ) + βwwᵀ`, `l = γw`.
+fn axial(w: DVec3, alpha: f64, beta: f64, gamma: f64, delta: f64) -> [f64; 10] {
+    let k = beta - alpha;
+    let m = DMat3::from_diagonal(DVec3::splat(alpha))
+        + DMat3::from_cols(w * (k * w.x), w * (k * w.y), w * (k * w.z));
+    pack(m, w * gamma, delta)
+}
+
+/// `[a, b, c, d, e, f, g, h, i, j]` from `M`, `l` and `j`.
+fn pack(m: DMat3, l: DVec3, j: f64) -> [f64; 10] {
+    [
+        m.x_axis.x, m.y_axis.y, m.z_axis.z, m.y_axis.x, m.z_axis.x, m.z_axis.y, l.x, l.y, l.z, j,
+    ]
+}
+
+impl Intersect for Quadric {
+    /// Conservative bounds: the clip box, intersected with the ellipsoid's exact box
+    /// (rounded outwards) for ellipsoids; [`Aabb::INFINITE`] when unbounded.
+    fn bounds(&self) -> Aabb {
+        self.bounds
+    }
+
     /// The nearest hit in `(ray.tmin, ray.tmax)`, from either side; `ng` is the unit
     /// gradient of `F` (outwards).
-    pub fn intersect(&self, ray: &Ray) -> Option<ShapeHit> {
+    fn intersect(&self, ray: &Ray) -> Option<ShapeHit> {
         let (t, p, d, exit) = self.first(ray)?;
         Some(ShapeHit {
             t,
@@ -757,7 +807,7 @@ impl Quadric {
     }
 
     /// Whether a hit lies in `(ray.tmin, ray.tmax)`.
-    pub fn occluded(&self, ray: &Ray) -> bool {
+    fn occluded(&self, ray: &Ray) -> bool {
         self.first(ray).is_some()
     }
 
@@ -769,7 +819,7 @@ impl Quadric {
     /// For a clipped quadric's span end on a box face (normal `±x`, `±y` or `±z`, as
     /// [`Quadric::spans`] reports them, and the point within the rounding of `t` of that
     /// face) the point is put on the face exactly instead.
-    pub fn surface(&self, ray: &Ray, hit: &ShapeHit) -> SurfacePoint {
+    fn surface(&self, ray: &Ray, hit: &ShapeHit) -> SurfacePoint {
         if let Some(sp) = self.cap_point(ray, hit.t, hit.ng) {
             return sp;
         }
@@ -877,40 +927,16 @@ impl Quadric {
             ng,
         }
     }
+}
 
-    /// The surface point for a span end on a face of the clip box: `ng` is that face's
-    /// normal (exactly `±x`, `±y` or `±z`, as [`Quadric::spans`] reports it) and the
-    /// point `o + t·d` is within the rounding of `t` of the face's plane.
-    fn cap_point(&self, ray: &Ray, t: f32, ng: Vec3) -> Option<SurfacePoint> {
-        let b = self.clip?;
-        let axis = (0..3).find(|&i| ng[i].abs() == 1.0)?;
-        if ng.length_squared() != 1.0 {
-            return None;
-        }
-        let face = if ng[axis] > 0.0 {
-            b.max[axis]
-        } else {
-            b.min[axis]
-        };
-        let pw = ray.org.as_dvec3() + ray.dir.as_dvec3() * t as f64;
-        let slack = (t.abs() * f32::EPSILON) as f64 * (ray.dir[axis] as f64).abs()
-            + gamma64(4) * (pw.abs().max_element() + ray.org.abs().max_element() as f64);
-        if !pw.is_finite() || (pw[axis] - face as f64).abs() > slack {
-            return None;
-        }
-        // On the face's plane exactly (its coordinate is an f32); the other coordinates
-        // are rounded once, and along the face that is all the error there is.
-        let mut p32 = pw.as_vec3();
-        p32[axis] = face;
-        Some(SurfacePoint {
-            p: p32,
-            err: rounding_err(p32, gamma64(4) * pw.abs().max_element()),
-            ng,
-        })
+impl Primitive for Quadric {
+    /// A solid where `{F ≤ 0}` is bounded (clipped, or an ellipsoid).
+    fn is_solid(&self) -> bool {
+        self.is_bounded()
     }
 
     /// The solid's spans along the whole line of `ray`.
-    pub fn spans(&self, ray: &Ray, out: &mut Spans) {
+    fn spans(&self, ray: &Ray, out: &mut Spans) {
         let Some(lr) = self.roots(ray) else {
             return;
         };
@@ -960,7 +986,7 @@ impl Quadric {
     }
 
     /// Whether `p` is inside the solid (`F(p) ≤ 0` and in the clip box).
-    pub fn contains(&self, p: Vec3) -> bool {
+    fn contains(&self, p: Vec3) -> bool {
         let pd = p.as_dvec3();
         let in_box = match &self.clip {
             Some(b) => box_contains(b, pd),
@@ -968,64 +994,44 @@ impl Quadric {
         };
         in_box && self.value(pd) <= 0.0
     }
-}
 
-/// The coefficients of `α|p⊥|² + β(p·w)² + 2γ(p·w) + δ` (`p⊥` the part of `p`
-/// perpendicular to the unit axis `w`), i.e. `M = α(I − wwᵀ) + βwwᵀ`, `l = γw`.
-fn axial(w: DVec3, alpha: f64, beta: f64, gamma: f64, delta: f64) -> [f64; 10] {
-    let k = beta - alpha;
-    let m = DMat3::from_diagonal(DVec3::splat(alpha))
-        + DMat3::from_cols(w * (k * w.x), w * (k * w.y), w * (k * w.z));
-    pack(m, w * gamma, delta)
-}
-
-/// `[a, b, c, d, e, f, g, h, i, j]` from `M`, `l` and `j`.
-fn pack(m: DMat3, l: DVec3, j: f64) -> [f64; 10] {
-    [
-        m.x_axis.x, m.y_axis.y, m.z_axis.z, m.y_axis.x, m.z_axis.x, m.z_axis.y, l.x, l.y, l.z, j,
-    ]
-}
-
-impl Intersect for Quadric {
-    fn bounds(&self) -> Aabb {
-        Quadric::bounds(self)
-    }
-    #[inline]
-    fn intersect(&self, ray: &Ray) -> Option<ShapeHit> {
-        Quadric::intersect(self, ray)
-    }
-    #[inline]
-    fn occluded(&self, ray: &Ray) -> bool {
-        Quadric::occluded(self, ray)
-    }
-    fn surface(&self, ray: &Ray, hit: &ShapeHit) -> SurfacePoint {
-        Quadric::surface(self, ray, hit)
-    }
-}
-
-impl Solid for Quadric {
-    fn spans(&self, ray: &Ray, out: &mut Spans) {
-        Quadric::spans(self, ray, out)
-    }
-    fn contains(&self, p: Vec3) -> bool {
-        Quadric::contains(self, p)
-    }
-}
-
-impl Primitive for Quadric {
-    /// A solid where `{F ≤ 0}` is bounded (clipped, or an ellipsoid).
-    fn is_solid(&self) -> bool {
-        self.is_bounded()
-    }
-    fn spans(&self, ray: &Ray, out: &mut Spans) {
-        Solid::spans(self, ray, out)
-    }
-    fn contains(&self, p: Vec3) -> bool {
-        Solid::contains(self, p)
-    }
     /// The planar parameterisation about the normal ([`Param::planar`]).
     fn param(&self, p: Vec3, ng: Vec3) -> Param {
         Param::planar(p, ng)
+    }
+
+    /// Unclipped, under any invertible map: F(L⁻¹(y − t)) about the origin t, the
+    /// coefficients through L⁻¹ alone. A clipped quadric does not bake (its clip box
+    /// would not stay a box).
+    fn bake(&self, m: &DAffine3) -> Option<Shape> {
+        if self.clip().is_some() {
+            return None;
+        }
+        let [a, b, c, d, e, f, g, h, i, j] = self.coefficients();
+        let qm =
+            DMat4::from_cols_array_2d(&[[a, d, e, g], [d, b, f, h], [e, f, c, i], [g, h, i, j]]);
+        let inv = DMat4::from_mat3(m.matrix3.inverse());
+        let r = inv.transpose() * qm * inv;
+        let k = |x: usize, y: usize| 0.5 * (r.col(x)[y] + r.col(y)[x]);
+        let coeffs = [
+            k(0, 0),
+            k(1, 1),
+            k(2, 2),
+            k(0, 1),
+            k(0, 2),
+            k(1, 2),
+            k(0, 3),
+            k(1, 3),
+            k(2, 3),
+            k(3, 3),
+        ];
+        let t = m.translation;
+        if !t.is_finite() {
+            return None;
+        }
+        Quadric::about(t.as_vec3(), coeffs, None)
+            .ok()
+            .map(|q| Arc::new(q).into())
     }
 }
 

@@ -30,9 +30,10 @@ use super::quadric::{
     aabb_out, check_finite, check_positive, gamma64, outward_or_dir, rounding_err, unit_axis,
     unit_f32,
 };
-use super::{Intersect, Param, Primitive, ShapeError, ShapeHit, Solid, Span, Spans, SurfacePoint};
-use crate::math::{Aabb, DVec3, Ray, Vec3};
-use glam::Vec2;
+use super::{Intersect, Param, Primitive, Shape, ShapeError, ShapeHit, Span, Spans, SurfacePoint};
+use crate::math::{Aabb, DVec3, Ray, Vec3, similarity_scale};
+use glam::{DAffine3, Vec2};
+use std::sync::Arc;
 use std::f64::consts::TAU;
 
 /// A torus around `axis` through `center`: the circle of radius `major` in the plane
@@ -129,12 +130,6 @@ impl Torus {
     /// `u = 1/4` along `y`.
     pub fn frame(&self) -> (Vec3, Vec3, Vec3) {
         (self.ex.as_vec3(), self.ey.as_vec3(), self.axis.as_vec3())
-    }
-
-    /// Conservative bounds: the box of the centre circle grown by the tube radius,
-    /// rounded outwards.
-    pub fn bounds(&self) -> Aabb {
-        self.bounds
     }
 
     /// `(ρ − R)² + z² − r²` at world point `p`: negative inside, positive outside.
@@ -302,17 +297,84 @@ impl Torus {
         }
         None
     }
+}
+
+/// `x` moved into `[0, 1)` by adding 1 to negative values.
+fn wrap01(x: f64) -> f32 {
+    let x = if x < 0.0 { x + 1.0 } else { x };
+    // Rounding of x + 1 for tiny negative x can give exactly 1.
+    let x = x as f32;
+    if x >= 1.0 { 0.0 } else { x }
+}
+
+/// The root of a function monotone on `[lo, hi]` whose values `f_lo`, `f_hi` at the two
+/// ends differ in sign, by safeguarded Newton iteration (`fun` returns the value and the
+/// derivative) from the regula falsi point: Newton steps while they stay inside the
+/// shrinking bracket and at least halve the step, bisection otherwise (Numerical
+/// Recipes' `rtsafe`). Stops once a step is below `tol` (absolute) or the bracket
+/// cannot shrink further.
+fn bracket_root(
+    fun: impl Fn(f64) -> (f64, f64),
+    (lo, hi): (f64, f64),
+    (f_lo, f_hi): (f64, f64),
+    tol: f64,
+) -> f64 {
+    let pos_lo = f_lo > 0.0;
+    let (mut lo, mut hi) = (lo, hi);
+    let guess = lo + (hi - lo) * (f_lo / (f_lo - f_hi));
+    let mut x = if guess > lo && guess < hi {
+        guess
+    } else {
+        0.5 * (lo + hi)
+    };
+    let mut dx_old = hi - lo;
+    let mut dx = dx_old;
+    let (mut fx, mut dfx) = fun(x);
+    for _ in 0..100 {
+        if fx == 0.0 {
+            return x;
+        }
+        if (fx > 0.0) == pos_lo {
+            lo = x;
+        } else {
+            hi = x;
+        }
+        let newton = x - fx / dfx;
+        let use_newton = newton > lo && newton < hi && (2.0 * fx).abs() <= (dx_old * dfx).abs();
+        dx_old = dx;
+        let x_new = if use_newton {
+            dx = fx / dfx;
+            newton
+        } else {
+            dx = 0.5 * (hi - lo);
+            lo + dx
+        };
+        if x_new == x || dx.abs() <= tol {
+            return x_new;
+        }
+        x = x_new;
+        (fx, dfx) = fun(x);
+    }
+    x
+}
+
+impl Intersect for Torus {
+    /// Conservative bounds: the box of the centre circle grown by the tube radius,
+    /// rounded outwards.
+    fn bounds(&self) -> Aabb {
+        self.bounds
+    }
 
     /// The nearest hit in `(ray.tmin, ray.tmax)`, from either side; `ng` is the unit
     /// outward normal.
-    pub fn intersect(&self, ray: &Ray) -> Option<ShapeHit> {
+    fn intersect(&self, ray: &Ray) -> Option<ShapeHit> {
         let (line, t, s, exit) = self.first(ray)?;
         let (ng, u, v) = self.at(&line, s, exit);
         Some(ShapeHit { t, u, v, ng })
     }
 
     /// Whether a hit lies in `(ray.tmin, ray.tmax)`.
-    pub fn occluded(&self, ray: &Ray) -> bool {
+    fn occluded(&self, ray: &Ray) -> bool {
         self.first(ray).is_some()
     }
 
@@ -321,7 +383,7 @@ impl Torus {
     /// point's meridian plane, or for a spindle torus whose projection would cross the
     /// axis to the cusp where the surface meets it), rounded to f32, with the bound of
     /// that rounding plus the f64 error.
-    pub fn surface(&self, ray: &Ray, hit: &ShapeHit) -> SurfacePoint {
+    fn surface(&self, ray: &Ray, hit: &ShapeHit) -> SurfacePoint {
         let d = ray.dir.as_dvec3();
         let p0 = ray.org.as_dvec3() + d * hit.t as f64;
         let p0 = if p0.is_finite() { p0 } else { self.center };
@@ -394,9 +456,15 @@ impl Torus {
             ng,
         }
     }
+}
+
+impl Primitive for Torus {
+    fn is_solid(&self) -> bool {
+        true
+    }
 
     /// The solid's spans along the whole line of `ray` (at most two).
-    pub fn spans(&self, ray: &Ray, out: &mut Spans) {
+    fn spans(&self, ray: &Ray, out: &mut Spans) {
         let Some(line) = self.line(ray) else {
             return;
         };
@@ -412,97 +480,12 @@ impl Torus {
     }
 
     /// Whether `p` is inside the solid.
-    pub fn contains(&self, p: Vec3) -> bool {
+    fn contains(&self, p: Vec3) -> bool {
         self.value(p.as_dvec3()) <= 0.0
     }
-}
 
-/// `x` moved into `[0, 1)` by adding 1 to negative values.
-fn wrap01(x: f64) -> f32 {
-    let x = if x < 0.0 { x + 1.0 } else { x };
-    // Rounding of x + 1 for tiny negative x can give exactly 1.
-    let x = x as f32;
-    if x >= 1.0 { 0.0 } else { x }
-}
-
-/// The root of a function monotone on `[lo, hi]` whose values `f_lo`, `f_hi` at the two
-/// ends differ in sign, by safeguarded Newton iteration (`fun` returns the value and the
-/// derivative) from the regula falsi point: Newton steps while they stay inside the
-/// shrinking bracket and at least halve the step, bisection otherwise (Numerical
-/// Recipes' `rtsafe`). Stops once a step is below `tol` (absolute) or the bracket
-/// cannot shrink further.
-fn bracket_root(
-    fun: impl Fn(f64) -> (f64, f64),
-    (lo, hi): (f64, f64),
-    (f_lo, f_hi): (f64, f64),
-    tol: f64,
-) -> f64 {
-    let pos_lo = f_lo > 0.0;
-    let (mut lo, mut hi) = (lo, hi);
-    let guess = lo + (hi - lo) * (f_lo / (f_lo - f_hi));
-    let mut x = if guess > lo && guess < hi {
-        guess
-    } else {
-        0.5 * (lo + hi)
-    };
-    let mut dx_old = hi - lo;
-    let mut dx = dx_old;
-    let (mut fx, mut dfx) = fun(x);
-    for _ in 0..100 {
-        if fx == 0.0 {
-            return x;
-        }
-        if (fx > 0.0) == pos_lo {
-            lo = x;
-        } else {
-            hi = x;
-        }
-        let newton = x - fx / dfx;
-        let use_newton = newton > lo && newton < hi && (2.0 * fx).abs() <= (dx_old * dfx).abs();
-        dx_old = dx;
-        let x_new = if use_newton {
-            dx = fx / dfx;
-            newton
-        } else {
-            dx = 0.5 * (hi - lo);
-            lo + dx
-        };
-        if x_new == x || dx.abs() <= tol {
-            return x_new;
-        }
-        x = x_new;
-        (fx, dfx) = fun(x);
-    }
-    x
-}
-
-impl Intersect for Torus {
-    fn bounds(&self) -> Aabb {
-        Torus::bounds(self)
-    }
-    fn intersect(&self, ray: &Ray) -> Option<ShapeHit> {
-        Torus::intersect(self, ray)
-    }
-    fn occluded(&self, ray: &Ray) -> bool {
-        Torus::occluded(self, ray)
-    }
-    fn surface(&self, ray: &Ray, hit: &ShapeHit) -> SurfacePoint {
-        Torus::surface(self, ray, hit)
-    }
-}
-
-impl Solid for Torus {
-    fn spans(&self, ray: &Ray, out: &mut Spans) {
-        Torus::spans(self, ray, out)
-    }
-    fn contains(&self, p: Vec3) -> bool {
-        Torus::contains(self, p)
-    }
-}
-
-impl Torus {
     /// The toroidal parameterisation at `p`.
-    pub fn param(&self, p: Vec3) -> Param {
+    fn param(&self, p: Vec3, _ng: Vec3) -> Param {
         let (ex, ey, a) = self.frame();
         let (big, small) = (self.major_radius(), self.minor_radius());
         let q = p - self.center();
@@ -520,20 +503,18 @@ impl Torus {
             dpdv: (a * cs - radial * ss) * (std::f32::consts::TAU * small),
         }
     }
-}
 
-impl Primitive for Torus {
-    fn is_solid(&self) -> bool {
-        true
-    }
-    fn spans(&self, ray: &Ray, out: &mut Spans) {
-        Solid::spans(self, ray, out)
-    }
-    fn contains(&self, p: Vec3) -> bool {
-        Solid::contains(self, p)
-    }
-    fn param(&self, p: Vec3, _ng: Vec3) -> Param {
-        Torus::param(self, p)
+    /// Under a similarity: the centre moved, the axis turned, the radii scaled.
+    fn bake(&self, m: &DAffine3) -> Option<Shape> {
+        let k = similarity_scale(m)?;
+        Torus::new(
+            m.transform_point3(self.center().as_dvec3()).as_vec3(),
+            (m.matrix3 * self.axis().as_dvec3()).as_vec3(),
+            (self.major_radius() as f64 * k) as f32,
+            (self.minor_radius() as f64 * k) as f32,
+        )
+        .ok()
+        .map(|t| Arc::new(t).into())
     }
 }
 

@@ -20,7 +20,7 @@
 use super::{LoadError, text};
 use crate::geometry::Kind;
 use crate::geometry::polygon::Triangulator;
-use crate::geometry::{Cone, Sphere, Triangle};
+use crate::geometry::{Cone, Intersect, Sphere, Triangle};
 use crate::math::{Aabb, DVec3, Vec3};
 use crate::scene::{Camera, Light, Material, Scene, default_light_intensity, range};
 use std::path::Path;

@@ -13,7 +13,7 @@ pub use aabb::Aabb;
 pub use glam::{DVec3, Vec3};
 pub use rng::Rng;
 pub use robust::{RayOrigins, gamma, gamma64, next_float_down, next_float_up, offset_ray_origin};
-pub use xform::{Xform, XformError};
+pub use xform::{Xform, XformError, similarity_scale};
 
 /// A ray with its valid parameter interval `[tmin, tmax]`.
 ///

@@ -2,7 +2,7 @@
 //! robust ray spawning needs (pbrt, 3rd ed., §3.9).
 
 use super::{Aabb, Ray, SurfacePoint, Vec3, gamma};
-use glam::{Affine3A, Mat3};
+use glam::{Affine3A, DAffine3, DMat3, DVec3, Mat3};
 
 /// Why a matrix is not a usable transform.
 #[derive(Clone, Copy, Debug, PartialEq, thiserror::Error)]
@@ -146,6 +146,24 @@ impl Xform {
     }
 }
 
+/// The uniform scale factor of `m` if its linear part is a rotation (or mirror) times
+/// that factor, to a relative 1e-6: a similarity, under which spheres, cones, tori and
+/// oriented boxes keep their kind.
+pub fn similarity_scale(m: &DAffine3) -> Option<f64> {
+    let l = m.matrix3;
+    let g = l.transpose() * l;
+    let s2 = (g.x_axis.x + g.y_axis.y + g.z_axis.z) / 3.0;
+    if !(s2 > 0.0 && s2.is_finite()) {
+        return None;
+    }
+    let dev = g - DMat3::from_diagonal(DVec3::splat(s2));
+    let worst = [dev.x_axis, dev.y_axis, dev.z_axis]
+        .iter()
+        .map(|c| c.abs().max_element())
+        .fold(0.0f64, f64::max);
+    (worst <= 1e-6 * s2).then(|| s2.sqrt())
+}
+
 #[cfg(test)]
 mod tests {
     use super::*;
@@ -231,5 +249,21 @@ mod tests {
             );
             assert!(w.contains(x.to_world.transform_point3(c)));
         }
+    }
+
+    #[test]
+    fn similarity_detection() {
+        let r = DAffine3::from_axis_angle(DVec3::new(1.0, 2.0, 3.0).normalize(), 0.7);
+        assert_eq!(similarity_scale(&r).map(|s| (s * 1e9).round()), Some(1e9));
+        let s = DAffine3::from_translation(DVec3::X) * DAffine3::from_scale(DVec3::splat(-2.5)) * r;
+        assert!((similarity_scale(&s).unwrap() - 2.5).abs() < 1e-12);
+        let ns = DAffine3::from_scale(DVec3::new(1.0, 2.0, 1.0)) * r;
+        assert_eq!(similarity_scale(&ns), None);
+        let shear = DAffine3::from_mat3(DMat3::from_cols(
+            DVec3::X,
+            DVec3::new(0.1, 1.0, 0.0),
+            DVec3::Z,
+        ));
+        assert_eq!(similarity_scale(&shear), None);
     }
 }

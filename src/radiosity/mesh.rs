@@ -9,9 +9,9 @@
 //! another element's edge, so that the display can interpolate them along that edge.
 
 use super::RadiosityError;
-use super::tessellate::{self, Lookup, Tessellation};
 use crate::accel::NO_INSTANCE;
-use crate::geometry::{Kind, Shape};
+use crate::geometry::tessellate::{self, Lookup, Tessellation};
+use crate::geometry::{Kind, Primitive};
 use crate::math::{Vec3, gamma};
 use crate::scene::{Geometry, INHERIT, Material, Scene};
 use std::collections::HashMap;
@@ -203,17 +203,9 @@ impl Mesh {
     fn add_shapes(&mut self, g: &Geometry, patch_size: f32) -> Result<usize, RadiosityError> {
         let mut unmeshed = 0;
         for entry in g.shapes() {
-            let t = match &entry.shape {
-                Shape::Sphere(s) => tessellate::sphere(s, patch_size),
-                Shape::Cone(c) => tessellate::cone(c, patch_size),
-                Shape::CappedCone(c) => tessellate::capped(c, patch_size),
-                Shape::Box(b) => tessellate::aabox(b),
-                Shape::OBox(b) => tessellate::obox(b),
-                Shape::Polyhedron(p) => tessellate::polyhedron(p),
-                _ => {
-                    unmeshed += 1;
-                    continue;
-                }
+            let Some(t) = entry.shape.tessellate(patch_size) else {
+                unmeshed += 1;
+                continue;
             };
             let id = (entry.kind, entry.prim as usize);
             self.add_shape(id, t, entry.material, patch_size)?;

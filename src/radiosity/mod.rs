@@ -18,13 +18,13 @@ pub(crate) mod formfactor;
 pub(crate) mod hemicube;
 pub(crate) mod mesh;
 pub(crate) mod solver;
-pub(crate) mod tessellate;
 
 #[cfg(test)]
 mod tests;
 
 use crate::accel::{Accel, AccelError, BackendOptions, Hit, WithAccel};
 use crate::geometry::Kind;
+/// The tessellation of analytic shapes the mesh starts from, in `geometry`.
 use crate::math::Vec3;
 use crate::render::color::srgb_encode;
 use crate::render::{Film, GlobalIllumination, gi};

@@ -10,13 +10,9 @@
 //! list at its static type (a [`KindVisitor`], as the backends do to build).
 
 use super::{Hit, PrimSources, Surface};
-use crate::geometry::{
-    AaBox, Analytic, CappedCone, Cone, Csg, Kind, OBox, Param, Plane, Polyhedron, QuadUv, Quadric,
-    Shape, ShapeHit, Sphere, Torus, Triangle, for_each_kind,
-};
+use crate::geometry::{Analytic, Kind, Param, QuadUv, Shape, ShapeHit, Triangle, for_each_kind};
 use crate::math::{Aabb, Ray, Vec3};
 use glam::Vec2;
-use std::sync::Arc;
 
 /// Primitives of one kind with a material index each.
 #[derive(Clone, Debug, PartialEq)]
@@ -87,8 +83,8 @@ pub struct ShapeEntry {
 
 /// Generates the store from the kinds table.
 macro_rules! define_store {
-    ($(($v:ident, $id:literal, $t:ty, $field:ident, $plural:literal, $singular:literal,
-        $doc:literal)),* $(,)?) => {
+    ($(($v:ident, $id:literal, $vis:vis mod $module:ident, $name:ident, $t:ty, $field:ident,
+        $plural:literal, $singular:literal, $doc:literal)),* $(,)?) => {
         /// Primitives: the top level of a scene, or an object that instances place.
         #[derive(Clone, Debug, Default, PartialEq)]
         pub struct Geometry {

@@ -3,7 +3,7 @@
 //! intersectors, intervals, occlusion, empty scenes, errors.
 
 use super::*;
-use crate::geometry::{Cone, Kind, ShapeHit, Sphere, Triangle};
+use crate::geometry::{Cone, Intersect, Kind, ShapeHit, Sphere, Triangle};
 use crate::math::Vec3;
 use crate::scene::{Camera, Material};
 

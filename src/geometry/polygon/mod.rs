@@ -16,13 +16,13 @@
 //! Cutting a polygon of `n` vertices costs `O(n)` when it is convex and, for a concave
 //! one, `O(n log n)` for polygons as they come (a worst case remains quadratic: a walk
 //! that finds no ear for long, on input that is not simple, or a vertex that many
-//! blockers in turn keep from being an ear). The parts: [`ring`] (the
-//! projected vertices, their links and the orientation tests), [`convex`] (the
+//! blockers in turn keep from being an ear). The parts: `ring` (the
+//! projected vertices, their links and the orientation tests), `convex` (the
 //! convexity check, and the straight vertices a convex polygon loses before it is cut),
-//! [`clip`] (the walk that cuts ears), [`shortcut`] (its jumps past vertices where it
-//! has nothing to do, with the [`witness`]es that show a convex vertex is not an ear),
-//! [`blockers`] (the ear test, from an index of the reflex and flat vertices, the only
-//! ones that can fail it) and [`tree`] (that index's spatial structure).
+//! `clip` (the walk that cuts ears), `shortcut` (its jumps past vertices where it
+//! has nothing to do, with the `witness`es that show a convex vertex is not an ear),
+//! `blockers` (the ear test, from an index of the reflex and flat vertices, the only
+//! ones that can fail it) and `tree` (that index's spatial structure).
 //!
 //! The triangles are exactly those of the plain quadratic ear clipper this replaced, so
 //! that scenes render as they did (the tests compare the two), but for a convex polygon

@@ -4,7 +4,6 @@
 //! tree); each may give its own material and transform.
 
 use super::super::format::{ObjectDef, Spanned};
-use super::bake::bake;
 use super::objects::Sink;
 use super::objects::split_translation;
 use super::types::Ty;
@@ -140,7 +139,7 @@ impl<'a> Builder<'a, '_> {
         let leaf = |shape| CsgTree::Leaf { shape, material };
         if rel == DAffine3::IDENTITY {
             Ok(leaf(shape))
-        } else if let Some(baked) = bake(&shape, &rel) {
+        } else if let Some(baked) = shape.bake(&rel) {
             Ok(leaf(baked))
         } else {
             let xform = self.check_invertible(&rel, span)?;

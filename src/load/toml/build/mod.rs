@@ -5,8 +5,12 @@
 //! Placement rules (the scene has exactly one level of instancing):
 //! - triangles (`triangle`, `polygon`, `mesh`, included files) are transformed into
 //!   their final coordinates (baked);
-//! - an analytic primitive under a similarity (rotation, uniform scale, translation,
-//!   mirror) whose shape stays of its kind (spheres, NFF cones) is baked too;
+//! - an analytic primitive under a transform that its kind can absorb exactly is baked
+//!   too, rewritten as a primitive of its kind in final coordinates
+//!   ([`Primitive::bake`](crate::geometry::Primitive::bake)): spheres, cones, oriented
+//!   boxes, capped cones and tori under similarities (rotation, uniform scale,
+//!   translation, mirror), axis-aligned boxes under diagonal linear parts, polyhedra,
+//!   unclipped quadrics and planes under any invertible transform, CSG solids never;
 //! - any other analytic primitive under a non-identity transform becomes, at the top
 //!   level, an object of its own placed by an instance; inside a `define` (which is
 //!   itself an object), a closed solid is wrapped in a one-leaf CSG with a
@@ -20,7 +24,6 @@
 //! folder builds one part of the scene (its own notes say which), and `shapes/` has one
 //! file per analytic object type.
 
-mod bake;
 mod bezier;
 mod camera;
 mod csg;

@@ -4,7 +4,6 @@
 //! [module notes](super)), and refusing what lands outside the range emray traces.
 
 use super::super::format::{ObjectDef, Spanned};
-use super::bake::bake;
 use super::shapes::At;
 use super::types::Ty;
 use super::{Builder, R, article};
@@ -214,7 +213,7 @@ impl<'a> Builder<'a, '_> {
             Self::geometry(&mut self.geometry, sink).add_shape(shape, material);
             return Ok(());
         }
-        if let Some(baked) = bake(&shape, x) {
+        if let Some(baked) = shape.bake(x) {
             Self::geometry(&mut self.geometry, sink).add_shape(baked, material);
             return Ok(());
         }

@@ -1,7 +1,6 @@
 //! Transforms: the steps of a `transform` list (`translate`, `rotate`, `scale`,
 //! `mirror`, `matrix`) composed into one affine map, checked to be invertible in the single
-//! precision the renderer uses, and the test for a similarity (rotation, mirror and
-//! uniform scale), under which some primitives keep their kind.
+//! precision the renderer uses.
 
 use super::super::format::{
     MirrorDef, ObjectDef, Real, Scale, Spanned, TransformList, TransformStep,
@@ -14,23 +13,6 @@ use std::ops::Range;
 /// `m` in single precision.
 fn affine_f32(m: &DAffine3) -> Affine3A {
     Affine3A::from_mat3_translation(m.matrix3.as_mat3(), m.translation.as_vec3())
-}
-
-/// The uniform scale factor of `m` if its linear part is a rotation (or mirror) times
-/// that factor, to a relative 1e-6.
-pub(super) fn similarity_scale(m: &DAffine3) -> Option<f64> {
-    let l = m.matrix3;
-    let g = l.transpose() * l;
-    let s2 = (g.x_axis.x + g.y_axis.y + g.z_axis.z) / 3.0;
-    if !(s2 > 0.0 && s2.is_finite()) {
-        return None;
-    }
-    let dev = g - DMat3::from_diagonal(DVec3::splat(s2));
-    let worst = [dev.x_axis, dev.y_axis, dev.z_axis]
-        .iter()
-        .map(|c| c.abs().max_element())
-        .fold(0.0f64, f64::max);
-    (worst <= 1e-6 * s2).then(|| s2.sqrt())
 }
 
 impl Builder<'_, '_> {
@@ -159,26 +141,5 @@ impl Builder<'_, '_> {
             Some(t) => self.transform_list(t),
             None => Ok(DAffine3::IDENTITY),
         }
-    }
-}
-
-#[cfg(test)]
-mod tests {
-    use super::*;
-
-    #[test]
-    fn similarity_detection() {
-        let r = DAffine3::from_axis_angle(DVec3::new(1.0, 2.0, 3.0).normalize(), 0.7);
-        assert_eq!(similarity_scale(&r).map(|s| (s * 1e9).round()), Some(1e9));
-        let s = DAffine3::from_translation(DVec3::X) * DAffine3::from_scale(DVec3::splat(-2.5)) * r;
-        assert!((similarity_scale(&s).unwrap() - 2.5).abs() < 1e-12);
-        let ns = DAffine3::from_scale(DVec3::new(1.0, 2.0, 1.0)) * r;
-        assert_eq!(similarity_scale(&ns), None);
-        let shear = DAffine3::from_mat3(DMat3::from_cols(
-            DVec3::X,
-            DVec3::new(0.1, 1.0, 0.0),
-            DVec3::Z,
-        ));
-        assert_eq!(similarity_scale(&shear), None);
     }
 }

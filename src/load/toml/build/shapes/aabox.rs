@@ -10,6 +10,8 @@ pub(super) const TYPE: AnalyticType = AnalyticType {
     name: "box",
     keys: &["min", "max"],
     build,
+    #[cfg(test)]
+    example: "min = [0, 0, 0]\nmax = [1, 1, 1]",
 };
 
 fn build(b: &Builder<'_, '_>, node: &Spanned<ObjectDef>, ty: Ty, at: At) -> R<Shape> {

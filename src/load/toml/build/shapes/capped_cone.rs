@@ -14,6 +14,8 @@ pub(super) const TYPE: AnalyticType = AnalyticType {
     name: "capped_cone",
     keys: &["base", "axis", "height", "base_radius", "top_radius"],
     build,
+    #[cfg(test)]
+    example: "base = [0, 0, 0]\naxis = [0, 1, 0]\nheight = 1\nbase_radius = 1\ntop_radius = 0.5",
 };
 
 fn build(b: &Builder<'_, '_>, node: &Spanned<ObjectDef>, ty: Ty, at: At) -> R<Shape> {

@@ -11,6 +11,8 @@ pub(super) const TYPE: AnalyticType = AnalyticType {
     name: "cone",
     keys: &["base", "base_radius", "apex", "apex_radius"],
     build,
+    #[cfg(test)]
+    example: "base = [0, 0, 0]\nbase_radius = 1\napex = [0, 1, 0]",
 };
 
 fn build(b: &Builder<'_, '_>, node: &Spanned<ObjectDef>, ty: Ty, at: At) -> R<Shape> {

@@ -12,6 +12,8 @@ pub(super) const TYPE: AnalyticType = AnalyticType {
     name: "cylinder",
     keys: &["base", "axis", "height", "radius"],
     build,
+    #[cfg(test)]
+    example: "base = [0, 0, 0]\naxis = [0, 1, 0]\nheight = 1\nradius = 1",
 };
 
 fn build(b: &Builder<'_, '_>, node: &Spanned<ObjectDef>, ty: Ty, at: At) -> R<Shape> {

@@ -2,12 +2,11 @@
 //! and its orientation, a `rotation` (a transform list of rotations) or three `axes`.
 
 use super::super::super::format::{ObjectDef, Spanned, TransformList};
-use super::super::transforms::similarity_scale;
 use super::super::types::Ty;
 use super::super::{Builder, R, f32v, v3};
 use super::{AnalyticType, At, from_constructor};
 use crate::geometry::{OBox, Shape};
-use crate::math::Vec3;
+use crate::math::{Vec3, similarity_scale};
 use glam::{DQuat, DVec3, Quat};
 use std::sync::Arc;
 
@@ -15,6 +14,8 @@ pub(super) const TYPE: AnalyticType = AnalyticType {
     name: "obox",
     keys: &["center", "size", "half_size", "rotation", "axes"],
     build,
+    #[cfg(test)]
+    example: "center = [0, 0, 0]\nsize = [1, 2, 3]",
 };
 
 fn build(b: &Builder<'_, '_>, node: &Spanned<ObjectDef>, ty: Ty, at: At) -> R<Shape> {

@@ -10,6 +10,8 @@ pub(super) const TYPE: AnalyticType = AnalyticType {
     name: "plane",
     keys: &["point", "normal"],
     build,
+    #[cfg(test)]
+    example: "point = [0, 0, 0]\nnormal = [0, 1, 0]",
 };
 
 fn build(b: &Builder<'_, '_>, node: &Spanned<ObjectDef>, ty: Ty, at: At) -> R<Shape> {

@@ -16,6 +16,8 @@ pub(super) const TYPE: AnalyticType = AnalyticType {
     name: "polyhedron",
     keys: &["planes", "preset", "center", "radius", "sides", "height"],
     build,
+    #[cfg(test)]
+    example: "preset = \"octahedron\"\nradius = 1",
 };
 
 fn build(b: &Builder<'_, '_>, node: &Spanned<ObjectDef>, ty: Ty, at: At) -> R<Shape> {

@@ -13,6 +13,8 @@ pub(super) const TYPE: AnalyticType = AnalyticType {
     name: "quadric",
     keys: &["coefficients", "clip"],
     build,
+    #[cfg(test)]
+    example: "coefficients = [1, 1, 1, 0, 0, 0, 0, 0, 0, -1]",
 };
 
 fn build(b: &Builder<'_, '_>, node: &Spanned<ObjectDef>, ty: Ty, at: At) -> R<Shape> {

@@ -10,6 +10,8 @@ pub(super) const TYPE: AnalyticType = AnalyticType {
     name: "sphere",
     keys: &["center", "radius"],
     build,
+    #[cfg(test)]
+    example: "center = [0, 0, 0]\nradius = 1",
 };
 
 fn build(b: &Builder<'_, '_>, node: &Spanned<ObjectDef>, ty: Ty, at: At) -> R<Shape> {

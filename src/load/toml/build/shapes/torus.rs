@@ -16,6 +16,8 @@ pub(super) const TYPE: AnalyticType = AnalyticType {
     name: "torus",
     keys: &["center", "axis", "major_radius", "minor_radius"],
     build,
+    #[cfg(test)]
+    example: "center = [0, 0, 0]\naxis = [0, 1, 0]\nmajor_radius = 2\nminor_radius = 0.5",
 };
 
 fn build(b: &Builder<'_, '_>, node: &Spanned<ObjectDef>, ty: Ty, at: At) -> R<Shape> {

@@ -1,23 +1,24 @@
-//! Tessellation of analytic shapes for the radiosity pass.
+//! Tessellation of analytic shapes, for the radiosity pass: what
+//! [`Primitive::tessellate`](super::Primitive::tessellate) returns, and the tools each
+//! kind builds it with in its own file.
 //!
 //! Spheres, open and capped cones and cylinders, axis-aligned and oriented boxes and
 //! convex polyhedra become convex planar faces (counterclockwise seen from their front,
-//! the outside, or the inside for an inside-only sphere or cone); the mesh splits each
-//! face into a fan of source triangles and meshes those like any other triangle. The
-//! curved surfaces use a grid whose cells are about one patch across: latitude ×
-//! longitude on a sphere (y up, as its texture parameterisation), angle × height on a
-//! cone. Their faces are inscribed in the true surface; each face records how far it
-//! lies inside it at most ([`Tessellation::depth`]), and the visibility rays of its
-//! elements start that far out, so that the true surface does not shadow its own
-//! elements. CSG, quadrics, planes and tori are not tessellated: they only occlude
-//! (ray casting) and are shaded by the Whitted renderer.
+//! the outside, or the inside for an inside-only sphere or cone); the radiosity mesh
+//! splits each face into a fan of source triangles and meshes those like any other
+//! triangle. The curved surfaces use a grid whose cells are about one patch across:
+//! latitude × longitude on a sphere (y up, as its texture parameterisation), angle ×
+//! height on a cone (`revolution`). Their faces are inscribed in the true surface;
+//! each face records how far it lies inside it at most ([`Tessellation::depth`]), and
+//! the visibility rays of its elements start that far out, so that the true surface
+//! does not shadow its own elements. CSG, quadrics, planes and tori are not tessellated:
+//! they only occlude (ray casting) and are shaded by the Whitted renderer.
 //!
 //! The display maps a hit on the true surface back to its element: [`Lookup`] finds the
 //! face from the hit point (grid cell, cap, or nearest plane), the face's fan triangle
 //! that best contains the point's projection gives barycentric coordinates, and the
 //! triangle's quadtree gives the element and the Gouraud-interpolated radiosity there.
 
-use crate::geometry::{AaBox, CappedCone, Cone, OBox, Polyhedron, Sphere};
 use crate::math::{Frame, Vec3};
 use std::f32::consts::{PI, TAU};
 
@@ -133,7 +134,7 @@ pub struct Tessellation {
 
 /// Cells along a length `len` for patches of `patch`, at least `min` (for the shape's
 /// geometric accuracy) and at most `max`.
-fn cells(len: f32, patch: f32, min: u32, max: u32) -> u32 {
+pub(super) fn cells(len: f32, patch: f32, min: u32, max: u32) -> u32 {
     let n = (len / patch).ceil();
     if n.is_finite() {
         (n as u32).clamp(min, max)
@@ -144,7 +145,7 @@ fn cells(len: f32, patch: f32, min: u32, max: u32) -> u32 {
 
 /// Orient `poly` counterclockwise about `front` and drop repeated corners (poles and
 /// apices); empty when fewer than three corners remain.
-fn oriented(mut poly: Vec<Vec3>, front: Vec3) -> Vec<Vec3> {
+pub(super) fn oriented(mut poly: Vec<Vec3>, front: Vec3) -> Vec<Vec3> {
     poly.dedup();
     while poly.len() > 1 && poly.first() == poly.last() {
         poly.pop();
@@ -169,7 +170,7 @@ pub fn newell(poly: &[Vec3]) -> Vec3 {
 }
 
 /// Reverse every face when the inside is the front.
-fn flip(faces: &mut [Vec<Vec3>], inside: bool) {
+pub(super) fn flip(faces: &mut [Vec<Vec3>], inside: bool) {
     if inside {
         for f in faces {
             f.reverse();
@@ -177,59 +178,9 @@ fn flip(faces: &mut [Vec<Vec3>], inside: bool) {
     }
 }
 
-/// A sphere on a latitude–longitude grid of cells about `patch` across (at least
-/// 16 × 8).
-pub fn sphere(s: &Sphere, patch: f32) -> Tessellation {
-    let r = s.radius.abs();
-    let nu = cells(TAU * r, patch, 16, 256);
-    let nv = cells(PI * r, patch, 8, 128);
-    // Grid points, the seam and the poles computed once so shared corners are equal.
-    let point = |i: u32, j: u32| -> Vec3 {
-        if j == 0 {
-            return s.center - Vec3::Y * r;
-        }
-        if j == nv {
-            return s.center + Vec3::Y * r;
-        }
-        let theta = PI * (1.0 - j as f32 / nv as f32);
-        let phi = TAU * (i % nu) as f32 / nu as f32;
-        let (st, ct) = theta.sin_cos();
-        let (sp, cp) = phi.sin_cos();
-        s.center + Vec3::new(st * sp, ct, st * cp) * r
-    };
-    let mut faces = Vec::new();
-    let mut depth = Vec::new();
-    for j in 0..nv {
-        for i in 0..nu {
-            let poly = vec![
-                point(i, j),
-                point(i + 1, j),
-                point(i + 1, j + 1),
-                point(i, j + 1),
-            ];
-            let mid = poly.iter().copied().sum::<Vec3>() / 4.0 - s.center;
-            let f = oriented(poly, mid);
-            depth.push(inscribed_depth(&f, s.center, r));
-            faces.push(f);
-        }
-    }
-    flip(&mut faces, s.inside_only);
-    Tessellation {
-        faces,
-        depth,
-        lookup: Lookup::Sphere {
-            center: s.center,
-            nu,
-            nv,
-        },
-        smooth: true,
-        open: false,
-    }
-}
-
 /// How far a face inscribed in the sphere of centre `c` and radius `r` lies inside it
 /// at most.
-fn inscribed_depth(face: &[Vec3], c: Vec3, r: f32) -> f32 {
+pub(super) fn inscribed_depth(face: &[Vec3], c: Vec3, r: f32) -> f32 {
     if face.len() < 3 {
         return 0.0;
     }
@@ -239,7 +190,7 @@ fn inscribed_depth(face: &[Vec3], c: Vec3, r: f32) -> f32 {
 
 /// A surface of revolution: base centre, unit axis, height, end radii; cells about
 /// `patch` across (at least 16 around), with the two caps when `caps`.
-fn revolution(
+pub(super) fn revolution(
     base: Vec3,
     axis: Vec3,
     height: f32,
@@ -301,34 +252,8 @@ fn revolution(
     }
 }
 
-/// An open cone or cylinder (its outside, or its inside when only that is visible).
-pub fn cone(c: &Cone, patch: f32) -> Tessellation {
-    let mut t = revolution(
-        c.base,
-        c.axis(),
-        c.height(),
-        (c.base_radius.abs(), c.apex_radius.abs()),
-        patch,
-        false,
-    );
-    flip(&mut t.faces, c.inside_only);
-    t
-}
-
-/// A capped cone or cylinder.
-pub fn capped(c: &CappedCone, patch: f32) -> Tessellation {
-    revolution(
-        c.base(),
-        c.axis(),
-        c.height(),
-        (c.base_radius(), c.top_radius()),
-        patch,
-        true,
-    )
-}
-
 /// A box with centre `c`, half extents `half` along the unit axes `axes`.
-fn boxed(c: Vec3, half: Vec3, axes: [Vec3; 3]) -> Tessellation {
+pub(super) fn boxed(c: Vec3, half: Vec3, axes: [Vec3; 3]) -> Tessellation {
     let mut faces = Vec::new();
     let mut planes = Vec::new();
     for k in 0..3 {
@@ -346,65 +271,6 @@ fn boxed(c: Vec3, half: Vec3, axes: [Vec3; 3]) -> Tessellation {
             planes.push((n, n.dot(centre)));
             faces.push(oriented(poly, n));
         }
-    }
-    Tessellation {
-        depth: vec![0.0; faces.len()],
-        faces,
-        lookup: Lookup::Planes(planes),
-        smooth: false,
-        open: false,
-    }
-}
-
-/// An axis-aligned box.
-pub fn aabox(b: &AaBox) -> Tessellation {
-    boxed(
-        (b.min() + b.max()) * 0.5,
-        (b.max() - b.min()) * 0.5,
-        [Vec3::X, Vec3::Y, Vec3::Z],
-    )
-}
-
-/// An oriented box.
-pub fn obox(b: &OBox) -> Tessellation {
-    boxed(b.center(), b.half_extents(), b.axes())
-}
-
-/// A convex polyhedron: one face per plane that has at least three corners on it.
-pub fn polyhedron(p: &Polyhedron) -> Tessellation {
-    let corners = p.vertices();
-    let size = corners
-        .iter()
-        .fold(0.0f64, |m, v| m.max((*v - corners[0]).length()));
-    let mut faces = Vec::new();
-    let mut planes = Vec::new();
-    for (n, d) in p.world_planes() {
-        let len = n.length();
-        let (n, d) = (n / len, d / len);
-        let on: Vec<_> = corners
-            .iter()
-            .filter(|v| (n.dot(**v) - d).abs() <= 1e-5 * size)
-            .collect();
-        if on.len() < 3 {
-            continue;
-        }
-        let centre = on.iter().copied().sum::<glam::DVec3>() / on.len() as f64;
-        let nf = Frame::from_z(n.as_vec3());
-        let (fx, fy) = (nf.x.as_dvec3(), nf.y.as_dvec3());
-        let mut ring: Vec<(f64, Vec3)> = on
-            .iter()
-            .map(|v| {
-                let q = **v - centre;
-                (q.dot(fy).atan2(q.dot(fx)), v.as_vec3())
-            })
-            .collect();
-        ring.sort_by(|a, b| a.0.total_cmp(&b.0));
-        let face = oriented(ring.into_iter().map(|x| x.1).collect(), n.as_vec3());
-        if face.is_empty() {
-            continue;
-        }
-        planes.push((n.as_vec3(), d as f32));
-        faces.push(face);
     }
     Tessellation {
         depth: vec![0.0; faces.len()],
@@ -444,6 +310,7 @@ pub fn clamp_barycentric(u: f32, v: f32) -> (f32, f32) {
 #[cfg(test)]
 mod tests {
     use super::*;
+    use crate::geometry::{AaBox, CappedCone, Polyhedron, Primitive, Sphere};
 
     fn check_closed(t: &Tessellation, inside: impl Fn(Vec3) -> Vec3) {
         // Every face is planar, convex-ordered and faces away from the inside point.
@@ -465,15 +332,15 @@ mod tests {
     #[test]
     fn closed_shapes_are_closed_and_face_out() {
         let s = Sphere::new(Vec3::new(1.0, 2.0, 3.0), 0.5);
-        check_closed(&sphere(&s, 0.1), |_| s.center);
+        check_closed(&s.tessellate(0.1).unwrap(), |_| s.center);
         let c = CappedCone::new(Vec3::ZERO, Vec3::new(0.0, 1.0, 1.0), 2.0, 0.5, 0.2).unwrap();
-        check_closed(&capped(&c, 0.3), |p| {
+        check_closed(&c.tessellate(0.3).unwrap(), |p| {
             c.base() + c.axis() * (p - c.base()).dot(c.axis())
         });
         let b = AaBox::new(Vec3::ZERO, Vec3::new(1.0, 2.0, 3.0)).unwrap();
-        check_closed(&aabox(&b), |_| Vec3::new(0.5, 1.0, 1.5));
+        check_closed(&b.tessellate(1.0).unwrap(), |_| Vec3::new(0.5, 1.0, 1.5));
         let p = Polyhedron::preset("icosahedron", Vec3::ONE, 1.0).unwrap();
-        let t = polyhedron(&p);
+        let t = p.tessellate(1.0).unwrap();
         assert_eq!(t.faces.len(), 20);
         check_closed(&t, |_| Vec3::ONE);
     }
@@ -481,7 +348,7 @@ mod tests {
     #[test]
     fn lookup_finds_the_face_under_a_surface_point() {
         let s = Sphere::new(Vec3::ZERO, 2.0);
-        let t = sphere(&s, 0.3);
+        let t = s.tessellate(0.3).unwrap();
         for k in 0..50 {
             let (a, b) = (k as f32 * 0.37, k as f32 * 0.11 - 2.5);
             let dir = Vec3::new(a.cos() * b.cos(), b.sin(), a.sin() * b.cos());
