@@ -42,12 +42,13 @@
 //! structure over it ([`Accel`]: Embree or the BVH, chosen by [`Backend`]), [`render`]
 //! traces rays through that structure and [`output`] writes the film; [`radiosity`] is
 //! the diffuse second pass and [`spd`] the Standard Procedural Databases. [`batch`],
-//! [`bench`](mod@bench) and [`quality`] are the engines of `emray batch`, `emray bench` and
+//! [`bench`](mod@bench) and [`accuracy`] are the engines of `emray batch`, `emray bench` and
 //! `emray compare`, `stress` and `study`.
 #![deny(unsafe_code)]
 #![warn(missing_docs)]
 
 pub mod accel;
+pub mod accuracy;
 pub mod batch;
 pub mod bench;
 pub mod geometry;
@@ -55,7 +56,6 @@ pub mod job;
 pub mod load;
 pub mod math;
 pub mod output;
-pub mod quality;
 pub mod radiosity;
 pub mod render;
 pub mod scene;

@@ -2,7 +2,7 @@
 //! grazing, from inside, tiny and huge sizes, far from the origin. Plus the robustness
 //! of spawned rays: a ray leaving a surface never re-hits it.
 
-use emray::geometry::{Cone, Intersect, Sphere, Triangle, reference};
+use emray::geometry::{Cone, Intersect, Sphere, Triangle, precise};
 use emray::math::{DRay, DVec3, Ray, Vec3, offset_ray_origin};
 use proptest::prelude::*;
 
@@ -64,7 +64,7 @@ proptest! {
         let ray = Ray::new(org, dir);
         let got = s.intersect(&ray);
         let dr = DRay::from(&ray);
-        let want = reference::sphere(&dr, center.as_dvec3(), radius as f64, neg, 0.0);
+        let want = precise::sphere(&dr, center.as_dvec3(), radius as f64, neg, 0.0);
         // Conditioning: squared distance from the centre to the line, relative to r².
         let f = dr.org - center.as_dvec3();
         let l = f - dr.dir * (f.dot(dr.dir) / dr.dir.dot(dr.dir));
@@ -112,7 +112,7 @@ proptest! {
         let ray = Ray::new(org, dir);
         let got = c.intersect(&ray);
         let dr = DRay::from(&ray);
-        let want = reference::cone(&dr, base.as_dvec3(), (rb * scale) as f64, apex.as_dvec3(),
+        let want = precise::cone(&dr, base.as_dvec3(), (rb * scale) as f64, apex.as_dvec3(),
             (ra * scale) as f64, neg, 0.0);
         let scale_d = ((dr.org - base.as_dvec3()).length() + (h * scale) as f64 + (rb.max(ra) * scale) as f64)
             / dr.dir.length();
@@ -173,7 +173,7 @@ proptest! {
         let ray = Ray::new(org, (target - org).normalize_or(Vec3::Z));
         let got = tri.intersect(&ray);
         let dr = DRay::from(&ray);
-        let want = reference::triangle(&dr, p.map(|q| q.as_dvec3()), 0.0);
+        let want = precise::triangle(&dr, p.map(|q| q.as_dvec3()), 0.0);
         let scale_d = scale as f64 * 5.0;
         match (got, want) {
             (Some(g), Some((wt, wu, wv))) => {
@@ -271,7 +271,7 @@ fn cylinder_and_cone_analytic() {
     let side = Vec3::new(-1.0, 0.0, 1.0).normalize();
     let org = Vec3::new(2.0, 0.0, -1.0) + Vec3::new(0.1, 0.0, 0.1);
     let got = k.intersect(&Ray::new(org, side));
-    let want = reference::cone(
+    let want = precise::cone(
         &DRay {
             org: org.as_dvec3(),
             dir: side.as_dvec3(),

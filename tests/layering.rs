@@ -59,7 +59,7 @@ const LAYERS: &[(&str, &[&str])] = &[
         ],
     ),
     (
-        "quality",
+        "accuracy",
         &[
             "math", "geometry", "scene", "spd", "load", "accel", "render", "output", "job",
         ],
@@ -258,7 +258,7 @@ fn the_architecture_doc_lists_the_same_layers() {
         "{ARCHITECTURE}: the layer table's rows"
     );
     // "all of the above" means the modules of the rows above that are not drivers.
-    let stages = ["job", "batch", "bench", "quality"];
+    let stages = ["job", "batch", "bench", "accuracy"];
     let mut above: Vec<String> = Vec::new();
     for ((module, cell), (want_module, want)) in rows.iter().zip(LAYERS) {
         assert_eq!(

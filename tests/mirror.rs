@@ -4,8 +4,8 @@
 //! refraction enters and leaves where it should.
 
 use emray::accel::Backend;
+use emray::accuracy::stress::invariance_of;
 use emray::job::render_scene;
-use emray::quality::stress::invariance_of;
 use emray::render::{Film, RenderSettings};
 use glam::DVec3;
 use std::path::Path;

@@ -1100,7 +1100,7 @@ fn the_frame_is_the_eye_and_far_scenes_keep_their_detail() {
         resolution 8 8\nl 3 -2 5\ns 0.3 0.2 0.1 0.7\nc 0 0 0 0.2 0 0 1 0.1\n\
         p 3 0 0 0 1 0 0 0 1 0.3\n";
     let shift = glam::DVec3::new(1e6, -1e6, 1e6);
-    let far = emray::quality::moved::move_nff(near, 1.0, shift).unwrap();
+    let far = emray::accuracy::moved::move_nff(near, 1.0, shift).unwrap();
     let a = parse_str(near, Path::new("near.nff")).unwrap();
     let b = parse_str(&far, Path::new("far.nff")).unwrap();
     assert_eq!(a.origin, glam::DVec3::new(0.1, -5.3, 1.7));

@@ -1,5 +1,5 @@
 //! Quadrics, planes and tori against their independent f64 references
-//! (`reference::quadric`: the homogeneous form solved directly; `reference::torus`: dense
+//! (`precise::quadric`: the homogeneous form solved directly; `precise::torus`: dense
 //! sampling of the implicit function and bisection), on random placements across twelve
 //! orders of magnitude, plus analytic cases and the robustness of spawned rays.
 //!
@@ -17,7 +17,7 @@
 //! * `surface()`: the true surface point lies within `err`, and `err` is at most
 //!   `ERR_ULPS` ulps of the point's largest coordinate.
 
-use emray::geometry::reference::{quadric as rq, torus as rt};
+use emray::geometry::precise::{quadric as rq, torus as rt};
 use emray::geometry::{Intersect, Plane, Primitive, Quadric, ShapeHit, Spans, Sphere, Torus};
 use emray::math::{Aabb, DRay, DVec3, Ray, Vec3, offset_ray_origin};
 use proptest::prelude::*;

@@ -9,7 +9,7 @@
 //! (`|cos| < 1e-3` between ray and normal on a face, `< 2e-2` on the curved side, where
 //! the distance is ill-conditioned like a square root).
 
-use emray::geometry::reference::solids::{self as refs, Crossing};
+use emray::geometry::precise::solids::{self as refs, Crossing};
 use emray::geometry::{AaBox, CappedCone, Intersect, OBox, Polyhedron, Primitive, ShapeHit, Spans};
 use emray::math::{DRay, DVec3, Ray, Vec3, offset_ray_origin};
 use glam::Quat;

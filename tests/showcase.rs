@@ -77,7 +77,7 @@ fn teapot() {
 #[cfg(feature = "embree")]
 #[test]
 fn teapot_has_no_pinholes_on_either_backend() {
-    use emray::quality::stress::invariance_of;
+    use emray::accuracy::stress::invariance_of;
     let path = Path::new(env!("CARGO_MANIFEST_DIR")).join("scenes/teapot.toml");
     let scene = emray::load::load_path(&path).unwrap_or_else(|e| panic!("{e}"));
     let mut settings = RenderSettings::for_scene(&scene);

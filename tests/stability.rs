@@ -4,9 +4,9 @@
 use emray::Backend;
 use emray::accel::Accel;
 use emray::accel::bvh::Bvh;
+use emray::accuracy::stress::{self, acne, convex_scene, differing_share, floor_scene, render};
 use emray::load::nff::parse_str;
 use emray::math::{Ray, Vec3};
-use emray::quality::stress::{self, acne, convex_scene, differing_share, floor_scene, render};
 use std::path::Path;
 
 mod common;
@@ -48,7 +48,7 @@ fn translated_scenes_have_no_acne_and_render_the_same() {
 /// database at its default size, 256×256).
 #[test]
 fn moved_and_scaled_spd_scenes_render_the_same() {
-    use emray::quality::stress::invariance;
+    use emray::accuracy::stress::invariance;
     use emray::spd::Database;
     for (db, size) in [
         (Database::Balls, 2),
@@ -96,7 +96,7 @@ fn rays_at_shared_edges_and_vertices_never_miss_on_the_bvh() {
 /// coordinates' rounding of the plane; the BVH is.
 #[test]
 fn hard_triangles_match_the_f64_reference_on_both_backends() {
-    use emray::quality::hard_triangles::{Family, hard_cases, known_cases, run_cases};
+    use emray::accuracy::hard_triangles::{Family, hard_cases, known_cases, run_cases};
     let mut cases = known_cases(1024);
     cases.extend(hard_cases(200, 64, 2027));
     for backend in backends() {

@@ -4,10 +4,10 @@
 
 use emray::Scene;
 use emray::accel::Backend;
+#[cfg(feature = "quality")]
+use emray::accuracy::metrics::compare;
 use emray::job::{Report, render_scene};
 use emray::load::nff::parse_str;
-#[cfg(feature = "quality")]
-use emray::quality::metrics::compare;
 #[cfg(feature = "quality")]
 use emray::render::Aa;
 use emray::render::{Film, RenderSettings};
@@ -342,8 +342,8 @@ fn the_reference_refuses_what_it_does_not_model() {
 fn study_writes_a_row_per_setting_and_a_curve_per_knob() {
     let s = scene(ANALYTIC);
     let dir = tempfile::tempdir().unwrap();
-    let rows =
-        emray::quality::study::write(&s, "analytic", dir.path(), 8, 8, 2, &[Backend::Bvh]).unwrap();
+    let rows = emray::accuracy::study::write(&s, "analytic", dir.path(), 8, 8, 2, &[Backend::Bvh])
+        .unwrap();
     let csv = std::fs::read_to_string(dir.path().join("study.csv")).unwrap();
     assert_eq!(csv.lines().count(), rows.len() + 1);
     assert!(csv.starts_with("knob,setting,render_ms,rays,rmse,psnr"));
@@ -364,7 +364,7 @@ fn study_writes_a_row_per_setting_and_a_curve_per_knob() {
     // The PNG: the plot's size, with every curve's colour and dark (text) pixels.
     let png = image::open(dir.path().join("study.png")).unwrap().to_rgb8();
     assert_eq!(png.dimensions(), (800, 520));
-    for (r, g, b) in emray::quality::study::COLOURS {
+    for (r, g, b) in emray::accuracy::study::COLOURS {
         assert!(png.pixels().any(|p| p.0 == [r, g, b]), "{r} {g} {b}");
     }
     let dark = png.pixels().filter(|p| p.0.iter().all(|&c| c < 80)).count();

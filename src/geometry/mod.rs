@@ -3,7 +3,7 @@
 //! The pure-Rust BVH calls them from its leaves; the Embree backend calls the very same
 //! functions from its user-geometry callbacks, so the two backends agree by
 //! construction on everything but triangles (which Embree intersects natively).
-//! Every intersector has a double-precision reference in [`reference`](mod@reference)
+//! Every intersector has a double-precision reference in [`precise`]
 //! used by the tests to bound the f32 error.
 //!
 //! A primitive kind implements two traits in its own file: [`Intersect`], the ray
@@ -18,7 +18,7 @@ mod error;
 mod kinds;
 mod param;
 pub mod polygon;
-pub mod reference;
+pub mod precise;
 pub mod tessellate;
 mod triangle;
 mod triangle4;

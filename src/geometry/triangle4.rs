@@ -373,7 +373,7 @@ mod tests {
     /// scalar test bit for bit.
     #[test]
     fn lanes_decided_in_f64_equal_the_scalar_test() {
-        use crate::quality::hard_triangles::{hard_cases, known_cases};
+        use crate::accuracy::hard_triangles::{hard_cases, known_cases};
         let mut cases = known_cases(64);
         cases.extend(hard_cases(200, 16, 5));
         let mut compared = 0;

@@ -1,6 +1,6 @@
 //! The reference renderer (`--reference`): the same Whitted model computed entirely in
 //! f64 — camera, intersections (the independent intersectors of
-//! [`crate::geometry::reference`]), normals, shading — with `n × n` stratified jittered
+//! [`crate::geometry::precise`]), normals, shading — with `n × n` stratified jittered
 //! samples per pixel, so that "error" means error against something that shares
 //! neither the f32 arithmetic nor either backend's traversal.
 //!
@@ -14,7 +14,7 @@
 use super::RayCounts;
 use super::film::Film;
 use crate::geometry::Kind;
-use crate::geometry::reference as r64;
+use crate::geometry::precise as r64;
 use crate::math::DRay;
 use crate::scene::{Camera, Scene};
 use glam::{DVec3, Vec3};

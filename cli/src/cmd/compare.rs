@@ -40,7 +40,7 @@ pub struct Args {
 
 /// The table `emray compare` prints.
 #[cfg(feature = "quality")]
-fn table(m: &emray::quality::metrics::Metrics) -> String {
+fn table(m: &emray::accuracy::metrics::Metrics) -> String {
     format!(
         "rmse       {:.6e}\n\
          psnr       {:.3} dB\n\
@@ -61,8 +61,8 @@ fn table(m: &emray::quality::metrics::Metrics) -> String {
 /// that cannot be read (or of another size) is a usage error.
 #[cfg(feature = "quality")]
 pub fn run(a: Args) -> Result<(), Error> {
+    use emray::accuracy::metrics;
     use emray::output::Encoding;
-    use emray::quality::metrics;
     for (name, v) in [("--max-rmse", a.max_rmse), ("--max-flip", a.max_flip)] {
         if v.is_some_and(|v| v.is_nan() || v < 0.0) {
             return Err(Error::usage(format!("{name} must be a number ≥ 0")));
@@ -97,7 +97,7 @@ pub fn run(a: Args) -> Result<(), Error> {
 
 /// Whether `m` is within `--max-rmse` and `--max-flip`, saying which is not.
 #[cfg(feature = "quality")]
-fn within_thresholds(a: &Args, m: &emray::quality::metrics::Metrics) -> bool {
+fn within_thresholds(a: &Args, m: &emray::accuracy::metrics::Metrics) -> bool {
     let mut pass = true;
     if let Some(x) = a.max_rmse {
         if m.rmse.is_nan() || m.rmse > x {

@@ -5,7 +5,7 @@ use super::Error;
 use super::args::LogArgs;
 use super::error::print;
 use emray::Backend;
-use emray::quality::stress::*;
+use emray::accuracy::stress::*;
 
 /// `emray stress`.
 #[derive(clap::Args, Debug, Clone)]
@@ -214,7 +214,7 @@ fn watertight(checks: &mut Checks) {
 /// Huge, sliver and grazing triangles and origins near their plane: both backends find
 /// every hit of the f64 reference and nothing where it finds none.
 fn hard_triangles(checks: &mut Checks, backends: &[Backend], n: u32) {
-    use emray::quality::hard_triangles::{Family, hard_cases, known_cases, run_cases};
+    use emray::accuracy::hard_triangles::{Family, hard_cases, known_cases, run_cases};
     let mut cases = known_cases(4096);
     cases.extend(hard_cases(n, 256, 2027));
     for &b in backends {

@@ -33,7 +33,7 @@ pub struct Args {
 #[cfg(feature = "quality")]
 pub fn run(a: Args) -> Result<(), Error> {
     use emray::job::{SceneError, load_scene};
-    let files = emray::quality::study::FILES.map(|f| a.out.join(f));
+    let files = emray::accuracy::study::FILES.map(|f| a.out.join(f));
     super::outputs::prepare(files.iter().map(PathBuf::as_path))?;
     let name = a.scene.display().to_string();
     let scene = match load_scene(&a.scene) {
@@ -47,9 +47,9 @@ pub fn run(a: Args) -> Result<(), Error> {
     }
     let (w, h) = (a.res.width, a.res.height);
     let rows =
-        emray::quality::study::write(&scene, &name, &a.out, w, h, a.reference_strata, &backends)
+        emray::accuracy::study::write(&scene, &name, &a.out, w, h, a.reference_strata, &backends)
             .map_err(|e| Error::failed(format!("{name}: {e}")))?;
-    print(format_args!("{}", emray::quality::study::csv(&rows)))?;
+    print(format_args!("{}", emray::accuracy::study::csv(&rows)))?;
     Ok(())
 }
 

@@ -2,7 +2,7 @@
 //! small counts) and `emray stress` (which prints the measured numbers on full counts).
 
 use crate::accel::{Accel, AccelError, Backend, BackendOptions, WithAccel};
-use crate::geometry::reference as r64;
+use crate::geometry::precise as r64;
 use crate::job::render_scene;
 use crate::load::nff::{parse_str, parse_str_at};
 use crate::math::{DRay, DVec3, Ray, Rng, Vec3, next_float_down, offset_ray_origin};

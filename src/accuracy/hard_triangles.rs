@@ -1,7 +1,7 @@
 //! Hard triangles against the f64 reference: the cases where an f32 triangle test can
 //! lose a hit that is plainly there. Each case is one triangle and rays from one
 //! origin aimed at points inside and outside it; both backends must find every hit the
-//! f64 reference finds ([`crate::geometry::reference::triangle`], on the same f32
+//! f64 reference finds ([`crate::geometry::precise::triangle`], on the same f32
 //! numbers) and no hit where it finds none, except for rays within rounding of an edge
 //! (where the f32 test is allowed to decide either way, as long as it decides the same
 //! way for both triangles sharing the edge).
@@ -14,7 +14,7 @@
 //! triangles that showed the BVH losing hits ([`known_cases`]).
 
 use crate::accel::{Accel, BackendOptions, WithAccel};
-use crate::geometry::{Kind, Triangle, reference};
+use crate::geometry::{Kind, Triangle, precise};
 use crate::math::{DRay, DVec3, Ray, Rng, Vec3, gamma};
 use crate::scene::{Camera, Scene};
 
@@ -126,7 +126,7 @@ impl HardStats {
 pub fn truth(tri: &Triangle, ray: &Ray) -> Truth {
     let dray = DRay::from(ray);
     let p = tri.p.map(|v| v.as_dvec3());
-    let exact = reference::triangle(&dray, p, 0.0);
+    let exact = precise::triangle(&dray, p, 0.0);
     let (edges, band) = sheared_edges(&p, &dray);
     if edges.iter().any(|e| e.abs() <= band) {
         return Truth::EdgeBand;

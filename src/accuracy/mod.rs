@@ -1,4 +1,4 @@
-//! The quality tools: how far an image is from a reference ([`metrics`], used by
+//! The accuracy tools: how far an image is from a reference ([`metrics`], used by
 //! `emray compare`), how the renderer holds up numerically ([`stress`], used by
 //! `emray stress` and `tests/stability.rs`), and what each speed/accuracy knob costs
 //! in error against time ([`study`], used by `emray study`); [`moved`] moves and scales
