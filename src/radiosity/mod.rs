@@ -22,7 +22,7 @@ pub(crate) mod solver;
 #[cfg(test)]
 mod tests;
 
-use crate::accel::{Accel, AccelError, BackendOptions, Hit, WithAccel};
+use crate::accel::{Accel, AccelError, Hit};
 use crate::geometry::Kind;
 /// The tessellation of analytic shapes the mesh starts from, in `geometry`.
 use crate::math::Vec3;
@@ -533,34 +533,4 @@ pub(crate) fn solve_and_view<A: Accel>(
         view_ms,
     };
     Ok((sol, film, report))
-}
-
-/// Solve and view with a built backend.
-struct SolveAndView<'a> {
-    scene: &'a Scene,
-    settings: &'a RadiositySettings,
-    view: (u32, u32, u32),
-}
-
-impl WithAccel for SolveAndView<'_> {
-    type Output = Result<(Solution, Film, RadiosityReport), RadiosityError>;
-    fn run<A: Accel>(self, accel: &A, build_ms: f64) -> Self::Output {
-        solve_and_view(self.scene, accel, self.settings, self.view, build_ms)
-    }
-}
-
-/// Build the backend over `scene`, solve, and render one `width × height` view with
-/// `spp²` samples per pixel.
-pub fn run(
-    scene: &Scene,
-    backend: impl Into<BackendOptions>,
-    settings: &RadiositySettings,
-    view: (u32, u32, u32),
-) -> Result<(Solution, Film, RadiosityReport), RadiosityError> {
-    let work = SolveAndView {
-        scene,
-        settings,
-        view,
-    };
-    crate::accel::build(scene, &backend.into(), work)?
 }
