@@ -203,62 +203,34 @@ pub(crate) trait BoundArith: Copy + Add<Output = Self> + Mul<Output = Self> {
     fn gamma(n: u32) -> Self;
 }
 
-impl BoundArith for f32 {
-    #[inline(always)]
-    fn abs(self) -> f32 {
-        f32::abs(self)
-    }
-    #[inline(always)]
-    fn max(self, other: f32) -> f32 {
-        f32::max(self, other)
-    }
-    #[inline(always)]
-    fn splat(v: f32) -> f32 {
-        v
-    }
-    #[inline(always)]
-    fn gamma(n: u32) -> f32 {
-        gamma(n)
-    }
+/// `BoundArith` for a type with inherent `abs` and `max`, a constant from an f32 by
+/// `$splat` and γₙ by `$gamma`.
+macro_rules! bound_arith {
+    ($t:ty, $splat:expr, $gamma:expr) => {
+        impl BoundArith for $t {
+            #[inline(always)]
+            fn abs(self) -> $t {
+                <$t>::abs(self)
+            }
+            #[inline(always)]
+            fn max(self, other: $t) -> $t {
+                <$t>::max(self, other)
+            }
+            #[inline(always)]
+            fn splat(v: f32) -> $t {
+                $splat(v)
+            }
+            #[inline(always)]
+            fn gamma(n: u32) -> $t {
+                $gamma(n)
+            }
+        }
+    };
 }
 
-impl BoundArith for Vec4 {
-    #[inline(always)]
-    fn abs(self) -> Vec4 {
-        Vec4::abs(self)
-    }
-    #[inline(always)]
-    fn max(self, other: Vec4) -> Vec4 {
-        Vec4::max(self, other)
-    }
-    #[inline(always)]
-    fn splat(v: f32) -> Vec4 {
-        Vec4::splat(v)
-    }
-    #[inline(always)]
-    fn gamma(n: u32) -> Vec4 {
-        Vec4::splat(gamma(n))
-    }
-}
-
-impl BoundArith for f64 {
-    #[inline(always)]
-    fn abs(self) -> f64 {
-        f64::abs(self)
-    }
-    #[inline(always)]
-    fn max(self, other: f64) -> f64 {
-        f64::max(self, other)
-    }
-    #[inline(always)]
-    fn splat(v: f32) -> f64 {
-        f64::from(v)
-    }
-    #[inline(always)]
-    fn gamma(n: u32) -> f64 {
-        gamma64(n)
-    }
-}
+bound_arith!(f32, |v| v, gamma);
+bound_arith!(Vec4, Vec4::splat, |n| Vec4::splat(gamma(n)));
+bound_arith!(f64, f64::from, gamma64);
 
 /// The bound on the rounding error of the watertight test's distance `t` (pbrt §6.8.7),
 /// from the sheared vertex coordinates `xy` (`ax, ay, bx, by, cx, cy`), the vertices'
