@@ -51,13 +51,17 @@ impl Ray {
     /// within [`MAX_RAY_COMPONENT`] in every component, and an interval that is not
     /// NaN. Every ray query checks it first and treats any other ray as hitting
     /// nothing, so that no value reaches a traversal or Embree that they do not accept.
+    ///
+    /// Branch-free, on the bits: a non-negative float orders as its bit pattern, and
+    /// NaN's patterns lie above infinity's, so `|x| <= limit` is `bits(|x|) <=
+    /// bits(limit)` for every `x`, NaN included (every eye ray passes through here
+    /// before Embree sees it).
     #[inline]
     pub fn is_traceable(&self) -> bool {
-        let limit = Vec3::splat(MAX_RAY_COMPONENT);
-        self.org.abs().cmple(limit).all()
-            && self.dir.abs().cmple(limit).all()
-            && !self.tmin.is_nan()
-            && !self.tmax.is_nan()
+        const LIMIT: u32 = MAX_RAY_COMPONENT.to_bits();
+        let within = |x: f32| (x.to_bits() & 0x7fff_ffff) <= LIMIT;
+        let all_within = |v: Vec3| within(v.x) & within(v.y) & within(v.z);
+        all_within(self.org) & all_within(self.dir) & !self.tmin.is_nan() & !self.tmax.is_nan()
     }
 }
 
@@ -135,4 +139,49 @@ pub fn hash(mut x: u32) -> u32 {
 #[inline]
 pub fn hash_unit(x: u32) -> f32 {
     (x >> 8) as f32 * (1.0 / (1u32 << 24) as f32)
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+
+    /// The bit test of `is_traceable` against the plain comparisons, over the values
+    /// at and around its edges: zeros, the limit and its neighbours, infinities, NaNs.
+    #[test]
+    fn traceable_is_the_comparison_with_the_limit() {
+        let edges = [
+            0.0,
+            -0.0,
+            1.0,
+            f32::MIN_POSITIVE,
+            MAX_RAY_COMPONENT,
+            next_float_up(MAX_RAY_COMPONENT),
+            next_float_down(MAX_RAY_COMPONENT),
+            f32::MAX,
+            f32::INFINITY,
+            f32::NAN,
+            f32::from_bits(0x7fff_ffff),
+            f32::from_bits(0x7f80_0001),
+        ];
+        let values = edges.iter().flat_map(|&x| [x, -x]);
+        for x in values {
+            for axis in 0..6 {
+                let mut c = [1.0f32; 6];
+                c[axis] = x;
+                let ray = Ray {
+                    org: Vec3::new(c[0], c[1], c[2]),
+                    dir: Vec3::new(c[3], c[4], c[5]),
+                    tmin: 0.0,
+                    tmax: f32::INFINITY,
+                };
+                let expected = x.abs() <= MAX_RAY_COMPONENT;
+                assert_eq!(ray.is_traceable(), expected, "{x:e} on axis {axis}");
+            }
+        }
+        let nan_interval = Ray {
+            tmax: f32::NAN,
+            ..Ray::new(Vec3::ZERO, Vec3::X)
+        };
+        assert!(!nan_interval.is_traceable());
+    }
 }
