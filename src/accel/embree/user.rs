@@ -3,10 +3,10 @@
 //! so both backends give the same hits for every analytic kind, bit for bit.
 //!
 //! A panic must not unwind out of an `extern "C"` callback into Embree (Rust aborts the
-//! process there). Every callback therefore runs the Rust intersector inside
-//! [`std::panic::catch_unwind`]; a caught panic is recorded and the primitive reported
-//! as missed (empty bounds for the bounds callback), and the panic is raised again on
-//! the Rust side once Embree has returned:
+//! process there). Every callback therefore runs the Rust intersector inside one
+//! [`std::panic::catch_unwind`] per call (around all the lanes of a packet); a caught
+//! panic is recorded (empty bounds for the bounds callback), and the panic is raised
+//! again on the Rust side once Embree has returned:
 //! - ray queries (`rtcIntersect1/4/8/16`, `rtcOccluded1/4/8/16`) run their traversal, and
 //!   so the intersect and occluded callbacks, on the thread that calls them (Embree 3
 //!   and 4 alike: the callbacks are "invoked by `rtcIntersect`-type ray queries", and
@@ -423,8 +423,28 @@ unsafe fn current_hit(hits: Packet, i: usize) -> Option<(u32, u32, u32)> {
     (geom != sys::INVALID_GEOMETRY_ID).then(|| (geom, word(soa::PRIM_ID), word(soa::INST_ID)))
 }
 
+/// Mark every active ray of a call as missed: the callback has no primitive to test
+/// (an id Embree should never pass).
+///
+/// # Safety
+/// `valid` points to the live mask of at least `n` rays.
+#[cold]
+unsafe fn report_all_missed(valid: *mut i32, n: usize) {
+    for i in 0..n {
+        // SAFETY: by the caller's contract.
+        unsafe { report_miss(valid, i) };
+    }
+}
+
 /// `RTCIntersectFunctionN`: nearest hit with primitive `primID` for each active ray (or
-/// one at the current `tfar` that wins the tie with the hit there); on a hit, writes `tfar`, `u`, `v`, `Ng`, `primID`, `geomID` and `instID`.
+/// one at the current `tfar` that wins the tie with the hit there); on a hit, writes
+/// `tfar`, `u`, `v`, `Ng`, `primID`, `geomID` and `instID`.
+///
+/// Packet queries call it with all `N` lanes of a packet and a mask whenever any lane
+/// reaches the primitive, so the per-call work (the primitive, its id, the instance
+/// stack, the unwind guard) is done once and the per-lane work is the test alone. A
+/// panic leaves the lanes after it unanswered: the query's result is thrown away when
+/// [`rethrow_caught`] raises the panic.
 pub(super) unsafe extern "C" fn intersect<T: Analytic>(
     args: *const sys::RTCIntersectFunctionNArguments,
 ) {
@@ -435,11 +455,12 @@ pub(super) unsafe extern "C" fn intersect<T: Analytic>(
     let n = args.N as usize;
     // SAFETY: registered only with `UserPrims<T>` user data (see `bounds`).
     let user = unsafe { prims::<T>(args.geometryUserPtr) };
-    let prim = user.and_then(|p| p.items.get(args.primID as usize));
-    let prim_id = user
-        .and_then(|p| p.ids.get(args.primID as usize))
-        .copied()
-        .unwrap_or(args.primID);
+    let index = args.primID as usize;
+    let Some((prim, &prim_id)) = user.and_then(|p| p.items.get(index).zip(p.ids.get(index))) else {
+        // SAFETY: `valid` has `N` entries.
+        unsafe { report_all_missed(args.valid, n) };
+        return;
+    };
     let packet = Packet {
         base: args.rayhit.cast(),
         n,
@@ -449,67 +470,64 @@ pub(super) unsafe extern "C" fn intersect<T: Analytic>(
     #[cfg(embree_instance_array)]
     // SAFETY: as above.
     let inst_prim = unsafe { instance_prim_ids(args.context) };
-    for i in 0..n {
-        // SAFETY: `valid` has `N` entries.
-        if unsafe { args.valid.add(i).read() } == 0 {
-            continue;
-        }
-        // SAFETY: `rayhit` is a live `RTCRayHitN` packet of `N` rays and `i < N`.
-        let mut ray = unsafe { packet.ray(i) };
-        // SAFETY: as above; the hit members follow the ray's.
-        let current = unsafe { current_hit(packet.hits(), i) };
-        // A hit at `tfar` already: look up to and including `tfar` for a coincident
-        // primitive that wins the tie (`Hit::wins_tie_with`), as the BVH does.
-        let tfar = ray.tmax;
-        if current.is_some() {
-            ray.tmax = next_float_up(tfar);
-        }
-        let hit = catch_unwind(AssertUnwindSafe(|| {
+    let lanes = || {
+        for i in 0..n {
+            // SAFETY: `valid` has `N` entries.
+            if unsafe { args.valid.add(i).read() } == 0 {
+                continue;
+            }
+            // SAFETY: `rayhit` is a live `RTCRayHitN` packet of `N` rays and `i < N`.
+            let mut ray = unsafe { packet.ray(i) };
+            // SAFETY: as above; the hit members follow the ray's.
+            let current = unsafe { current_hit(packet.hits(), i) };
+            // A hit at `tfar` already: look up to and including `tfar` for a coincident
+            // primitive that wins the tie (`Hit::wins_tie_with`), as the BVH does.
+            let tfar = ray.tmax;
+            if current.is_some() {
+                ray.tmax = next_float_up(tfar);
+            }
             #[cfg(test)]
             maybe_injected_panic(Callback::Intersect);
-            prim.and_then(|p| p.intersect(&ray))
-        }))
-        .unwrap_or_else(|payload| {
-            record_query_panic(Callback::Intersect, T::KIND.name(), &*payload);
-            None
-        })
-        .filter(|h| {
-            h.t < tfar
-                || current.is_some_and(|(geom, prim, level)| {
-                    h.t == tfar && level == inst[0] && (args.geomID, prim_id) < (geom, prim)
-                })
-        });
-        match hit {
-            Some(h) => {
-                // SAFETY: ray `i` is active; Embree expects the callback to write its
-                // `tfar` and hit members on a hit. All offsets are inside the packet.
-                unsafe {
-                    packet.set_f32(soa::TFAR, i, h.t);
-                    let hits = packet.hits();
-                    hits.set_f32(soa::NG_X, i, h.ng.x);
-                    hits.set_f32(soa::NG_Y, i, h.ng.y);
-                    hits.set_f32(soa::NG_Z, i, h.ng.z);
-                    hits.set_f32(soa::U, i, h.u);
-                    hits.set_f32(soa::V, i, h.v);
-                    hits.set_u32(soa::PRIM_ID, i, prim_id);
-                    hits.set_u32(soa::GEOM_ID, i, args.geomID);
-                    for (level, id) in inst.iter().enumerate() {
-                        hits.set_u32(soa::INST_ID + level, i, *id);
-                    }
-                    #[cfg(embree_instance_array)]
-                    for (level, id) in inst_prim.iter().enumerate() {
-                        hits.set_u32(soa::INST_ID + sys::MAX_INSTANCE_LEVELS + level, i, *id);
-                    }
+            let hit = prim.intersect(&ray).filter(|h| {
+                h.t < tfar
+                    || current.is_some_and(|(geom, prim, level)| {
+                        h.t == tfar && level == inst[0] && (args.geomID, prim_id) < (geom, prim)
+                    })
+            });
+            let Some(h) = hit else {
+                // SAFETY: `valid` has `N` entries.
+                unsafe { report_miss(args.valid, i) };
+                continue;
+            };
+            // SAFETY: ray `i` is active; Embree expects the callback to write its `tfar`
+            // and hit members on a hit. All offsets are inside the packet.
+            unsafe {
+                packet.set_f32(soa::TFAR, i, h.t);
+                let hits = packet.hits();
+                hits.set_f32(soa::NG_X, i, h.ng.x);
+                hits.set_f32(soa::NG_Y, i, h.ng.y);
+                hits.set_f32(soa::NG_Z, i, h.ng.z);
+                hits.set_f32(soa::U, i, h.u);
+                hits.set_f32(soa::V, i, h.v);
+                hits.set_u32(soa::PRIM_ID, i, prim_id);
+                hits.set_u32(soa::GEOM_ID, i, args.geomID);
+                for (level, id) in inst.iter().enumerate() {
+                    hits.set_u32(soa::INST_ID + level, i, *id);
+                }
+                #[cfg(embree_instance_array)]
+                for (level, id) in inst_prim.iter().enumerate() {
+                    hits.set_u32(soa::INST_ID + sys::MAX_INSTANCE_LEVELS + level, i, *id);
                 }
             }
-            // SAFETY: `valid` has `N` entries.
-            None => unsafe { report_miss(args.valid, i) },
         }
+    };
+    if let Err(payload) = catch_unwind(AssertUnwindSafe(lanes)) {
+        record_query_panic(Callback::Intersect, T::KIND.name(), &*payload);
     }
 }
 
 /// `RTCOccludedFunctionN`: for each active ray that primitive `primID` occludes, sets
-/// `tfar = -inf`.
+/// `tfar = -inf` (per-call work done once, as in [`intersect`]).
 pub(super) unsafe extern "C" fn occluded<T: Analytic>(
     args: *const sys::RTCOccludedFunctionNArguments,
 ) {
@@ -519,34 +537,36 @@ pub(super) unsafe extern "C" fn occluded<T: Analytic>(
     };
     let n = args.N as usize;
     // SAFETY: registered only with `UserPrims<T>` user data (see `bounds`).
-    let prim =
-        unsafe { prims::<T>(args.geometryUserPtr) }.and_then(|p| p.items.get(args.primID as usize));
+    let user = unsafe { prims::<T>(args.geometryUserPtr) };
+    let Some(prim) = user.and_then(|p| p.items.get(args.primID as usize)) else {
+        // SAFETY: `valid` has `N` entries.
+        unsafe { report_all_missed(args.valid, n) };
+        return;
+    };
     let packet = Packet {
         base: args.ray.cast(),
         n,
     };
-    for i in 0..n {
-        // SAFETY: `valid` has `N` entries.
-        if unsafe { args.valid.add(i).read() } == 0 {
-            continue;
-        }
-        // SAFETY: `ray` is a live `RTCRayN` packet of `N` rays and `i < N`.
-        let ray = unsafe { packet.ray(i) };
-        let occluded = catch_unwind(AssertUnwindSafe(|| {
+    let lanes = || {
+        for i in 0..n {
+            // SAFETY: `valid` has `N` entries.
+            if unsafe { args.valid.add(i).read() } == 0 {
+                continue;
+            }
+            // SAFETY: `ray` is a live `RTCRayN` packet of `N` rays and `i < N`.
+            let ray = unsafe { packet.ray(i) };
             #[cfg(test)]
             maybe_injected_panic(Callback::Occluded);
-            prim.is_some_and(|p| p.occluded(&ray))
-        }))
-        .unwrap_or_else(|payload| {
-            record_query_panic(Callback::Occluded, T::KIND.name(), &*payload);
-            false
-        });
-        if occluded {
-            // SAFETY: ray `i` is active; Embree reads `tfar = -inf` as "occluded".
-            unsafe { packet.set_f32(soa::TFAR, i, f32::NEG_INFINITY) };
-        } else {
-            // SAFETY: `valid` has `N` entries.
-            unsafe { report_miss(args.valid, i) };
+            if prim.occluded(&ray) {
+                // SAFETY: ray `i` is active; Embree reads `tfar = -inf` as "occluded".
+                unsafe { packet.set_f32(soa::TFAR, i, f32::NEG_INFINITY) };
+            } else {
+                // SAFETY: `valid` has `N` entries.
+                unsafe { report_miss(args.valid, i) };
+            }
         }
+    };
+    if let Err(payload) = catch_unwind(AssertUnwindSafe(lanes)) {
+        record_query_panic(Callback::Occluded, T::KIND.name(), &*payload);
     }
 }
