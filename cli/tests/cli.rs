@@ -514,3 +514,28 @@ fn a_scene_without_objects_is_warned_about() {
         stderr(&o)
     );
 }
+
+/// On a terminal the progress bar names each phase before the tiles count: a long
+/// load or build is never a silent wait. The terminal is `script`'s (util-linux); the
+/// test is skipped where it is missing.
+#[test]
+fn the_progress_bar_names_the_phases_on_a_terminal() {
+    let dir = tempfile::tempdir().unwrap();
+    std::fs::write(dir.path().join("a.nff"), SCENE).unwrap();
+    let command = format!(
+        "'{}' render a.nff -o out.png --res 64x48",
+        env!("CARGO_BIN_EXE_emray")
+    );
+    let run = Command::new("script")
+        .args(["-qec", &command, "/dev/null"])
+        .current_dir(dir.path())
+        .output();
+    let Ok(o) = run else {
+        eprintln!("skipped: no `script` to give the render a terminal");
+        return;
+    };
+    assert!(o.status.success(), "{}", stderr(&o));
+    let screen = String::from_utf8_lossy(&o.stdout);
+    assert!(screen.contains("a.nff: loading …"), "{screen:?}");
+    assert!(dir.path().join("out.png").exists());
+}

@@ -1,6 +1,7 @@
 //! Progress bars on a terminal: the tiles of one render, and the jobs of a batch with
-//! a bar per running job and a line per finished one. A render's bar spins while the
-//! scene loads, counts the tiles from 0 once the render tells how many there are, with
+//! a bar per running job and a line per finished one. A render's bar spins, naming the
+//! phase (loading, building, rendering), while the scene loads and the backend builds,
+//! counts the tiles from 0 once the render tells how many there are, with
 //! the time left ([`eta`]), and names the file being written.
 
 use super::error::error_line;
@@ -91,6 +92,14 @@ impl Tiles {
         self.bar.set_position(done as u64);
     }
 
+    /// The job is in `phase` (loading, building): say so beside the name, until the
+    /// tiles' bar takes over.
+    fn phase(&self, phase: &str) {
+        if !self.started.is_completed() {
+            self.bar.set_message(format!("{}: {phase} …", self.name));
+        }
+    }
+
     /// The render is done and `path` is being written.
     fn writing(&self, path: &Path) {
         spin(&self.bar, format!("writing {} …", path.display()));
@@ -119,6 +128,14 @@ impl TileBar {
     pub fn set(&self, done: usize, total: usize) {
         if let Some(t) = &self.0 {
             t.set(done, total);
+        }
+    }
+
+    /// The job is in `phase` (`loading`, `building`, `rendering`): say so on the
+    /// spinner, so that a long load or build is never a silent wait.
+    pub fn phase(&self, phase: &str) {
+        if let Some(t) = &self.0 {
+            t.phase(phase);
         }
     }
 

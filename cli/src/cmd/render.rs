@@ -105,6 +105,9 @@ fn render_one(args: &Args, job: &Job) -> Result<(), Error> {
     // Cleared when dropped, on an error too.
     let bar = TileBar::new(&job.scene.name(), args.log.quiet);
     let observer = |e: Event<'_>| match e {
+        Event::Loading => bar.phase("loading"),
+        Event::Building => bar.phase("building"),
+        Event::Rendering => bar.phase("rendering"),
         Event::Tiles { done, total } => bar.set(done, total),
         Event::Writing(path) => bar.writing(path),
         _ => {}
