@@ -95,6 +95,9 @@ mod embree {
             let unix = env::var("CARGO_CFG_TARGET_FAMILY").is_ok_and(|f| f == "unix");
             if unix && !is_loader_default(lib) {
                 println!("cargo::rustc-link-arg=-Wl,-rpath,{}", lib.display());
+                // For the binaries of the packages that depend on this one (the
+                // `emray` command): `DEP_EMBREE_RPATH` in their build scripts.
+                println!("cargo::metadata=rpath={}", lib.display());
             }
         }
         let version = header_version(&found.include_dir.join(found.api.name()));
