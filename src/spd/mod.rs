@@ -4,22 +4,32 @@
 //! Each database writes NFF through [`NffWriter`] exactly as the SPD programs' default
 //! NFF output does (curved primitives, not tessellated): the same entities in the same
 //! order, every number printed with C's `%g` ([`fmt_g`]), computed in double precision.
+//! The same entities can also go straight into a scene ([`Database::scene`]), the one
+//! the NFF loader reads from that text, without the text.
 
 mod balls;
 mod gears;
 mod jacks;
 mod lattice;
 mod mount;
+mod printed;
 mod rings;
+mod scene;
 mod shells;
+mod sink;
 mod sombrero;
 mod teapot;
 mod tetra;
 mod tree;
 mod tx;
 
+pub use sink::NffSink;
+
+use crate::load::LoadError;
+use crate::scene::Scene;
 use glam::DVec3;
 use std::fmt::Write;
+use std::path::Path;
 
 /// C's `printf("%g", x)`: six significant digits, trailing zeros removed, exponent
 /// form when the exponent is below −4 or at least 6 (two exponent digits at least);
@@ -443,20 +453,40 @@ impl Database {
     /// The NFF text of the database at size factor `size`.
     pub fn generate(self, size: u32) -> String {
         let mut w = NffWriter::new();
-        match self {
-            Database::Balls => balls::generate(size, &mut w),
-            Database::Gears => gears::generate(size, &mut w),
-            Database::Jacks => jacks::generate(size, &mut w),
-            Database::Lattice => lattice::generate(size, &mut w),
-            Database::Mount => mount::generate(size, &mut w),
-            Database::Rings => rings::generate(size, &mut w),
-            Database::Shells => shells::generate(size, &mut w),
-            Database::Sombrero => sombrero::generate(size, &mut w),
-            Database::Teapot => teapot::generate(size, &mut w),
-            Database::Tetra => tetra::generate(size, &mut w),
-            Database::Tree => tree::generate(size, &mut w),
-        }
+        self.emit(size, &mut w);
         w.finish()
+    }
+
+    /// The scene of the database at size factor `size`: the scene the NFF loader reads
+    /// from [`Database::generate`]'s text (named `path`, the file name of its sources
+    /// and messages), built without the text when it can be (it nearly always can).
+    ///
+    /// # Errors
+    /// What the loader reports for the text, if anything.
+    pub fn scene(self, size: u32, path: &Path) -> Result<Scene, LoadError> {
+        let mut builder = scene::SceneBuilder::new(path);
+        self.emit(size, &mut builder);
+        match builder.finish() {
+            Some(scene) => scene,
+            None => crate::load::nff::parse_str(&self.generate(size), path),
+        }
+    }
+
+    /// Send the database's entities at size factor `size` to `sink`.
+    pub fn emit(self, size: u32, sink: &mut impl NffSink) {
+        match self {
+            Database::Balls => balls::generate(size, sink),
+            Database::Gears => gears::generate(size, sink),
+            Database::Jacks => jacks::generate(size, sink),
+            Database::Lattice => lattice::generate(size, sink),
+            Database::Mount => mount::generate(size, sink),
+            Database::Rings => rings::generate(size, sink),
+            Database::Shells => shells::generate(size, sink),
+            Database::Sombrero => sombrero::generate(size, sink),
+            Database::Teapot => teapot::generate(size, sink),
+            Database::Tetra => tetra::generate(size, sink),
+            Database::Tree => tree::generate(size, sink),
+        }
     }
 }
 
