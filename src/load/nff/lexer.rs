@@ -5,6 +5,8 @@
 //! there, so that the pieces of a file parsed apart number their lines as the whole
 //! file does.
 
+use super::number::{Plain, scan_plain};
+
 /// One token: a slice of the source and where it starts.
 #[derive(Clone, Copy, Debug)]
 pub(super) struct Tok<'a> {
@@ -29,9 +31,36 @@ pub(super) struct Lexer<'a> {
 }
 
 #[inline]
-pub(super) fn is_space(b: u8) -> bool {
+pub(super) const fn is_space(b: u8) -> bool {
     matches!(b, b' ' | b'\t' | b'\n' | b'\r' | 0x0b | 0x0c)
 }
+
+/// What a byte is to the lexer: part of a token, a blank, a line end or a comment.
+#[derive(Clone, Copy, PartialEq, Eq)]
+enum Class {
+    Token,
+    Blank,
+    Lf,
+    Cr,
+    Hash,
+}
+
+/// [`Class`] by byte, one look-up instead of a chain of comparisons.
+const CLASSES: [Class; 256] = {
+    let mut t = [Class::Token; 256];
+    let mut b = 0;
+    while b < 256 {
+        t[b] = match b as u8 {
+            b'\n' => Class::Lf,
+            b'\r' => Class::Cr,
+            b'#' => Class::Hash,
+            c if is_space(c) => Class::Blank,
+            _ => Class::Token,
+        };
+        b += 1;
+    }
+    t
+};
 
 impl<'a> Lexer<'a> {
     /// A lexer at the start of `src`.
@@ -55,13 +84,15 @@ impl<'a> Lexer<'a> {
     fn scan(&mut self) -> Option<Tok<'a>> {
         let b = self.src.as_bytes();
         loop {
-            match *b.get(self.pos)? {
-                b'\n' => {
+            match CLASSES[*b.get(self.pos)? as usize] {
+                Class::Token => break,
+                Class::Blank => self.pos += 1,
+                Class::Lf => {
                     self.pos += 1;
                     self.line += 1;
                     self.line_start = self.pos;
                 }
-                b'\r' => {
+                Class::Cr => {
                     self.pos += 1;
                     // CR LF counts once (at the LF); a lone CR ends a line too.
                     if b.get(self.pos) != Some(&b'\n') {
@@ -69,19 +100,18 @@ impl<'a> Lexer<'a> {
                         self.line_start = self.pos;
                     }
                 }
-                b'#' => {
+                Class::Hash => {
                     while self.pos < b.len() && !matches!(b[self.pos], b'\n' | b'\r') {
                         self.pos += 1;
                     }
                 }
-                c if is_space(c) => self.pos += 1,
-                _ => break,
             }
         }
         let start = self.pos;
-        while self.pos < b.len() && !is_space(b[self.pos]) && b[self.pos] != b'#' {
-            self.pos += 1;
-        }
+        self.pos += b[start..]
+            .iter()
+            .position(|&c| CLASSES[c as usize] != Class::Token)
+            .unwrap_or(b.len() - start);
         // Token boundaries are ASCII bytes, so they are char boundaries.
         Some(Tok {
             text: &self.src[start..self.pos],
@@ -101,6 +131,31 @@ impl<'a> Lexer<'a> {
             self.last = t;
         }
         t
+    }
+
+    /// The next token when it is a plain decimal on the same line (after blanks),
+    /// read in the same pass, and handed out as [`Lexer::next`] would; `None`, with
+    /// nothing consumed, for anything else.
+    #[inline]
+    pub fn next_plain(&mut self) -> Option<(Tok<'a>, Plain)> {
+        if self.peeked.is_some() {
+            return None;
+        }
+        let b = self.src.as_bytes();
+        let mut start = self.pos;
+        while matches!(b.get(start), Some(b' ' | b'\t')) {
+            start += 1;
+        }
+        let (plain, len) = scan_plain(&b[start..])?;
+        self.pos = start + len;
+        let tok = Tok {
+            text: &self.src[start..self.pos],
+            start,
+            line: self.line,
+            line_start: self.line_start,
+        };
+        self.last = Some(tok);
+        Some((tok, plain))
     }
 
     #[inline]

@@ -9,6 +9,8 @@
 //! parser returns. Everything else (exponents, long mantissas, `inf`, `nan`, malformed
 //! text) goes to the standard parser.
 
+use super::lexer::is_space;
+
 /// Powers of ten exact in double precision.
 const POW10_F64: [f64; 23] = [
     1e0, 1e1, 1e2, 1e3, 1e4, 1e5, 1e6, 1e7, 1e8, 1e9, 1e10, 1e11, 1e12, 1e13, 1e14, 1e15,
@@ -22,70 +24,91 @@ const POW10_F32: [f32; 11] = [
 /// A plain decimal: sign, all its digits as an integer, and how many of them follow
 /// the point.
 #[derive(Clone, Copy, Debug, PartialEq)]
-struct Plain {
+pub(super) struct Plain {
     negative: bool,
     mantissa: u64,
     fraction_digits: usize,
 }
 
-/// `s` as a [`Plain`] decimal, or `None` when it has another form (or more than 19
-/// digits).
+/// The plain decimal that starts `s` and runs to its end or to the first byte that
+/// ends a token (a blank, a line end, `#`), with its length; `None` when the token has
+/// another form (or more than 19 digits).
 #[inline]
-fn plain(s: &[u8]) -> Option<Plain> {
-    let (negative, body) = match s.first()? {
-        b'-' => (true, &s[1..]),
-        b'+' => (false, &s[1..]),
-        _ => (false, s),
+pub(super) fn scan_plain(s: &[u8]) -> Option<(Plain, usize)> {
+    let (negative, mut i) = match s.first()? {
+        b'-' => (true, 1),
+        b'+' => (false, 1),
+        _ => (false, 0),
     };
+    // Past 19 digits the mantissa wraps, and the token is refused below.
     let mut mantissa = 0u64;
-    let mut digits = 0usize;
-    let mut point = None;
-    for (i, &b) in body.iter().enumerate() {
-        match b {
-            b'0'..=b'9' => {
-                mantissa = mantissa * 10 + u64::from(b - b'0');
-                digits += 1;
-                if digits > 19 {
-                    return None;
-                }
-            }
-            b'.' if point.is_none() => point = Some(i),
-            _ => return None,
+    let digits = |i: &mut usize, mantissa: &mut u64| {
+        let start = *i;
+        while let Some(&b @ b'0'..=b'9') = s.get(*i) {
+            *mantissa = mantissa.wrapping_mul(10).wrapping_add(u64::from(b - b'0'));
+            *i += 1;
         }
-    }
-    if digits == 0 {
+        *i - start
+    };
+    let whole = digits(&mut i, &mut mantissa);
+    let fraction_digits = if s.get(i) == Some(&b'.') {
+        i += 1;
+        digits(&mut i, &mut mantissa)
+    } else {
+        0
+    };
+    let ends = s.get(i).is_none_or(|&b| is_space(b) || b == b'#');
+    if !ends || whole + fraction_digits == 0 || whole + fraction_digits > 19 {
         return None;
     }
-    let fraction_digits = point.map_or(0, |p| body.len() - p - 1);
-    Some(Plain {
+    let plain = Plain {
         negative,
         mantissa,
         fraction_digits,
-    })
+    };
+    Some((plain, i))
+}
+
+/// `s` as a [`Plain`] decimal when all of it is one.
+#[inline]
+fn plain(s: &[u8]) -> Option<Plain> {
+    scan_plain(s).filter(|&(_, n)| n == s.len()).map(|(p, _)| p)
+}
+
+/// The value of `p` in double precision, when one division gives it exactly rounded.
+#[inline]
+pub(super) fn plain_f64(p: Plain) -> Option<f64> {
+    if p.mantissa <= 1 << 53 && p.fraction_digits < POW10_F64.len() {
+        let v = p.mantissa as f64 / POW10_F64[p.fraction_digits];
+        return Some(if p.negative { -v } else { v });
+    }
+    None
+}
+
+/// The value of `p` in single precision, when one division gives it exactly rounded.
+#[inline]
+pub(super) fn plain_f32(p: Plain) -> Option<f32> {
+    if p.mantissa <= 1 << 24 && p.fraction_digits < POW10_F32.len() {
+        let v = p.mantissa as f32 / POW10_F32[p.fraction_digits];
+        return Some(if p.negative { -v } else { v });
+    }
+    None
 }
 
 /// `s` as `s.parse::<f64>().ok()` returns it, bit for bit.
 #[inline]
 pub(super) fn parse_f64(s: &str) -> Option<f64> {
-    if let Some(p) = plain(s.as_bytes()) {
-        if p.mantissa <= 1 << 53 && p.fraction_digits < POW10_F64.len() {
-            let v = p.mantissa as f64 / POW10_F64[p.fraction_digits];
-            return Some(if p.negative { -v } else { v });
-        }
-    }
-    s.parse().ok()
+    plain(s.as_bytes())
+        .and_then(plain_f64)
+        .or_else(|| s.parse().ok())
 }
 
 /// `s` as `s.parse::<f32>().ok()` returns it, bit for bit.
 #[inline]
 pub(super) fn parse_f32(s: &str) -> Option<f32> {
-    if let Some(p) = plain(s.as_bytes()) {
-        if p.mantissa <= 1 << 24 && p.fraction_digits < POW10_F32.len() {
-            let v = p.mantissa as f32 / POW10_F32[p.fraction_digits];
-            return Some(if p.negative { -v } else { v });
-        }
-    }
-    s.parse().ok()
+    plain(s.as_bytes())
+        .and_then(plain_f32)
+        .or_else(|| s.parse().ok())
 }
 
 #[cfg(test)]
@@ -125,6 +148,9 @@ mod tests {
             })
         );
         assert_eq!(plain(b"1e5"), None);
+        assert_eq!(scan_plain(b"1.5 2").map(|(_, n)| n), Some(3));
+        assert_eq!(scan_plain(b"1.5#c").map(|(_, n)| n), Some(3));
+        assert_eq!(scan_plain(b"1.5x 2"), None);
     }
 
     proptest! {

@@ -4,7 +4,7 @@
 //! to its last token, wherever that is), or at the first error.
 
 use super::lexer::{Lexer, Tok};
-use super::number::{parse_f32, parse_f64};
+use super::number::{parse_f32, parse_f64, plain_f32, plain_f64};
 use super::part::{Note, Part};
 use super::{MAX_PIXELS, MAX_RESOLUTION_SIDE, looks_numeric, show};
 use crate::geometry::{Cone, Intersect, Kind, Sphere};
@@ -127,8 +127,14 @@ impl<'a> Parser<'a, '_> {
     /// The next token as a finite `f32`. `what` names it for errors (built only then).
     #[inline]
     fn num_with(&mut self, what: &dyn Fn() -> String) -> Result<(f32, Tok<'a>), LoadError> {
-        let t = self.token(what)?;
-        match parse_f32(t.text) {
+        let (t, v) = match self.lex.next_plain() {
+            Some((t, p)) => (t, plain_f32(p).or_else(|| parse_f32(t.text))),
+            None => {
+                let t = self.token(what)?;
+                (t, parse_f32(t.text))
+            }
+        };
+        match v {
             Some(v) if v.is_finite() => Ok((v, t)),
             Some(_) => Err(self.not_a_number(&t, what, false)),
             None => Err(self.not_a_number(&t, what, true)),
@@ -138,10 +144,16 @@ impl<'a> Parser<'a, '_> {
     /// The next token as an `f64` that is also finite as an `f32` (so that the file's
     /// numbers are refused alike whether they are points or not).
     #[inline]
-    fn num64_with(&mut self, what: &dyn Fn() -> String) -> Result<f64, LoadError> {
-        let t = self.token(what)?;
-        match parse_f64(t.text) {
-            Some(v) if v.is_finite() && (v as f32).is_finite() => Ok(v),
+    fn num64_with(&mut self, what: &dyn Fn() -> String) -> Result<(f64, Tok<'a>), LoadError> {
+        let (t, v) = match self.lex.next_plain() {
+            Some((t, p)) => (t, plain_f64(p).or_else(|| parse_f64(t.text))),
+            None => {
+                let t = self.token(what)?;
+                (t, parse_f64(t.text))
+            }
+        };
+        match v {
+            Some(v) if v.is_finite() && (v as f32).is_finite() => Ok((v, t)),
             Some(_) => Err(self.not_a_number(&t, what, false)),
             None => Err(self.not_a_number(&t, what, true)),
         }
@@ -151,13 +163,10 @@ impl<'a> Parser<'a, '_> {
     /// range in world coordinates, and returned in the scene's frame, with the first
     /// number's token.
     fn point(&mut self, what: &str) -> Result<(Vec3, Tok<'a>), LoadError> {
-        let tok = self.lex.peek();
-        let mut p = [0.0; 3];
-        for (c, name) in p.iter_mut().zip(XYZ) {
-            *c = self.num64_with(&|| format!("{what} {name}"))?;
-        }
-        let world = DVec3::from(p);
-        let tok = tok.expect("a number was read");
+        let (x, tok) = self.num64_with(&|| format!("{what} x"))?;
+        let (y, _) = self.num64_with(&|| format!("{what} y"))?;
+        let (z, _) = self.num64_with(&|| format!("{what} z"))?;
+        let world = DVec3::new(x, y, z);
         self.in_range(&tok, range::check_point(what, world.as_vec3()))?;
         Ok(((world - self.origin).as_vec3(), tok))
     }
