@@ -212,11 +212,13 @@ fn append_indices(list: &mut Vec<u32>, other: Vec<u32>, first: usize, base: usiz
     }
     list.resize(first, u32::MAX);
     let base = base as u32;
-    list.extend(
-        other
-            .into_iter()
-            .map(|k| if k == u32::MAX { k } else { k.wrapping_add(base) }),
-    );
+    list.extend(other.into_iter().map(|k| {
+        if k == u32::MAX {
+            k
+        } else {
+            k.wrapping_add(base)
+        }
+    }));
 }
 
 /// `list` followed by `other` (`other`'s storage when `list` is empty).

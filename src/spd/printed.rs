@@ -14,13 +14,11 @@ use super::fmt_g;
 
 /// Powers of ten exact in double precision.
 const POW10: [f64; 23] = [
-    1e0, 1e1, 1e2, 1e3, 1e4, 1e5, 1e6, 1e7, 1e8, 1e9, 1e10, 1e11, 1e12, 1e13, 1e14, 1e15,
-    1e16, 1e17, 1e18, 1e19, 1e20, 1e21, 1e22,
+    1e0, 1e1, 1e2, 1e3, 1e4, 1e5, 1e6, 1e7, 1e8, 1e9, 1e10, 1e11, 1e12, 1e13, 1e14, 1e15, 1e16,
+    1e17, 1e18, 1e19, 1e20, 1e21, 1e22,
 ];
 /// Powers of ten exact in single precision.
-const POW10_F32: [f32; 11] = [
-    1e0, 1e1, 1e2, 1e3, 1e4, 1e5, 1e6, 1e7, 1e8, 1e9, 1e10,
-];
+const POW10_F32: [f32; 11] = [1e0, 1e1, 1e2, 1e3, 1e4, 1e5, 1e6, 1e7, 1e8, 1e9, 1e10];
 /// How close to a tie or to the range's ends the scaled value may come.
 const MARGIN: f64 = 1e-6;
 
@@ -77,9 +75,7 @@ fn six_digits(x: f64) -> Option<(u64, i32)> {
         scaled = scale(a, k)?;
     }
     let frac = scaled - scaled.floor();
-    let unsure = (frac - 0.5).abs() < MARGIN
-        || scaled < 1e5 + MARGIN
-        || scaled >= 1e6 - MARGIN;
+    let unsure = (frac - 0.5).abs() < MARGIN || scaled < 1e5 + MARGIN || scaled >= 1e6 - MARGIN;
     if unsure {
         return None;
     }
@@ -107,10 +103,37 @@ mod tests {
     #[test]
     fn printed_values_are_read_back_exactly() {
         for x in [
-            0.0, -0.0, 1.0, -1.0, 0.5, 0.1, 1e5, 1e6, 999_999.5, 999_999.4, 99_999.95,
-            0.0001, 0.00001, 1e-30, 1e30, 3.0827, -0.816497, 0.1234565, 1.2345650000000001,
-            12.0, 2.1, 0.01, 100000.0, 1.0 / 3.0, 2.0 / 3.0, f64::MAX, f64::MIN_POSITIVE,
-            5e-324, 1e22, 1e23, 123456789.0,
+            0.0,
+            -0.0,
+            1.0,
+            -1.0,
+            0.5,
+            0.1,
+            1e5,
+            1e6,
+            999_999.5,
+            999_999.4,
+            99_999.95,
+            0.0001,
+            0.00001,
+            1e-30,
+            1e30,
+            3.0827,
+            -0.816497,
+            0.1234565,
+            1.2345650000000001,
+            12.0,
+            2.1,
+            0.01,
+            100000.0,
+            1.0 / 3.0,
+            2.0 / 3.0,
+            f64::MAX,
+            f64::MIN_POSITIVE,
+            5e-324,
+            1e22,
+            1e23,
+            123456789.0,
         ] {
             same_as_text(x);
         }

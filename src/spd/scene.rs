@@ -234,7 +234,9 @@ impl SceneBuilder<'_> {
         }
         if !self.failed {
             let normals = normals.map(|_| &nrm[..]);
-            let added = self.part.add_polygon(&pts, normals, line, || (line as usize, 1));
+            let added = self
+                .part
+                .add_polygon(&pts, normals, line, || (line as usize, 1));
             self.check(added.is_ok());
         }
         (self.pts, self.nrm) = (pts, nrm);
@@ -261,7 +263,12 @@ mod tests {
                 let what = format!("{} size {size}", db.name());
                 assert_eq!(built, read, "{what}");
                 assert!(built.geometry.sources.same_origins(&read.geometry.sources));
-                assert!(built.sources.materials.same_origins(&read.sources.materials));
+                assert!(
+                    built
+                        .sources
+                        .materials
+                        .same_origins(&read.sources.materials)
+                );
                 assert!(built.sources.lights.same_origins(&read.sources.lights));
                 assert_eq!(db.scene(size, path).unwrap(), read, "{what}");
             }
@@ -281,6 +288,9 @@ mod tests {
         builder.polygon(&[D::ZERO, D::X, D::Y]);
         let scene = builder.finish().unwrap().unwrap();
         assert_eq!(scene.geometry.count(Kind::Triangle), 1);
-        assert_eq!(scene.geometry.sources.get(Kind::Triangle, 0).unwrap().line, 9);
+        assert_eq!(
+            scene.geometry.sources.get(Kind::Triangle, 0).unwrap().line,
+            9
+        );
     }
 }

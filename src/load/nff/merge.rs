@@ -156,4 +156,3 @@ impl<'p> Merger<'p> {
         Ok(scene)
     }
 }
-

@@ -121,7 +121,10 @@ impl<'a> Parser<'a, '_> {
 
     fn not_a_number(&self, t: &Tok<'a>, what: &dyn Fn() -> String, finite: bool) -> LoadError {
         let why = if finite { "" } else { " (not a finite number)" };
-        self.err(t, format!("expected {}, found {}{why}", what(), show(t.text)))
+        self.err(
+            t,
+            format!("expected {}, found {}{why}", what(), show(t.text)),
+        )
     }
 
     /// The next token as a finite `f32`. `what` names it for errors (built only then).
