@@ -1,11 +1,12 @@
 //! Where a database's entities go: [`NffSink`], which the NFF text writer
-//! ([`super::NffWriter`]) and the scene builder ([`super::scene::SceneBuilder`]) both
-//! implement, so that one generator makes both the file and the scene.
+//! ([`super::NffWriter`]) and the scene builder (`spd::scene`, behind
+//! [`super::Database::scene`]) both implement, so that one generator makes both the
+//! file and the scene.
 
 use super::NffWriter;
 use glam::DVec3;
 
-/// Receives the NFF entities of a database, in file order.
+/// Receives the NFF entities of a database, in file order (text or a scene).
 pub trait NffSink {
     /// `v`: from, at, up, angle, hither, resolution.
     fn viewpoint(
