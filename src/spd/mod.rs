@@ -4,8 +4,8 @@
 //! Each database writes NFF through [`NffWriter`] exactly as the SPD programs' default
 //! NFF output does (curved primitives, not tessellated): the same entities in the same
 //! order, every number printed with C's `%g` ([`fmt_g`]), computed in double precision.
-//! The same entities can also go straight into a scene ([`Database::scene`]), the one
-//! the NFF loader reads from that text, without the text.
+//! The same entities can also go to any other [`NffSink`] ([`Database::emit`]): the
+//! job builds the scene from them without the text (`job::spd_scene`).
 
 mod balls;
 mod gears;
@@ -14,7 +14,6 @@ mod lattice;
 mod mount;
 mod printed;
 mod rings;
-mod scene;
 mod shells;
 mod sink;
 mod sombrero;
@@ -23,13 +22,11 @@ mod tetra;
 mod tree;
 mod tx;
 
+pub(crate) use printed::{g_f32, g_f64};
 pub use sink::NffSink;
 
-use crate::load::LoadError;
-use crate::scene::Scene;
 use glam::DVec3;
 use std::fmt::Write;
-use std::path::Path;
 
 /// C's `printf("%g", x)`: six significant digits, trailing zeros removed, exponent
 /// form when the exponent is below −4 or at least 6 (two exponent digits at least);
@@ -455,21 +452,6 @@ impl Database {
         let mut w = NffWriter::new();
         self.emit(size, &mut w);
         w.finish()
-    }
-
-    /// The scene of the database at size factor `size`: the scene the NFF loader reads
-    /// from [`Database::generate`]'s text (named `path`, the file name of its sources
-    /// and messages), built without the text when it can be (it nearly always can).
-    ///
-    /// # Errors
-    /// What the loader reports for the text, if anything.
-    pub fn scene(self, size: u32, path: &Path) -> Result<Scene, LoadError> {
-        let mut builder = scene::SceneBuilder::new(path);
-        self.emit(size, &mut builder);
-        match builder.finish() {
-            Some(scene) => scene,
-            None => crate::load::nff::parse_str(&self.generate(size), path),
-        }
     }
 
     /// Send the database's entities at size factor `size` to `sink`.

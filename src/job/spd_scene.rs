@@ -1,16 +1,15 @@
-//! [`SceneBuilder`]: a database's entities made into a [`Scene`] without text, the
-//! scene the NFF loader reads from the database's file, bit for bit.
+//! The scene of an SPD database ([`scene`]), built from the database's entities
+//! ([`NffSink`]) without text: the scene the NFF loader reads from the database's
+//! file, bit for bit.
 //!
-//! Every number takes the value it has once printed and read back
-//! ([`super::printed`]): points in double precision, moved into the frame of the first
+//! Every number takes the value it has once printed with `%g` and read back
+//! (`spd::g_f64`, `spd::g_f32`): points in double precision, moved into the frame of the first
 //! viewpoint's eye, the rest in single precision; the entities go into the loader's
 //! own [`Part`] and are joined by its [`Merger`], with the lines the file would give
 //! them. Whatever the loader would refuse or warn about differently (a point before
 //! the first viewpoint, a number out of range, a degenerate entity) marks the build
 //! as failed: the caller then writes the text and reads it.
 
-use super::NffSink;
-use super::printed::{g_f32, g_f64};
 use crate::geometry::{Cone, Intersect, Kind, Sphere};
 use crate::load::LoadError;
 use crate::load::nff::{
@@ -19,12 +18,28 @@ use crate::load::nff::{
 };
 use crate::math::{DVec3, Vec3};
 use crate::scene::{Camera, Light, Scene, range};
+use crate::spd::{Database, NffSink, g_f32, g_f64};
 use glam::DVec3 as D;
 use std::path::Path;
 use std::sync::Arc;
 
+/// The scene of database `db` at size factor `size`: the scene the NFF loader reads from
+/// [`Database::generate`]'s text (named `path`, the file name of its sources and
+/// messages), built without the text when it can be (it nearly always can).
+///
+/// # Errors
+/// What the loader reports for the text, if anything.
+pub(crate) fn scene(db: Database, size: u32, path: &Path) -> Result<Scene, LoadError> {
+    let mut builder = SceneBuilder::new(path);
+    db.emit(size, &mut builder);
+    match builder.finish() {
+        Some(scene) => scene,
+        None => crate::load::nff::parse_str(&db.generate(size), path),
+    }
+}
+
 /// Builds the scene of a database's entities (see the module documentation).
-pub(crate) struct SceneBuilder<'p> {
+struct SceneBuilder<'p> {
     path: &'p Path,
     part: Part,
     /// The first viewpoint's eye, once it is known.
@@ -40,7 +55,7 @@ pub(crate) struct SceneBuilder<'p> {
 
 impl<'p> SceneBuilder<'p> {
     /// No entities yet; `path` names the scene as the loader's file name does.
-    pub fn new(path: &'p Path) -> Self {
+    fn new(path: &'p Path) -> Self {
         SceneBuilder {
             path,
             part: Part::new(Arc::from(path.display().to_string())),
@@ -53,7 +68,7 @@ impl<'p> SceneBuilder<'p> {
     }
 
     /// The scene, or `None` when the build failed (the text then decides).
-    pub fn finish(self) -> Option<Result<Scene, LoadError>> {
+    fn finish(self) -> Option<Result<Scene, LoadError>> {
         if self.failed {
             return None;
         }
@@ -247,7 +262,6 @@ impl SceneBuilder<'_> {
 mod tests {
     use super::*;
     use crate::load::nff::parse_str;
-    use crate::spd::Database;
 
     /// The scene built from each database's entities is the scene read from its text,
     /// down to every primitive's line, and it is built without the text.
@@ -270,7 +284,7 @@ mod tests {
                         .same_origins(&read.sources.materials)
                 );
                 assert!(built.sources.lights.same_origins(&read.sources.lights));
-                assert_eq!(db.scene(size, path).unwrap(), read, "{what}");
+                assert_eq!(scene(db, size, path).unwrap(), read, "{what}");
             }
         }
     }
