@@ -102,7 +102,7 @@ fn the_first_error_in_file_order_is_reported() {
         format!("{CAMERA}s 0 0 0 1\r\ns 1 2\rs 1 2 3 4\r\nf 1 1 1 1 1 -1 0 0\n"),
         format!("{CAMERA}p 99999999\n0 0 0\n"),
         format!("{CAMERA}s 0 0 0 1\nv\nfrom 0 0 5\nat 0 0 5\nup 0 1 0\n"),
-        format!("s 0 0 0 1\nl 1 1 1\n"),
+        "s 0 0 0 1\nl 1 1 1\n".to_string(),
         format!("{CAMERA}s 0 0 0 1\np 3\n0 0 0\n1 0 0\n"),
         "é s\n".to_string(),
     ];

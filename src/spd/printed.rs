@@ -75,7 +75,7 @@ fn six_digits(x: f64) -> Option<(u64, i32)> {
         scaled = scale(a, k)?;
     }
     let frac = scaled - scaled.floor();
-    let unsure = (frac - 0.5).abs() < MARGIN || scaled < 1e5 + MARGIN || scaled >= 1e6 - MARGIN;
+    let unsure = (frac - 0.5).abs() < MARGIN || !(1e5 + MARGIN..1e6 - MARGIN).contains(&scaled);
     if unsure {
         return None;
     }
