@@ -102,7 +102,7 @@ impl SceneSource {
 pub fn load_scene(spec: impl AsRef<Path>) -> Result<Scene, SceneError> {
     let spec = spec.as_ref();
     match Database::parse_spec(&spec.to_string_lossy())? {
-        Some((db, size)) => Ok(load::nff::parse_str(&db.generate(size), spec)?),
+        Some((db, size)) => Ok(super::spd_scene::scene(db, size, spec)?),
         None => Ok(load::load_path(spec)?),
     }
 }

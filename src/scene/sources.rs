@@ -103,6 +103,39 @@ impl Sources {
         });
     }
 
+    /// Append `other`'s items after the first `offset` indices: the table that adding
+    /// `other`'s items here one by one, in order, `offset` places on, would make.
+    pub fn append(&mut self, other: &Sources, offset: usize) {
+        for run in &other.runs {
+            let file = &other.files[run.file as usize];
+            let first = run.first as usize + offset;
+            let lines = run.count / run.per;
+            // The first line of a run may continue the last run here; the rest then do.
+            self.add(first, run.per as usize, file, run.line);
+            if lines > 1 {
+                let Some(last) = self.runs.last_mut() else {
+                    return;
+                };
+                if last.first + last.count == first as u32 + run.per {
+                    last.count += run.count - run.per;
+                }
+            }
+        }
+    }
+
+    /// Whether `other` records the same origins as `self` (the equality that the
+    /// [`PartialEq`] implementation leaves out).
+    pub fn same_origins(&self, other: &Sources) -> bool {
+        let key = |s: &Sources| -> Vec<(Run, Arc<str>)> {
+            s.runs
+                .iter()
+                .map(|r| (*r, s.files[r.file as usize].clone()))
+                .map(|(r, f)| (Run { file: 0, ..r }, f))
+                .collect()
+        };
+        key(self) == key(other)
+    }
+
     fn file_index(&mut self, file: &Arc<str>) -> u32 {
         match self.files.iter().rposition(|f| f == file) {
             Some(k) => k as u32,
@@ -162,6 +195,32 @@ impl PrimSources {
             self.kinds.resize_with(k + 1, Sources::default);
         }
         self.kinds[k].add(first, count, file, line);
+    }
+
+    /// Append `other`'s primitives after the first `offset(kind)` of each kind (see
+    /// [`Sources::append`]).
+    pub fn append(&mut self, other: &PrimSources, offset: &dyn Fn(Kind) -> usize) {
+        for (k, sources) in other.kinds.iter().enumerate() {
+            if sources.runs.is_empty() {
+                continue;
+            }
+            let kind = Kind::ALL[k];
+            if self.kinds.len() <= k {
+                self.kinds.resize_with(k + 1, Sources::default);
+            }
+            self.kinds[k].append(sources, offset(kind));
+        }
+    }
+
+    /// Whether `other` records the same origins as `self` (see
+    /// [`Sources::same_origins`]).
+    pub fn same_origins(&self, other: &PrimSources) -> bool {
+        (0..self.kinds.len().max(other.kinds.len())).all(|k| {
+            let empty = Sources::default();
+            let a = self.kinds.get(k).unwrap_or(&empty);
+            let b = other.kinds.get(k).unwrap_or(&empty);
+            a.same_origins(b)
+        })
     }
 
     /// Where primitive `prim` of `kind` was defined, if it was recorded.

@@ -49,6 +49,20 @@ impl<T> Prims<T> {
         self.items.is_empty()
     }
 
+    /// Append `other`'s primitives, their materials mapped by `material`; an empty
+    /// list takes `other`'s storage as it is.
+    pub fn append(&mut self, mut other: Prims<T>, material: impl Fn(u32) -> u32) {
+        for m in &mut other.material {
+            *m = material(*m);
+        }
+        if self.items.is_empty() {
+            *self = other;
+        } else {
+            self.items.append(&mut other.items);
+            self.material.append(&mut other.material);
+        }
+    }
+
     /// Every primitive with its `prim_id` and material.
     pub fn iter(&self) -> impl Iterator<Item = (u32, &T, u32)> + '_ {
         (0u32..)
@@ -136,6 +150,30 @@ macro_rules! define_store {
                 }
             }
 
+            /// Append `other`'s primitives after this store's, their materials mapped
+            /// by `material`, their sources and their triangles' normals, texture
+            /// coordinates and quads numbered on.
+            pub fn append(&mut self, other: Geometry, material: impl Fn(u32) -> u32) {
+                let Geometry {
+                    triangles, triangle_normals, vertex_normals, triangle_uvs, vertex_uvs,
+                    triangle_quads, quads, sources, $($field,)*
+                } = other;
+                let mark = self.mark();
+                self.sources.append(&sources, &|k| mark.count(k));
+                let first_triangle = self.triangles.len();
+                self.triangles.append(triangles, &material);
+                append_indices(&mut self.triangle_normals, triangle_normals, first_triangle,
+                    self.vertex_normals.len());
+                append_indices(&mut self.triangle_uvs, triangle_uvs, first_triangle,
+                    self.vertex_uvs.len());
+                append_indices(&mut self.triangle_quads, triangle_quads, first_triangle,
+                    self.quads.len());
+                extend(&mut self.vertex_normals, vertex_normals);
+                extend(&mut self.vertex_uvs, vertex_uvs);
+                extend(&mut self.quads, quads);
+                $(self.$field.append($field, &material);)*
+            }
+
             /// Run `visitor` on the list of `kind` (`None` for triangles).
             #[inline]
             pub fn visit<V: KindVisitor>(&self, kind: Kind, visitor: &mut V) -> Option<V::Output> {
@@ -164,6 +202,33 @@ macro_rules! define_store {
 }
 
 for_each_kind!(define_store);
+
+/// Append `other`, a per-triangle list of indices into a list that had `base` items
+/// (`u32::MAX` for none), to `list`, which is per triangle for the first `first`
+/// triangles but may be shorter (the rest have none).
+fn append_indices(list: &mut Vec<u32>, other: Vec<u32>, first: usize, base: usize) {
+    if other.is_empty() {
+        return;
+    }
+    list.resize(first, u32::MAX);
+    let base = base as u32;
+    list.extend(other.into_iter().map(|k| {
+        if k == u32::MAX {
+            k
+        } else {
+            k.wrapping_add(base)
+        }
+    }));
+}
+
+/// `list` followed by `other` (`other`'s storage when `list` is empty).
+fn extend<T>(list: &mut Vec<T>, mut other: Vec<T>) {
+    if list.is_empty() {
+        *list = other;
+    } else {
+        list.append(&mut other);
+    }
+}
 
 /// The primitive counts of a [`Geometry`] at one moment ([`Geometry::mark`]), per kind.
 #[derive(Clone, Copy, Debug, Default, PartialEq, Eq)]

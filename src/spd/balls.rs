@@ -17,7 +17,7 @@
 //! printed numbers are the SPD's to the last digit.
 
 use super::tx::{IDENTITY, rotate, rotate_axis, transform_coord_w0};
-use super::{NffWriter, phong_power};
+use super::{NffSink, phong_power};
 use glam::DVec3;
 use std::f64::consts::PI;
 
@@ -150,7 +150,7 @@ fn grow(
 }
 
 /// Write the database at size factor `size`.
-pub fn generate(size: u32, w: &mut NffWriter) {
+pub fn generate(size: u32, w: &mut impl NffSink) {
     // Radius of the sphere that would enclose the whole flake.
     let radius = 1.0;
     w.background(DVec3::new(0.078, 0.361, 0.753));
@@ -198,6 +198,7 @@ pub fn generate(size: u32, w: &mut NffWriter) {
 #[cfg(test)]
 mod tests {
     use super::*;
+    use crate::spd::NffWriter;
     use std::path::Path;
 
     fn sphere_count(n: u32) -> usize {

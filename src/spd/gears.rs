@@ -11,7 +11,7 @@
 //! Size factor `n`: n³ gears, each 2 + 144 polygons, plus the ground square:
 //! 146·n³ + 1 polygons (147, 1169, 3943, 9345, …).
 
-use super::{NffWriter, phong_power};
+use super::{NffSink, phong_power};
 use glam::DVec3;
 use std::f64::consts::PI;
 
@@ -29,7 +29,7 @@ const INNER_EDGE_RATIO: f64 = 0.9;
 const DEPTH_RATIO: f64 = 0.1;
 
 /// Write the database at size factor `size`.
-pub fn generate(size: u32, w: &mut NffWriter) {
+pub fn generate(size: u32, w: &mut impl NffSink) {
     let sf = size as f64;
     w.background(DVec3::new(0.078, 0.361, 0.753));
     w.viewpoint(
@@ -112,7 +112,7 @@ pub fn generate(size: u32, w: &mut NffWriter) {
 
 /// One gear: top face at `center.z`, sides, bottom face `thickness` lower.
 fn gear(
-    w: &mut NffWriter,
+    w: &mut impl NffSink,
     center: DVec3,
     offset_angle: f64,
     outer: f64,

@@ -12,7 +12,7 @@
 //! are (8ⁿ − 1)/7 jacks: 9·(8ⁿ − 1)/7 primitives (9, 81, 657, 5265, 42129, …).
 
 use super::tx::{IDENTITY, Matrix, multiply};
-use super::{NffWriter, phong_power};
+use super::{NffSink, phong_power};
 use glam::DVec3;
 use std::f64::consts::PI;
 
@@ -22,7 +22,7 @@ use std::f64::consts::PI;
 pub const DEFAULT_SIZE: u32 = 4;
 
 /// Write the database at size factor `size` (nesting depth; 0 writes no jacks).
-pub fn generate(size: u32, w: &mut NffWriter) {
+pub fn generate(size: u32, w: &mut impl NffSink) {
     w.background(DVec3::new(0.2, 0.05, 0.2));
     w.viewpoint(
         DVec3::new(0.0, 0.0, -8.0),
@@ -53,7 +53,7 @@ pub fn generate(size: u32, w: &mut NffWriter) {
 }
 
 /// One jack and, below the deepest level, its eight half-size children.
-fn rec_jack(depth: u32, max_depth: u32, tx: &mut TxStack, w: &mut NffWriter) {
+fn rec_jack(depth: u32, max_depth: u32, tx: &mut TxStack, w: &mut impl NffSink) {
     jack(tx, w);
     if depth < max_depth {
         // The SPD steps a double from −0.5 while it is ≤ 0.5: −0.5, then 0.5.
@@ -73,7 +73,7 @@ fn rec_jack(depth: u32, max_depth: u32, tx: &mut TxStack, w: &mut NffWriter) {
 
 /// Three cylinders along the axes from −1 to 1 (radius 0.1) and spheres of radius 0.2
 /// at their ends, all scaled by 0.75 to keep neighbours apart.
-fn jack(tx: &mut TxStack, w: &mut NffWriter) {
+fn jack(tx: &mut TxStack, w: &mut impl NffSink) {
     tx.push();
     tx.scale(0.75);
     let axes = [DVec3::X, DVec3::Y, DVec3::Z];

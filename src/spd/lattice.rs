@@ -6,7 +6,7 @@
 //! radius 1/(16n), each starting and ending just inside the spheres it joins.
 //! Everything gets its own `f` line before it, as the SPD program writes them.
 
-use super::{NffWriter, phong_power};
+use super::{NffSink, phong_power};
 use glam::DVec3;
 
 /// The SPD program's default size factor: `lattice.c` starts with
@@ -20,7 +20,7 @@ const RADIUS1: f64 = 1.0 / 4.0;
 const RADIUS2: f64 = 1.0 / 16.0;
 
 /// Write the database at size factor `size` (at least 1).
-pub fn generate(size: u32, w: &mut NffWriter) {
+pub fn generate(size: u32, w: &mut impl NffSink) {
     let sf = size as f64;
     let inv_factor = 1.0 / sf;
     let radius1 = RADIUS1 / sf;

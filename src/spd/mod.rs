@@ -4,19 +4,26 @@
 //! Each database writes NFF through [`NffWriter`] exactly as the SPD programs' default
 //! NFF output does (curved primitives, not tessellated): the same entities in the same
 //! order, every number printed with C's `%g` ([`fmt_g`]), computed in double precision.
+//! The same entities can also go to any other [`NffSink`] ([`Database::emit`]): the
+//! job builds the scene from them without the text (`job::spd_scene`).
 
 mod balls;
 mod gears;
 mod jacks;
 mod lattice;
 mod mount;
+mod printed;
 mod rings;
 mod shells;
+mod sink;
 mod sombrero;
 mod teapot;
 mod tetra;
 mod tree;
 mod tx;
+
+pub(crate) use printed::{g_f32, g_f64};
+pub use sink::NffSink;
 
 use glam::DVec3;
 use std::fmt::Write;
@@ -443,20 +450,25 @@ impl Database {
     /// The NFF text of the database at size factor `size`.
     pub fn generate(self, size: u32) -> String {
         let mut w = NffWriter::new();
-        match self {
-            Database::Balls => balls::generate(size, &mut w),
-            Database::Gears => gears::generate(size, &mut w),
-            Database::Jacks => jacks::generate(size, &mut w),
-            Database::Lattice => lattice::generate(size, &mut w),
-            Database::Mount => mount::generate(size, &mut w),
-            Database::Rings => rings::generate(size, &mut w),
-            Database::Shells => shells::generate(size, &mut w),
-            Database::Sombrero => sombrero::generate(size, &mut w),
-            Database::Teapot => teapot::generate(size, &mut w),
-            Database::Tetra => tetra::generate(size, &mut w),
-            Database::Tree => tree::generate(size, &mut w),
-        }
+        self.emit(size, &mut w);
         w.finish()
+    }
+
+    /// Send the database's entities at size factor `size` to `sink`.
+    pub fn emit(self, size: u32, sink: &mut impl NffSink) {
+        match self {
+            Database::Balls => balls::generate(size, sink),
+            Database::Gears => gears::generate(size, sink),
+            Database::Jacks => jacks::generate(size, sink),
+            Database::Lattice => lattice::generate(size, sink),
+            Database::Mount => mount::generate(size, sink),
+            Database::Rings => rings::generate(size, sink),
+            Database::Shells => shells::generate(size, sink),
+            Database::Sombrero => sombrero::generate(size, sink),
+            Database::Teapot => teapot::generate(size, sink),
+            Database::Tetra => tetra::generate(size, sink),
+            Database::Tree => tree::generate(size, sink),
+        }
     }
 }
 

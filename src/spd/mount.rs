@@ -15,7 +15,7 @@
 //! 3.x made the fix optional).
 
 use super::tx::{rotate, rotate_axis, transform_vector};
-use super::{NffWriter, phong_power};
+use super::{NffSink, phong_power};
 use glam::DVec3;
 use std::f64::consts::PI;
 
@@ -70,7 +70,7 @@ pub(crate) fn gauss_rand(seed: i64) -> f64 {
 
 /// The pyramid of four spheres of radius `radius` resting around `center`: one on
 /// top, three below it spaced 120° apart, each touching the top one.
-fn create_spheres(w: &mut NffWriter, center: DVec3, radius: f64) {
+fn create_spheres(w: &mut impl NffSink, center: DVec3, radius: f64) {
     let axis = DVec3::new(1.0, 1.0, 0.0);
     let len = (axis.x * axis.x + axis.y * axis.y + axis.z * axis.z).sqrt();
     let axis = DVec3::new(axis.x / len, axis.y / len, axis.z / len);
@@ -161,7 +161,7 @@ impl<F: FnMut([DVec3; 3])> Mountain<F> {
 }
 
 /// Write the database at size factor `size`.
-pub fn generate(size: u32, w: &mut NffWriter) {
+pub fn generate(size: u32, w: &mut impl NffSink) {
     // UNC sky blue.
     w.background(DVec3::new(0.078, 0.361, 0.753));
     w.viewpoint(
@@ -213,6 +213,7 @@ fn for_each_triangle(size: u32, emit: impl FnMut([DVec3; 3])) {
 #[cfg(test)]
 mod tests {
     use super::*;
+    use crate::spd::NffWriter;
     use std::collections::HashMap;
     use std::path::Path;
 

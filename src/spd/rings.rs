@@ -12,7 +12,7 @@
 //! 5·n(n+1)(2n+1) of each (30, 150, 420, …, 4200 at 7), plus the wall polygon.
 
 use super::tx::{rotate, transform_point};
-use super::{NffWriter, phong_power};
+use super::{NffSink, phong_power};
 use glam::DVec3;
 use std::f64::consts::PI;
 
@@ -26,7 +26,7 @@ const RADIUS: f64 = 0.07412;
 const SPREAD_OUT: f64 = 1.0;
 
 /// Write the database at size factor `size`.
-pub fn generate(size: u32, w: &mut NffWriter) {
+pub fn generate(size: u32, w: &mut impl NffSink) {
     let spread = 1.0 / (PI / 8.0).sin();
     let (y_diff, xz_diff) = if SPREAD_OUT <= spread {
         (spread / SPREAD_OUT, 1.0)

@@ -9,7 +9,7 @@
 //! `z = β r` form). That is `steps + 1 = 180·2ˢⁱᶻᵉ + 1` spheres and nothing else (the
 //! SPD's comment mentions a square, but the program writes none).
 
-use super::NffWriter;
+use super::NffSink;
 use glam::DVec3;
 use std::f64::consts::PI;
 
@@ -43,7 +43,7 @@ fn spheres(size: u32) -> Vec<(DVec3, f64)> {
 }
 
 /// Write the database at size factor `size`.
-pub fn generate(size: u32, w: &mut NffWriter) {
+pub fn generate(size: u32, w: &mut impl NffSink) {
     w.background(DVec3::new(0.078, 0.361, 0.753));
     w.viewpoint(
         DVec3::new(-6.0, -60.0, 35.0),
@@ -70,6 +70,7 @@ pub fn generate(size: u32, w: &mut NffWriter) {
 #[cfg(test)]
 mod tests {
     use super::*;
+    use crate::spd::NffWriter;
     use std::path::Path;
 
     #[test]

@@ -9,7 +9,7 @@
 //! writes each of the `(w − 1)²` cells as two triangles, `2(w − 1)²` in all (1922 at
 //! size 1).
 
-use super::NffWriter;
+use super::NffSink;
 use glam::DVec3;
 
 /// emray's default size factor: the SPD convention of the largest size below 10,000
@@ -89,7 +89,7 @@ fn triangles(data: &[Vec<f32>]) -> Vec<[DVec3; 3]> {
 }
 
 /// Write the database at size factor `size`.
-pub fn generate(size: u32, w: &mut NffWriter) {
+pub fn generate(size: u32, w: &mut impl NffSink) {
     w.background(DVec3::new(0.078, 0.361, 0.753));
     w.viewpoint(
         DVec3::new(0.0, 5.0, -8.0),
@@ -117,6 +117,7 @@ pub fn generate(size: u32, w: &mut NffWriter) {
 #[cfg(test)]
 mod tests {
     use super::*;
+    use crate::spd::NffWriter;
     use std::collections::BTreeMap;
     use std::path::Path;
 

@@ -18,7 +18,7 @@
 //! so that the printed rounding noise (e.g. normals `1.4538e-15 -1.67359e-15 1`)
 //! comes out the same.
 
-use super::{NffWriter, phong_power};
+use super::{NffSink, phong_power};
 use crate::geometry::bezier::newell::{PATCHES, VERTS};
 use glam::DVec3;
 
@@ -41,7 +41,7 @@ const DARK_SQUARES: DVec3 = DVec3::new(0.5, 0.5, 0.5);
 
 /// Write the database at size factor `size` (the number of subdivisions of each patch
 /// parameter and of each side of the floor).
-pub fn generate(size: u32, w: &mut NffWriter) {
+pub fn generate(size: u32, w: &mut impl NffSink) {
     w.background(DVec3::new(0.078, 0.361, 0.753));
     w.viewpoint(
         DVec3::new(4.86, 7.2, 5.4),
@@ -59,13 +59,13 @@ pub fn generate(size: u32, w: &mut NffWriter) {
 
 /// A material the way the SPD library writes it for NFF: colour, Kd, Ks, Shine (from
 /// the highlight angle), no transmission.
-fn material(w: &mut NffWriter, color: DVec3, kd: f64, ks: f64, angle_deg: f64) {
+fn material(w: &mut impl NffSink, color: DVec3, kd: f64, ks: f64, angle_deg: f64) {
     w.fill(color, kd, ks, phong_power(angle_deg), 0.0, 0.0);
 }
 
 /// The floor: a `size × size` checkerboard on `z = 0` spanning `[-4, 4]²`, the squares
 /// with odd `i + j` first (white), then the even ones (grey).
-fn checkerboard(size: u32, w: &mut NffWriter) {
+fn checkerboard(size: u32, w: &mut impl NffSink) {
     for (color, parity) in [(LIGHT_SQUARES, 1), (DARK_SQUARES, 0)] {
         material(w, color, 0.5, 0.5, 30.0);
         for i in 0..size {
@@ -94,7 +94,7 @@ fn cell_corner(k: usize) -> (u32, u32) {
 
 /// The teapot: every patch, every parameter cell, two triangles per cell (corners
 /// 0-1-2 and 2-3-0), skipping triangles degenerate at a cusp.
-fn teapot(size: u32, w: &mut NffWriter) {
+fn teapot(size: u32, w: &mut impl NffSink) {
     material(w, TEAPOT_COLOR, 0.75, 0.25, 37.0);
     let n = f64::from(size);
     for index in 0..PATCHES.len() {
@@ -273,6 +273,7 @@ impl Patch {
 #[cfg(test)]
 mod tests {
     use super::*;
+    use crate::spd::NffWriter;
     use std::path::Path;
 
     fn text(size: u32) -> String {

@@ -8,7 +8,7 @@
 //! tetrahedra is written as its four triangular faces: `4ˢⁱᶻᵉ` triangles in all, no
 //! floor. Every coordinate is a dyadic fraction, so the numbers are exact.
 
-use super::NffWriter;
+use super::NffSink;
 use glam::DVec3;
 
 /// The SPD program's default size factor (`tetra.c`: `size_factor = 6`, 4096
@@ -63,7 +63,7 @@ fn triangles(depth: u32, center: DVec3, half: f64, out: &mut Vec<[DVec3; 3]>) {
 }
 
 /// Write the database at size factor `size`.
-pub fn generate(size: u32, w: &mut NffWriter) {
+pub fn generate(size: u32, w: &mut impl NffSink) {
     w.background(DVec3::new(0.078, 0.361, 0.753));
     // Kay & Kajiya's view and light, moved into these world coordinates.
     w.viewpoint(
@@ -94,6 +94,7 @@ pub fn generate(size: u32, w: &mut NffWriter) {
 #[cfg(test)]
 mod tests {
     use super::*;
+    use crate::spd::NffWriter;
     use std::collections::BTreeSet;
     use std::path::Path;
 

@@ -12,7 +12,7 @@
 //! from depth `size` down to 0, so size factor `n` gives `2ⁿ⁺¹ − 1` cones and as many
 //! spheres (4095 of each at the default 11), plus the one field polygon.
 
-use super::NffWriter;
+use super::NffSink;
 use super::tx::{IDENTITY, Matrix, multiply, rotate, transform_point};
 use glam::DVec3;
 use std::f64::consts::PI;
@@ -93,7 +93,7 @@ fn for_each_branch(size: u32, mut emit: impl FnMut(&Branch)) {
 }
 
 /// Write the database at size factor `size`.
-pub fn generate(size: u32, w: &mut NffWriter) {
+pub fn generate(size: u32, w: &mut impl NffSink) {
     // UNC sky blue.
     w.background(DVec3::new(0.078, 0.361, 0.753));
     w.viewpoint(
@@ -136,6 +136,7 @@ pub fn generate(size: u32, w: &mut NffWriter) {
 #[cfg(test)]
 mod tests {
     use super::*;
+    use crate::spd::NffWriter;
     use std::path::Path;
 
     fn nff(size: u32) -> String {

@@ -1,0 +1,310 @@
+//! The scene of an SPD database ([`scene`]), built from the database's entities
+//! ([`NffSink`]) without text: the scene the NFF loader reads from the database's
+//! file, bit for bit.
+//!
+//! Every number takes the value it has once printed with `%g` and read back
+//! (`spd::g_f64`, `spd::g_f32`): points in double precision, moved into the frame of the first
+//! viewpoint's eye, the rest in single precision; the entities go into the loader's
+//! own [`Part`] and are joined by its [`Merger`], with the lines the file would give
+//! them. Whatever the loader would refuse or warn about differently (a point before
+//! the first viewpoint, a number out of range, a degenerate entity) marks the build
+//! as failed: the caller then writes the text and reads it.
+
+use crate::geometry::{Cone, Intersect, Kind, Sphere};
+use crate::load::LoadError;
+use crate::load::nff::{
+    MAX_PIXELS, MAX_RESOLUTION_SIDE, Merger, Note, Part, fill, unit_normal, up_is_usable,
+    world_bounds,
+};
+use crate::math::{DVec3, Vec3};
+use crate::scene::{Camera, Light, Scene, range};
+use crate::spd::{Database, NffSink, g_f32, g_f64};
+use glam::DVec3 as D;
+use std::path::Path;
+use std::sync::Arc;
+
+/// The scene of database `db` at size factor `size`: the scene the NFF loader reads from
+/// [`Database::generate`]'s text (named `path`, the file name of its sources and
+/// messages), built without the text when it can be (it nearly always can).
+///
+/// # Errors
+/// What the loader reports for the text, if anything.
+pub(crate) fn scene(db: Database, size: u32, path: &Path) -> Result<Scene, LoadError> {
+    let mut builder = SceneBuilder::new(path);
+    db.emit(size, &mut builder);
+    match builder.finish() {
+        Some(scene) => scene,
+        None => crate::load::nff::parse_str(&db.generate(size), path),
+    }
+}
+
+/// Builds the scene of a database's entities (see the module documentation).
+struct SceneBuilder<'p> {
+    path: &'p Path,
+    part: Part,
+    /// The first viewpoint's eye, once it is known.
+    origin: Option<DVec3>,
+    /// The line the next entity starts on.
+    line: u32,
+    /// Whether an entity could not be made as the loader would make it.
+    failed: bool,
+    /// Scratch: a polygon's vertices and normals.
+    pts: Vec<Vec3>,
+    nrm: Vec<Vec3>,
+}
+
+impl<'p> SceneBuilder<'p> {
+    /// No entities yet; `path` names the scene as the loader's file name does.
+    fn new(path: &'p Path) -> Self {
+        SceneBuilder {
+            path,
+            part: Part::new(Arc::from(path.display().to_string())),
+            origin: None,
+            line: 1,
+            failed: false,
+            pts: Vec::new(),
+            nrm: Vec::new(),
+        }
+    }
+
+    /// The scene, or `None` when the build failed (the text then decides).
+    fn finish(self) -> Option<Result<Scene, LoadError>> {
+        if self.failed {
+            return None;
+        }
+        let mut merger = Merger::new(self.path, self.origin.unwrap_or(DVec3::ZERO));
+        merger.add(self.part);
+        Some(merger.finish())
+    }
+
+    /// The line of an entity of `lines` lines, the next one's after it.
+    fn entity(&mut self, lines: usize) -> u32 {
+        let line = self.line;
+        self.line = self.line.saturating_add(lines as u32);
+        line
+    }
+
+    /// Fail unless `ok`.
+    fn check(&mut self, ok: bool) {
+        self.failed |= !ok;
+    }
+
+    /// A number read in single precision.
+    fn num(&mut self, x: f64) -> f32 {
+        let v = g_f32(x);
+        self.check(v.is_finite());
+        v
+    }
+
+    fn vec3(&mut self, v: D) -> Vec3 {
+        Vec3::new(self.num(v.x), self.num(v.y), self.num(v.z))
+    }
+
+    /// A point, in the scene's frame.
+    fn point(&mut self, p: D) -> Vec3 {
+        let world = D::new(g_f64(p.x), g_f64(p.y), g_f64(p.z));
+        let finite = world.is_finite() && world.as_vec3().is_finite();
+        self.check(finite && range::check_point("", world.as_vec3()).is_ok());
+        match self.origin {
+            Some(o) => (world - o).as_vec3(),
+            None => {
+                self.failed = true;
+                Vec3::ZERO
+            }
+        }
+    }
+
+    /// The loader's warning for a colour written with channels above 1 (the colour is
+    /// the entity's first number, at column 3).
+    fn warn_above_one(&mut self, line: u32, what: &str, c: Vec3) {
+        if c.max_element() > 1.0 {
+            let warning = format!(
+                "{}:{line}:3: the {what} colour {} {} {} has channels above 1; NFF colours run \
+                 from 0 to 1 (a colour on a 0-255 scale is divided by 255)",
+                self.path.display(),
+                c.x,
+                c.y,
+                c.z
+            );
+            self.part.notes.push(Note::Warning(warning));
+        }
+    }
+
+    fn world_bounds_ok(&self, what: &str, bounds: &crate::math::Aabb) -> bool {
+        let origin = self.origin.unwrap_or(DVec3::ZERO);
+        range::check_bounds(what, &world_bounds(origin, bounds)).is_ok()
+    }
+}
+
+impl NffSink for SceneBuilder<'_> {
+    fn viewpoint(&mut self, from: D, at: D, up: D, angle: f64, hither: f64, res: (i32, i32)) {
+        let line = self.entity(7) as usize;
+        self.part.notes.push(Note::Viewpoint { line, col: 1 });
+        if self.origin.is_none() {
+            self.origin = Some(D::new(g_f64(from.x), g_f64(from.y), g_f64(from.z)));
+        }
+        let (from, at, up) = (self.point(from), self.point(at), self.vec3(up));
+        let (angle, hither) = (self.num(angle), self.num(hither));
+        let (w, h) = (i128::from(res.0), i128::from(res.1));
+        let side = 1..=MAX_RESOLUTION_SIDE as i128;
+        self.check(at != from && up_is_usable(at - from, up));
+        self.check(angle > 0.0 && angle < 180.0 && hither >= 0.0);
+        self.check(side.contains(&w) && side.contains(&h) && w * h <= MAX_PIXELS as i128);
+        if self.failed {
+            return;
+        }
+        self.part.notes.push(Note::Camera(Camera {
+            from,
+            at,
+            up,
+            angle_deg: angle,
+            hither,
+            width: w as u32,
+            height: h as u32,
+        }));
+    }
+
+    fn background(&mut self, rgb: D) {
+        let line = self.entity(1);
+        let c = self.vec3(rgb);
+        self.warn_above_one(line, "background", c);
+        self.part.background = Some(c);
+    }
+
+    fn light(&mut self, pos: D) {
+        let line = self.entity(1);
+        let pos = self.point(pos);
+        self.part
+            .add_light(Light::point(pos, Vec3::ZERO), false, line);
+    }
+
+    fn fill(&mut self, rgb: D, kd: f64, ks: f64, shine: f64, t: f64, ior: f64) {
+        let line = self.entity(1);
+        let color = self.vec3(rgb);
+        self.warn_above_one(line, "fill", color);
+        let [kd, ks, shine, t, ior] = [kd, ks, shine, t, ior].map(|x| self.num(x));
+        self.check(shine >= 0.0 && range::check_ior(t, ior).is_ok());
+        self.part
+            .add_material(fill(color, kd, ks, shine, t, ior), line);
+    }
+
+    fn sphere(&mut self, center: D, radius: f64) {
+        let line = self.entity(1);
+        let (center, r) = (self.point(center), self.num(radius));
+        self.check(r != 0.0);
+        let sphere = Sphere::new(center, r);
+        let ok = self.world_bounds_ok("the sphere", &sphere.bounds());
+        self.check(ok);
+        if !self.failed {
+            self.part.add_analytic(sphere, Kind::Sphere, line);
+        }
+    }
+
+    fn cone(&mut self, base: D, base_radius: f64, apex: D, apex_radius: f64) {
+        let line = self.entity(1);
+        let (base, rb) = (self.point(base), self.num(base_radius));
+        let (apex, ra) = (self.point(apex), self.num(apex_radius));
+        let same_side = !((rb < 0.0 && ra > 0.0) || (rb > 0.0 && ra < 0.0));
+        self.check(!(rb == 0.0 && ra == 0.0) && same_side && base != apex);
+        if self.failed {
+            return;
+        }
+        let cone = Cone::new(base, rb, apex, ra);
+        let ok = self.world_bounds_ok("the cone", &cone.bounds());
+        self.check(ok);
+        if ok {
+            self.part.add_analytic(cone, Kind::Cone, line);
+        }
+    }
+
+    fn polygon(&mut self, verts: &[D]) {
+        self.polygon_with(verts, None);
+    }
+
+    fn polypatch(&mut self, verts: &[D], normals: &[D]) {
+        self.polygon_with(verts, Some(normals));
+    }
+}
+
+impl SceneBuilder<'_> {
+    /// `p` (no normals) or `pp`: one line for the count, one per vertex.
+    fn polygon_with(&mut self, verts: &[D], normals: Option<&[D]>) {
+        let line = self.entity(1 + verts.len());
+        self.check(!verts.is_empty() && normals.is_none_or(|n| n.len() >= verts.len()));
+        if self.failed {
+            return;
+        }
+        let mut pts = std::mem::take(&mut self.pts);
+        let mut nrm = std::mem::take(&mut self.nrm);
+        pts.clear();
+        nrm.clear();
+        for (k, &v) in verts.iter().enumerate() {
+            pts.push(self.point(v));
+            if let Some(n) = normals {
+                let n = self.vec3(n[k]);
+                let unit = unit_normal(n);
+                self.check(unit.is_some());
+                nrm.push(unit.unwrap_or(Vec3::Z));
+            }
+        }
+        if !self.failed {
+            let normals = normals.map(|_| &nrm[..]);
+            let added = self
+                .part
+                .add_polygon(&pts, normals, line, || (line as usize, 1));
+            self.check(added.is_ok());
+        }
+        (self.pts, self.nrm) = (pts, nrm);
+    }
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+    use crate::load::nff::parse_str;
+
+    /// The scene built from each database's entities is the scene read from its text,
+    /// down to every primitive's line, and it is built without the text.
+    #[test]
+    fn every_database_builds_the_scene_its_text_reads_as() {
+        for db in Database::ALL {
+            for size in [1, 2] {
+                let path = Path::new("spd:db");
+                let mut builder = SceneBuilder::new(path);
+                db.emit(size, &mut builder);
+                let built = builder.finish().expect("built directly").unwrap();
+                let read = parse_str(&db.generate(size), path).unwrap();
+                let what = format!("{} size {size}", db.name());
+                assert_eq!(built, read, "{what}");
+                assert!(built.geometry.sources.same_origins(&read.geometry.sources));
+                assert!(
+                    built
+                        .sources
+                        .materials
+                        .same_origins(&read.sources.materials)
+                );
+                assert!(built.sources.lights.same_origins(&read.sources.lights));
+                assert_eq!(scene(db, size, path).unwrap(), read, "{what}");
+            }
+        }
+    }
+
+    /// A point before the first viewpoint is in a frame not yet known: the text decides.
+    #[test]
+    fn a_point_before_the_viewpoint_fails_the_build() {
+        let mut builder = SceneBuilder::new(Path::new("x"));
+        builder.sphere(D::ZERO, 1.0);
+        builder.viewpoint(D::Z, D::ZERO, D::Y, 45.0, 0.0, (8, 8));
+        assert!(builder.finish().is_none());
+        let mut builder = SceneBuilder::new(Path::new("x"));
+        builder.viewpoint(D::Z, D::ZERO, D::Y, 45.0, 0.0, (8, 8));
+        builder.sphere(D::ZERO, 1.0);
+        builder.polygon(&[D::ZERO, D::X, D::Y]);
+        let scene = builder.finish().unwrap().unwrap();
+        assert_eq!(scene.geometry.count(Kind::Triangle), 1);
+        assert_eq!(
+            scene.geometry.sources.get(Kind::Triangle, 0).unwrap().line,
+            9
+        );
+    }
+}

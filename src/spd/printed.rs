@@ -1,0 +1,159 @@
+//! The value a number has once printed with `%g` ([`super::fmt_g`]) and read back by
+//! the NFF loader (`str::parse`), computed without the text.
+//!
+//! `%g` keeps six significant digits: the integer `m = round(|x| · 10^k)` with `k`
+//! chosen so that `10^5 ≤ |x| · 10^k < 10^6`. With `|k| ≤ 22`, `|x| · 10^k` is one
+//! correctly rounded operation away from the exact product, so `m` is certain unless
+//! the product lies within 10⁻⁶ of a rounding tie or of the range's ends; then the
+//! text is printed and read. Reading `m · 10^-k` is again one correctly rounded
+//! operation on exact operands (`m < 2^24`, the power exact) when `|k| ≤ 22` (double
+//! precision) or `|k| ≤ 10` (single precision), which is the correctly rounded value
+//! of the decimal: what `str::parse` returns. Elsewhere, the text decides.
+
+use super::fmt_g;
+
+/// Powers of ten exact in double precision.
+const POW10: [f64; 23] = [
+    1e0, 1e1, 1e2, 1e3, 1e4, 1e5, 1e6, 1e7, 1e8, 1e9, 1e10, 1e11, 1e12, 1e13, 1e14, 1e15, 1e16,
+    1e17, 1e18, 1e19, 1e20, 1e21, 1e22,
+];
+/// Powers of ten exact in single precision.
+const POW10_F32: [f32; 11] = [1e0, 1e1, 1e2, 1e3, 1e4, 1e5, 1e6, 1e7, 1e8, 1e9, 1e10];
+/// How close to a tie or to the range's ends the scaled value may come.
+const MARGIN: f64 = 1e-6;
+
+/// `x` printed with `%g` and read as an `f64`, bit for bit.
+pub(crate) fn g_f64(x: f64) -> f64 {
+    match six_digits(x) {
+        Some((0, _)) => x, // ±0, its sign kept
+        Some((m, k)) if (-22..=22).contains(&k) => {
+            let v = if k >= 0 {
+                m as f64 / POW10[k as usize]
+            } else {
+                m as f64 * POW10[(-k) as usize]
+            };
+            v.copysign(x)
+        }
+        _ => fmt_g(x).parse().unwrap_or(f64::NAN),
+    }
+}
+
+/// `x` printed with `%g` and read as an `f32`, bit for bit.
+pub(crate) fn g_f32(x: f64) -> f32 {
+    match six_digits(x) {
+        Some((0, _)) => x as f32,
+        Some((m, k)) if (-10..=10).contains(&k) => {
+            let v = if k >= 0 {
+                m as f32 / POW10_F32[k as usize]
+            } else {
+                m as f32 * POW10_F32[(-k) as usize]
+            };
+            v.copysign(x as f32)
+        }
+        _ => fmt_g(x).parse().unwrap_or(f32::NAN),
+    }
+}
+
+/// `|x|` to six significant digits as `m · 10^-k` (`m` of six digits, or `10^6` when
+/// rounding carried), or `(0, 0)` for zero; `None` when it is not certain (see the
+/// module documentation) or `x` is not finite.
+fn six_digits(x: f64) -> Option<(u64, i32)> {
+    let a = x.abs();
+    if a == 0.0 {
+        return Some((0, 0));
+    }
+    if !a.is_finite() {
+        return None;
+    }
+    let mut k = 5 - a.log10().floor() as i32;
+    let mut scaled = scale(a, k)?;
+    if scaled < 1e5 {
+        k += 1;
+        scaled = scale(a, k)?;
+    } else if scaled >= 1e6 {
+        k -= 1;
+        scaled = scale(a, k)?;
+    }
+    let frac = scaled - scaled.floor();
+    let unsure = (frac - 0.5).abs() < MARGIN || !(1e5 + MARGIN..1e6 - MARGIN).contains(&scaled);
+    if unsure {
+        return None;
+    }
+    Some((scaled.round() as u64, k))
+}
+
+/// `a · 10^k`, one rounding away from exact (`None` when `10^|k|` is not exact).
+fn scale(a: f64, k: i32) -> Option<f64> {
+    let p = *POW10.get(k.unsigned_abs() as usize)?;
+    Some(if k >= 0 { a * p } else { a / p })
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+    use proptest::prelude::*;
+
+    fn same_as_text(x: f64) {
+        let text = fmt_g(x);
+        let (want64, want32) = (text.parse::<f64>().unwrap(), text.parse::<f32>().unwrap());
+        assert_eq!(g_f64(x).to_bits(), want64.to_bits(), "f64 {x:e} ({text})");
+        assert_eq!(g_f32(x).to_bits(), want32.to_bits(), "f32 {x:e} ({text})");
+    }
+
+    #[test]
+    fn printed_values_are_read_back_exactly() {
+        for x in [
+            0.0,
+            -0.0,
+            1.0,
+            -1.0,
+            0.5,
+            0.1,
+            1e5,
+            1e6,
+            999_999.5,
+            999_999.4,
+            99_999.95,
+            0.0001,
+            0.00001,
+            1e-30,
+            1e30,
+            3.0827,
+            -0.816497,
+            0.1234565,
+            1.2345650000000001,
+            12.0,
+            2.1,
+            0.01,
+            100000.0,
+            1.0 / 3.0,
+            2.0 / 3.0,
+            f64::MAX,
+            f64::MIN_POSITIVE,
+            5e-324,
+            1e22,
+            1e23,
+            123456789.0,
+        ] {
+            same_as_text(x);
+        }
+    }
+
+    proptest! {
+        #[test]
+        fn any_value_is_read_back_as_its_text_reads(
+            x in proptest::num::f64::NORMAL | proptest::num::f64::SUBNORMAL,
+        ) {
+            same_as_text(x);
+        }
+
+        #[test]
+        fn values_of_scene_size_are_read_back_as_their_text_reads(
+            m in -1_000_000i64..1_000_000, e in -12i32..12, jitter in -4i64..4,
+        ) {
+            let x = m as f64 * 10f64.powi(e);
+            same_as_text(x);
+            same_as_text(f64::from_bits((x.to_bits() as i64 + jitter) as u64));
+        }
+    }
+}
