@@ -166,6 +166,13 @@ impl JobError {
 pub enum Event<'a> {
     /// Reading (or generating) the scene.
     Loading,
+    /// The options are resolved against the scene: the image is `width × height`.
+    Resolved {
+        /// Width in pixels.
+        width: u32,
+        /// Height in pixels.
+        height: u32,
+    },
     /// Building the backend.
     Building,
     /// Rendering (solving the radiosity first, in two-pass mode).
@@ -416,6 +423,10 @@ pub fn render(job: &Job, observer: &dyn Observer) -> Result<Rendered, JobError> 
         scene: name.clone(),
         error,
     })?;
+    observer.event(Event::Resolved {
+        width: resolved.settings.width,
+        height: resolved.settings.height,
+    });
     let extra = if resolved.wants_insight() {
         limits::aov_bytes(&resolved.settings)
     } else {
@@ -554,7 +565,11 @@ mod tests {
             height: 40,
             pixels: vec![Vec3::splat(-1.0); 48 * 40],
         });
+        let size = Mutex::new(None);
         let observer = |e: Event<'_>| {
+            if let Event::Resolved { width, height } = e {
+                *size.lock().unwrap() = Some((width, height));
+            }
             if let Event::Tile(t) = e {
                 let mut film = told.lock().unwrap();
                 for (j, row) in (t.region.y0..t.region.y1).zip(t.rows()) {
@@ -567,6 +582,7 @@ mod tests {
         let rendered = render(&job(), &observer).unwrap();
         let (film, _) = rendered.image().unwrap();
         assert_eq!(*film, told.into_inner().unwrap());
+        assert_eq!(size.into_inner().unwrap(), Some((48, 40)));
     }
 
     /// Stops after its first tile.
