@@ -105,7 +105,9 @@ impl Server {
 
 /// Whether the status shows image `generation` or a later one, finished.
 fn finished(st: &serde_json::Value, generation: u64) -> bool {
-    st["image"]["generation"].as_u64().is_some_and(|g| g >= generation)
+    st["image"]["generation"]
+        .as_u64()
+        .is_some_and(|g| g >= generation)
         && st["render"]["phase"] == "done"
 }
 
@@ -119,7 +121,10 @@ fn the_image_and_the_explanation_are_the_commands_own() {
     let server = start(dir.path(), &[&[scene][..], &OPTIONS].concat());
     let st = server.wait(|st| finished(st, 1));
     let r = &st["render"];
-    assert_eq!((r["width"].as_u64(), r["height"].as_u64()), (Some(80), Some(60)));
+    assert_eq!(
+        (r["width"].as_u64(), r["height"].as_u64()),
+        (Some(80), Some(60))
+    );
     assert!(r["total"].as_u64().unwrap() > 1, "{r}");
     assert_eq!(r["done"], r["total"]);
     for phase in ["load", "build", "render"] {
@@ -134,7 +139,11 @@ fn the_image_and_the_explanation_are_the_commands_own() {
     let out = dir.path().join("render.png");
     let o = emray(
         dir.path(),
-        &[&["render", scene, "-q", "-o", out.to_str().unwrap()][..], &OPTIONS].concat(),
+        &[
+            &["render", scene, "-q", "-o", out.to_str().unwrap()][..],
+            &OPTIONS,
+        ]
+        .concat(),
     );
     assert!(o.status.success(), "{}", common::stderr(&o));
     assert!(png.body == std::fs::read(&out).unwrap(), "the PNGs differ");
@@ -146,7 +155,11 @@ fn the_image_and_the_explanation_are_the_commands_own() {
         &[&["explain", scene, "40", "30", "--json"][..], &OPTIONS].concat(),
     );
     assert_eq!(e.text(), String::from_utf8_lossy(&o.stdout));
-    assert_eq!(server.get("/explain?x=80&y=0").status, 400, "outside the image");
+    assert_eq!(
+        server.get("/explain?x=80&y=0").status,
+        400,
+        "outside the image"
+    );
 
     // New options: a render of the new size, and refused ones with render's message.
     let g = server.get("/render?res=40x30&spp=2").json()["generation"]
@@ -158,13 +171,20 @@ fn the_image_and_the_explanation_are_the_commands_own() {
     assert_eq!(bad.status, 400);
     assert!(bad.text().contains("too large"), "{}", bad.text());
     let bad = server.get("/render?spp=0");
-    assert!(bad.text().contains("spp must be 1 to 65536"), "{}", bad.text());
+    assert!(
+        bad.text().contains("spp must be 1 to 65536"),
+        "{}",
+        bad.text()
+    );
     // Heat maps are layers of their own.
     let g = server.get("/render?heatmaps=1").json()["generation"]
         .as_u64()
         .unwrap();
     let st = server.wait(|st| finished(st, g));
-    assert_eq!(st["image"]["layers"], serde_json::json!(["colour", "rays", "time", "depth"]));
+    assert_eq!(
+        st["image"]["layers"],
+        serde_json::json!(["colour", "rays", "time", "depth"])
+    );
     let rays = server.get("/image.png?layer=rays");
     assert_eq!((rays.status, &rays.body[1..4]), (200, &b"PNG"[..]));
 }
@@ -196,13 +216,21 @@ fn a_broken_scene_is_reported_and_the_fixed_one_rendered() {
     let first = server.get("/image.png").body;
     // A line that does not parse, on line 3.
     let lines: Vec<&str> = good.lines().collect();
-    let broken = format!("{}\n{}\ns 1 2\n{}\n", lines[0], lines[1], lines[2..].join("\n"));
+    let broken = format!(
+        "{}\n{}\ns 1 2\n{}\n",
+        lines[0],
+        lines[1],
+        lines[2..].join("\n")
+    );
     std::fs::write(&scene, broken).unwrap();
     let st = server.wait(|st| st["render"]["phase"] == "failed");
     let error = st["render"]["error"].as_str().unwrap();
     assert!(error.contains("s.nff:3:"), "{error}");
     let col = error.split("s.nff:3:").nth(1).unwrap();
-    assert!(col.starts_with(|c: char| c.is_ascii_digit()), "file:line:col: {error}");
+    assert!(
+        col.starts_with(|c: char| c.is_ascii_digit()),
+        "file:line:col: {error}"
+    );
     // The last good image stays.
     assert_eq!(server.get("/image.png").body, first);
     std::fs::write(&scene, &good).unwrap();

@@ -65,6 +65,10 @@ function update(st) {
     const form = $('options');
     for (const [k, v] of Object.entries(st.request.fields)) if (form.elements[k]) form.elements[k].value = v;
     heatmaps = st.request.heatmaps;
+    if (layer !== 'colour' && !heatmaps) {
+      heatmaps = true;
+      render();
+    }
   }
   const r = st.render;
   if (r.generation !== gen) {
@@ -91,6 +95,13 @@ function update(st) {
       document.body.dataset.image = String(shown);
     };
     png.src = '/image.png?layer=colour&g=' + shown;
+    const rep = st.image.report, form = $('options').elements;
+    form['res'].placeholder = `${st.image.width}x${st.image.height}`;
+    if (rep) {
+      form['spp'].placeholder = rep.spp;
+      form['max-depth'].placeholder = rep.max_depth;
+      form['backend'].options[0].text = 'default (' + rep.backend + ')';
+    }
     showLayer();
     if (autoclick) {
       const [x, y] = autoclick.split(',').map(Number);
@@ -146,10 +157,12 @@ for (const el of [canvas, $('heatmap')]) {
   });
 }
 
-const v3 = (a) => a.map((c) => +c.toPrecision(4)).join(' ');
+const num = (c) => (typeof c === 'number' ? +c.toPrecision(4) : String(c));
+const v3 = (a) => (Array.isArray(a) ? a.map(num).join(' ') : num(a));
 function swatch(c) {
   const s = document.createElement('span');
   s.className = 'swatch';
+  if (!Array.isArray(c)) c = [c, c, c];
   const g = (v) => Math.round(255 * Math.min(1, Math.max(0, v)) ** (1 / 2.2));
   s.style.background = `rgb(${g(c[0])},${g(c[1])},${g(c[2])})`;
   return s;
