@@ -48,7 +48,8 @@ pub fn run(a: Args) -> Result<(), Error> {
         let json = json(&a.scene, &a.options, a.x, a.y).map_err(job_error)?;
         return Ok(print(format_args!("{json}"))?);
     }
-    let (job, rendered) = explain(&a.scene, &a.options, a.x, a.y).map_err(job_error)?;
+    let source = SceneSource::File(a.scene.clone());
+    let (job, rendered) = explain(&a.scene, source, &a.options, a.x, a.y).map_err(job_error)?;
     let Product::Explanation(explanation) = &rendered.product else {
         unreachable!("an explain job explains");
     };
@@ -64,29 +65,44 @@ pub fn run(a: Args) -> Result<(), Error> {
 /// The tree of pixel `(x, y)` of `scene` rendered with `options`, as `--json` prints
 /// it (a final newline included); `emray view` serves the same.
 pub fn json(scene: &Path, options: &RenderOptions, x: u32, y: u32) -> Result<String, JobError> {
-    let (job, rendered) = explain(scene, options, x, y)?;
-    let Product::Explanation(explanation) = &rendered.product else {
+    let source = SceneSource::File(scene.to_path_buf());
+    Ok(explained(scene, source, options, x, y)?.0)
+}
+
+/// [`json`] with the scene of file `scene` from `source` (which may hold it loaded
+/// already), and the explanation itself beside its JSON.
+pub fn explained(
+    scene: &Path,
+    source: SceneSource,
+    options: &RenderOptions,
+    x: u32,
+    y: u32,
+) -> Result<(String, Explanation), JobError> {
+    let (job, rendered) = explain(scene, source, options, x, y)?;
+    let Product::Explanation(explanation) = rendered.product else {
         unreachable!("an explain job explains");
     };
     let out = Output {
         scene: job.name,
         backend: rendered.resolved.backend.backend.name(),
-        explanation,
+        explanation: &explanation,
     };
     let json = serde_json::to_string_pretty(&out).expect("an explanation serialises");
-    Ok(json + "\n")
+    Ok((json + "\n", *explanation))
 }
 
-/// Check and run the job explaining pixel `(x, y)`.
+/// Check and run the job explaining pixel `(x, y)` of the file `scene`, had from
+/// `source`.
 fn explain(
     scene: &Path,
+    source: SceneSource,
     options: &RenderOptions,
     x: u32,
     y: u32,
 ) -> Result<(Job, job::Rendered), JobError> {
     let job = Job {
         name: scene.display().to_string(),
-        scene: SceneSource::File(scene.to_path_buf()),
+        scene: source,
         options: options.clone(),
         task: Task::Explain { x, y },
         outputs: Outputs::default(),

@@ -6,12 +6,16 @@
 //! - [`auth`]: the token and the `Host` check every request passes;
 //! - [`routes`]: what each path answers;
 //! - [`session`]: the render, its progress and its last image;
+//! - [`rays`]: a pixel's rays projected into the image;
+//! - [`difference`]: Embree's render against the BVH's;
 //! - [`watch`]: the scene file polled for changes;
 //! - [`assets`]: the page, embedded.
 
 mod assets;
 mod auth;
+mod difference;
 mod http;
+mod rays;
 mod routes;
 mod session;
 mod watch;

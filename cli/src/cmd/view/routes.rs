@@ -3,10 +3,14 @@
 //! - `/`, `/view.js`, `/view.css`: the page (`/?token=…` also sets the cookie);
 //! - `/status?gen=G&since=N`: the render under way and the last image, as JSON, with
 //!   the tiles of render `G` from the `N`th on;
-//! - `/render?backend=&res=&spp=&max-depth=&aa=&heatmaps=0|1`: render with these
-//!   options now (400 and the message `emray render` gives for options it refuses);
-//! - `/image.png?layer=colour|rays|time|depth`: a layer of the last image;
-//! - `/explain?x=&y=`: pixel `(x, y)`'s tree, as `emray explain --json` prints it.
+//! - `/render?backend=&res=&spp=&max-depth=&aa=&heatmaps=0|1&compare=0|1`: render
+//!   with these options now (400 and the message `emray render` gives for options it
+//!   refuses); `/compare?…` is `/render?…&compare=1`, Embree's render and the BVH's
+//!   with their difference;
+//! - `/image.png?layer=colour|rays|time|depth|bvh|difference`: a layer of the last
+//!   image;
+//! - `/explain?x=&y=`: pixel `(x, y)`'s tree, as `emray explain --json` prints it;
+//! - `/rays?x=&y=`: its rays projected into the image, and the same tree.
 
 use super::assets;
 use super::auth::{Access, Guard};
@@ -45,9 +49,10 @@ pub fn handle(app: &App, req: &Request) -> Response {
             let since = number(req, "since").unwrap_or(0) as usize;
             Response::json(200, &s.status(generation, since))
         }
-        "/render" => {
+        "/render" | "/compare" => {
             let heatmaps = req.param("heatmaps").is_some_and(|v| v == "1");
-            match s.parse(&req.query, heatmaps) {
+            let compare = req.path == "/compare" || req.param("compare").is_some_and(|v| v == "1");
+            match s.parse(&req.query, heatmaps, compare) {
                 Ok(request) => Response::json(200, &json!({"generation": s.submit(request)})),
                 Err(e) => Response::json(400, &json!({"error": e})),
             }
@@ -56,14 +61,19 @@ pub fn handle(app: &App, req: &Request) -> Response {
             Some(png) => Response::new(200, "image/png", png),
             None => Response::text(404, "no such image yet\n"),
         },
-        "/explain" => {
+        "/explain" | "/rays" => {
             let (Some(x), Some(y)) = (number(req, "x"), number(req, "y")) else {
                 return Response::json(400, &json!({"error": "explain needs x and y"}));
             };
             let (Ok(x), Ok(y)) = (u32::try_from(x), u32::try_from(y)) else {
                 return Response::json(400, &json!({"error": "x and y are pixels"}));
             };
-            match s.explain(x, y) {
+            let answer = if req.path == "/rays" {
+                s.rays(x, y)
+            } else {
+                s.explain(x, y)
+            };
+            match answer {
                 Ok(text) => Response::new(200, "application/json", text),
                 Err((usage, e)) => {
                     Response::json(if usage { 400 } else { 409 }, &json!({"error": e}))

@@ -1,6 +1,8 @@
 //! The render the page shows: what the page last asked for, the render under way (its
 //! phase, timings and the tiles done so far, as 8-bit sRGB) and the last image that
 //! finished (its PNGs, exactly the files `emray render` writes for the same options).
+//! A render that compares the backends renders on Embree, then on the BVH, and keeps
+//! both images and their [`difference`](super::difference).
 //!
 //! One thread renders ([`Session::renderer`]); a request for a new render (new options
 //! from the page, or the scene file saved) bumps the wanted generation, which stops the
@@ -8,7 +10,10 @@
 //! one. A render that fails leaves the last image in place, beside the error.
 
 use super::super::explain;
+use super::difference;
+use super::rays;
 use clap::Parser;
+use emray::Backend;
 use emray::job::{self, Event, Job, JobError, Observer, RenderOptions, SceneSource};
 use emray::render::color::srgb8;
 use serde_json::{Value, json};
@@ -24,6 +29,19 @@ pub const FIELDS: [&str; 5] = ["backend", "res", "spp", "max-depth", "aa"];
 /// The heat maps a render with heat maps writes, after the colour: `emray render
 /// --heatmap`'s quantities.
 pub const HEATMAPS: [&str; 3] = ["rays", "time", "depth"];
+
+/// The backends this build can render on, the default first.
+pub fn backends() -> Vec<&'static str> {
+    if cfg!(feature = "embree") {
+        vec!["embree", "bvh"]
+    } else {
+        vec!["bvh"]
+    }
+}
+
+/// Why this build cannot compare the backends.
+const NO_EMBREE: &str = "this emray was built without Embree: there is only the BVH, \
+                         nothing to compare it with";
 
 /// Most tiles one status answer carries (the page asks again for the rest).
 const TILES_PER_STATUS: usize = 256;
@@ -43,6 +61,8 @@ pub struct Request {
     pub fields: BTreeMap<String, String>,
     /// Whether to gather the heat maps too.
     pub heatmaps: bool,
+    /// Whether to render on both backends and show their difference.
+    pub compare: bool,
     /// The options: the fields over the command line's.
     pub options: RenderOptions,
 }
@@ -84,6 +104,8 @@ struct Tile {
 struct Progress {
     generation: u64,
     phase: Phase,
+    /// The backend rendering, in a render that compares them.
+    pass: Option<&'static str>,
     size: Option<(u32, u32)>,
     done: usize,
     total: usize,
@@ -121,6 +143,8 @@ pub struct Image {
     layers: Vec<(&'static str, Vec<u8>)>,
     /// What the job reports.
     report: Value,
+    /// The backends' difference, in a render that compares them.
+    compare: Option<difference::Difference>,
 }
 
 /// What the renderer and the page share.
@@ -167,6 +191,7 @@ impl Session {
         let request = Request {
             fields: BTreeMap::new(),
             heatmaps,
+            compare: false,
             options: base.clone(),
         };
         let s = Session {
@@ -182,7 +207,7 @@ impl Session {
             }),
             wake: Condvar::new(),
         };
-        s.job(&request)?;
+        s.job(&request, None, "colour", heatmaps)?;
         s.lock().request = request;
         Ok(s)
     }
@@ -201,16 +226,26 @@ impl Session {
         self.dir.join(format!("{name}.png"))
     }
 
-    /// The job of `request`, checked as `emray render` checks it.
-    fn job(&self, request: &Request) -> Result<Job, JobError> {
+    /// The job of `request` (on `backend`, when given) writing its image to layer
+    /// `layer` (and the heat maps with `heatmaps`), checked as `emray render` checks it.
+    fn job(
+        &self,
+        request: &Request,
+        backend: Option<Backend>,
+        layer: &str,
+        heatmaps: bool,
+    ) -> Result<Job, JobError> {
         let mut options = request.options.clone();
-        if request.heatmaps {
+        if backend.is_some() {
+            options.backend = backend;
+        }
+        if heatmaps {
             options.heatmap = HEATMAPS
                 .iter()
                 .flat_map(|q| [q.to_string(), self.file(q).display().to_string()])
                 .collect();
         }
-        let colour = self.file("colour").display().to_string();
+        let colour = self.file(layer).display().to_string();
         let source = SceneSource::File(self.scene.clone());
         let mut jobs = job::plan(vec![source], Some(&colour), &options)?;
         let job = jobs.pop().expect("one scene, one job");
@@ -219,9 +254,17 @@ impl Session {
     }
 
     /// The request of the page's `fields` (the render options of [`FIELDS`], as
-    /// `emray render` takes them) and `heatmaps`, checked as `emray render` checks its
-    /// own; a field with an empty value keeps the command line's.
-    pub fn parse(&self, fields: &[(String, String)], heatmaps: bool) -> Result<Request, String> {
+    /// `emray render` takes them), `heatmaps` and `compare`, checked as `emray render`
+    /// checks its own; a field with an empty value keeps the command line's.
+    pub fn parse(
+        &self,
+        fields: &[(String, String)],
+        heatmaps: bool,
+        compare: bool,
+    ) -> Result<Request, String> {
+        if compare && !cfg!(feature = "embree") {
+            return Err(NO_EMBREE.into());
+        }
         let fields: BTreeMap<String, String> = fields
             .iter()
             .filter(|(k, v)| FIELDS.contains(&k.as_str()) && !v.trim().is_empty())
@@ -238,9 +281,13 @@ impl Session {
         let request = Request {
             fields,
             heatmaps,
+            compare,
             options: parsed.options.over(&self.base),
         };
-        self.job(&request).map_err(message)?;
+        for (backend, layer, heatmaps) in self.passes(&request) {
+            self.job(&request, backend, layer, heatmaps)
+                .map_err(message)?;
+        }
         Ok(request)
     }
 
@@ -298,25 +345,60 @@ impl Session {
         }
     }
 
+    /// The renders `request` makes: each one's backend (`None`: the options'), layer
+    /// and whether it gathers the heat maps.
+    fn passes(&self, request: &Request) -> Vec<(Option<Backend>, &'static str, bool)> {
+        if request.compare {
+            vec![
+                (Some(Backend::Embree), "colour", request.heatmaps),
+                (Some(Backend::Bvh), "bvh", false),
+            ]
+        } else {
+            vec![(None, "colour", request.heatmaps)]
+        }
+    }
+
     /// Render generation `generation` of `request` and read its PNGs.
     fn render(&self, generation: u64, request: &Request) -> Result<Image, Failure> {
-        let job = self.job(request).map_err(|e| Failure::Error(message(e)))?;
         let watcher = Watcher {
             session: self,
             generation,
         };
-        let rendered = match job::run(&job, &watcher) {
-            Ok(r) => r,
-            Err(JobError::Cancelled(_)) => return Err(Failure::Stopped),
-            Err(e) => return Err(Failure::Error(message(e))),
-        };
+        let mut renders = Vec::new();
+        let mut names = Vec::new();
+        for (backend, layer, heatmaps) in self.passes(request) {
+            if request.compare {
+                self.pass(generation, backend.map(Backend::name));
+            }
+            let job = self
+                .job(request, backend, layer, heatmaps)
+                .map_err(|e| Failure::Error(message(e)))?;
+            renders.push(match job::run(&job, &watcher) {
+                Ok(r) => r,
+                Err(JobError::Cancelled(_)) => return Err(Failure::Stopped),
+                Err(e) => return Err(Failure::Error(message(e))),
+            });
+            names.push(layer);
+            if heatmaps {
+                names.extend(HEATMAPS);
+            }
+        }
+        let rendered = &renders[0];
         let (film, _) = rendered.image().expect("a render makes an image");
-        let names = std::iter::once("colour").chain(if request.heatmaps {
-            HEATMAPS.to_vec()
-        } else {
-            Vec::new()
-        });
+        let compare = match &renders[..] {
+            [a, b] => {
+                let (other, _) = b.image().expect("a render makes an image");
+                let d = difference::of(film, other, a.resolved.encoding).map_err(Failure::Error)?;
+                let path = self.file("difference");
+                emray::output::write_png_rgb8(&path, d.width, d.height, &d.rgb)
+                    .map_err(|e| Failure::Error(message(e)))?;
+                names.push("difference");
+                Some(d)
+            }
+            _ => None,
+        };
         let layers = names
+            .into_iter()
             .map(|name| {
                 let path = self.file(name);
                 std::fs::read(&path)
@@ -330,7 +412,19 @@ impl Session {
             height: film.height,
             layers,
             report: serde_json::to_value(&rendered.report).unwrap_or(Value::Null),
+            compare,
         })
+    }
+
+    /// Render `generation` goes on with `backend`: its tiles are counted afresh.
+    fn pass(&self, generation: u64, backend: Option<&'static str>) {
+        let mut s = self.lock();
+        let p = &mut s.progress;
+        if p.generation == generation {
+            p.pass = backend;
+            p.done = 0;
+            p.total = 0;
+        }
     }
 
     /// The PNG of layer `name` of the last image.
@@ -345,6 +439,25 @@ impl Session {
     pub fn explain(&self, x: u32, y: u32) -> Result<String, (bool, String)> {
         let options = self.lock().request.options.clone();
         explain::json(&self.scene, &options, x, y).map_err(|e| (e.is_usage(), message(e)))
+    }
+
+    /// The rays of pixel `(x, y)` of the render last asked for, where they appear in
+    /// the image, and its explain tree: `{"segments": [...], "tree": {...}}`, the tree
+    /// exactly as `emray explain --json` prints it. The scene is loaded once for both.
+    pub fn rays(&self, x: u32, y: u32) -> Result<String, (bool, String)> {
+        let options = self.lock().request.options.clone();
+        let fail = |e: JobError| (e.is_usage(), message(e));
+        let scene = job::load_scene(&self.scene).map_err(|e| fail(e.into()))?;
+        let scene = Arc::new(scene);
+        let source = SceneSource::Loaded {
+            name: self.scene.display().to_string(),
+            scene: scene.clone(),
+        };
+        let (tree, explanation) =
+            explain::explained(&self.scene, source, &options, x, y).map_err(fail)?;
+        let segments = rays::segments(&scene, &explanation);
+        let segments = serde_json::to_string(&segments).expect("segments serialise");
+        Ok(format!("{{\"segments\": {segments},\n\"tree\": {tree}}}\n"))
     }
 
     /// Where things are, with the tiles of render `generation` from the `since`th on
@@ -369,15 +482,22 @@ impl Session {
                 "height": i.height,
                 "layers": i.layers.iter().map(|(n, _)| *n).collect::<Vec<_>>(),
                 "report": i.report,
+                "compare": i.compare,
             })
         });
         json!({
             "scene": self.scene.display().to_string(),
+            "backends": backends(),
             "wanted": self.wanted.load(Ordering::SeqCst),
-            "request": {"fields": s.request.fields, "heatmaps": s.request.heatmaps},
+            "request": {
+                "fields": s.request.fields,
+                "heatmaps": s.request.heatmaps,
+                "compare": s.request.compare,
+            },
             "render": {
                 "generation": p.generation,
                 "phase": p.phase,
+                "pass": p.pass,
                 "width": p.size.map(|s| s.0),
                 "height": p.size.map(|s| s.1),
                 "done": p.done,
