@@ -239,3 +239,155 @@ fn a_broken_scene_is_reported_and_the_fixed_one_rendered() {
     assert!(st["render"]["error"].is_null(), "{st}");
     assert_eq!(server.get("/image.png").body, first);
 }
+
+/// A mirror sphere over a floor, with a red sphere beside it: spheres and polygons,
+/// which both backends render alike.
+const MIRROR: &str = "v
+from 0 -8 4
+at 0 0 1
+up 0 0 1
+angle 40
+hither 0.01
+resolution 80 60
+b 0.2 0.3 0.5
+l 4 -4 8
+f 0.8 0.8 0.8 0.1 0.9 30 0 1
+s 0 0 1 1
+f 0.9 0.2 0.2 0.8 0.1 10 0 1
+s 2 -1 0.6 0.6
+f 0.6 0.6 0.5 0.9 0 1 0 1
+p 4
+-6 -6 0
+6 -6 0
+6 6 0
+-6 6 0
+";
+
+#[test]
+fn a_pixels_rays_are_projected_where_they_show() {
+    let dir = tempfile::tempdir().unwrap();
+    std::fs::write(dir.path().join("mirror.nff"), MIRROR).unwrap();
+    let server = start(dir.path(), &["mirror.nff", "--backend", "bvh"]);
+    server.wait(|st| finished(st, 1));
+    let (x, y) = (40.0, 34.0);
+    let r = server.get("/rays?x=40&y=34");
+    assert_eq!(r.status, 200, "{}", r.text());
+    let r = r.json();
+    // The tree is the one /explain gives.
+    assert_eq!(r["tree"], server.get("/explain?x=40&y=34").json());
+    let segments = r["segments"].as_array().unwrap();
+    let point = |v: &serde_json::Value| (v[0].as_f64().unwrap(), v[1].as_f64().unwrap());
+    let near =
+        |(a, b): (f64, f64), (c, d): (f64, f64)| (a - c).abs() <= 1.0 && (b - d).abs() <= 1.0;
+    let centre = (x + 0.5, y + 0.5);
+    // The eye ray ends at its pixel, and shows there.
+    let eye = &segments[0];
+    assert_eq!(
+        (
+            eye["kind"].as_str(),
+            eye["path"].as_str(),
+            eye["ends"].as_str()
+        ),
+        (Some("eye"), Some("0.0"), Some("hit"))
+    );
+    assert!(near(point(&eye["end"]), centre), "{eye}");
+    assert!(near(point(&eye["line"][1]), centre), "{eye}");
+    // The mirror's reflection starts there and hits the floor inside the image.
+    let reflection = segments
+        .iter()
+        .find(|s| s["kind"] == "reflection" && s["path"] == "0.0.0")
+        .unwrap_or_else(|| panic!("no reflection: {segments:?}"));
+    assert_eq!(reflection["ends"], "hit", "{reflection}");
+    assert!(near(point(&reflection["line"][0]), centre), "{reflection}");
+    let (ex, ey) = point(&reflection["end"]);
+    assert!(
+        (0.0..80.0).contains(&ex) && (0.0..60.0).contains(&ey),
+        "{reflection}"
+    );
+    assert!(
+        !near((ex, ey), centre),
+        "the reflection goes somewhere: {reflection}"
+    );
+    // Shadow rays are there too, each with how it ended.
+    assert!(
+        segments
+            .iter()
+            .any(|s| s["kind"] == "shadow" && (s["ends"] == "light" || s["ends"] == "blocked")),
+        "{segments:?}"
+    );
+    assert_eq!(
+        server.get("/rays?x=80&y=0").status,
+        400,
+        "outside the image"
+    );
+}
+
+#[test]
+fn the_backends_are_compared_or_the_build_says_why_not() {
+    let dir = tempfile::tempdir().unwrap();
+    std::fs::write(dir.path().join("mirror.nff"), MIRROR).unwrap();
+    let server = start(dir.path(), &["mirror.nff", "--res", "64x48"]);
+    server.wait(|st| finished(st, 1));
+    let asked = server.get("/compare");
+    if !cfg!(feature = "embree") {
+        assert_eq!(asked.status, 400);
+        assert!(asked.text().contains("without Embree"), "{}", asked.text());
+        assert_eq!(
+            server.get("/status").json()["backends"],
+            serde_json::json!(["bvh"])
+        );
+        return;
+    }
+    assert_eq!(asked.status, 200, "{}", asked.text());
+    let g = asked.json()["generation"].as_u64().unwrap();
+    let st = server.wait(|st| finished(st, g));
+    let image = &st["image"];
+    assert_eq!(
+        image["layers"],
+        serde_json::json!(["colour", "bvh", "difference"])
+    );
+    let c = &image["compare"];
+    assert_eq!(
+        (c["width"].as_u64(), c["height"].as_u64()),
+        (Some(64), Some(48)),
+        "{c}"
+    );
+    assert_eq!(
+        (c["differing"].as_u64(), c["max"].as_u64()),
+        (Some(0), Some(0)),
+        "{c}"
+    );
+    let png = server.get("/image.png?layer=difference");
+    assert_eq!(png.status, 200);
+    let diff = image::load_from_memory(&png.body).unwrap().to_rgb8();
+    assert_eq!(diff.dimensions(), (64, 48));
+    assert!(
+        diff.pixels().all(|p| p.0 == [0, 0, 0]),
+        "no difference shown"
+    );
+    // The BVH's image is its own render's: `emray render --backend bvh`'s.
+    let out = dir.path().join("bvh.png");
+    let o = emray(
+        dir.path(),
+        &[
+            "render",
+            "mirror.nff",
+            "-q",
+            "--res",
+            "64x48",
+            "--backend",
+            "bvh",
+            "-o",
+            out.to_str().unwrap(),
+        ],
+    );
+    assert!(o.status.success(), "{}", common::stderr(&o));
+    assert!(server.get("/image.png?layer=bvh").body == std::fs::read(&out).unwrap());
+    // Unticked, a render makes one image again.
+    let g = server.get("/render?compare=0").json()["generation"]
+        .as_u64()
+        .unwrap();
+    let st = server.wait(|st| finished(st, g));
+    assert_eq!(st["image"]["layers"], serde_json::json!(["colour"]));
+    assert!(st["image"]["compare"].is_null());
+}

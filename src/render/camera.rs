@@ -176,8 +176,13 @@ mod tests {
         let g = RayGen::new(&c, 64, 64);
         let hit = g.ray(20.5, 40.5).at(3.0);
         let behind = c.from + (c.from - c.at);
-        let [a, b] = g.project_segment(behind, hit, 0.1).expect("partly in front");
-        assert!((b.0 - 20.5).abs() < 1e-3 && (b.1 - 40.5).abs() < 1e-3, "{b:?}");
+        let [a, b] = g
+            .project_segment(behind, hit, 0.1)
+            .expect("partly in front");
+        assert!(
+            (b.0 - 20.5).abs() < 1e-3 && (b.1 - 40.5).abs() < 1e-3,
+            "{b:?}"
+        );
         assert!(a.0.is_finite() && a.1.is_finite(), "{a:?}");
         assert!(g.depth(behind) < 0.0);
         assert_eq!(g.project_segment(behind, behind * 2.0, 0.1), None);
@@ -185,7 +190,10 @@ mod tests {
         let r = g.ray(7.5, 8.5);
         let [a, b] = g.project_segment(r.org, r.at(2.0), 0.01).unwrap();
         for p in [a, b] {
-            assert!((p.0 - 7.5).abs() < 1e-3 && (p.1 - 8.5).abs() < 1e-3, "{p:?}");
+            assert!(
+                (p.0 - 7.5).abs() < 1e-3 && (p.1 - 8.5).abs() < 1e-3,
+                "{p:?}"
+            );
         }
     }
 
