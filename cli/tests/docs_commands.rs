@@ -73,6 +73,10 @@ const PARSE_ONLY: &[(&str, &str)] = &[
         "circle.nff",
         "needs the file the big_polygon example writes",
     ),
+    (
+        "emray view",
+        "serves its page until Ctrl-C (cli/tests/view.rs drives it)",
+    ),
 ];
 
 /// What the scratch folder holds of the repository: the files of these that git

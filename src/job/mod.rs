@@ -66,7 +66,7 @@ pub fn render_scene(
     };
     let observer = |e: Event<'_>| {
         if let (Event::Tiles { done, total }, Some(p)) = (e, progress) {
-            p(done, total)
+            p.tiles(done, total)
         }
     };
     let work = work::Work {

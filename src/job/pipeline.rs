@@ -129,6 +129,9 @@ pub enum JobError {
     /// The pixel cannot be explained.
     #[error(transparent)]
     Explain(#[from] ExplainError),
+    /// The observer stopped the job ([`Observer::cancelled`]).
+    #[error("{0}: the render was stopped")]
+    Cancelled(String),
     /// The f64 reference cannot render the scene.
     #[error("{scene}: {why}")]
     Reference {
@@ -163,10 +166,21 @@ impl JobError {
 pub enum Event<'a> {
     /// Reading (or generating) the scene.
     Loading,
+    /// The options are resolved against the scene: the image is `width × height`.
+    Resolved {
+        /// Width in pixels.
+        width: u32,
+        /// Height in pixels.
+        height: u32,
+    },
     /// Building the backend.
     Building,
     /// Rendering (solving the radiosity first, in two-pass mode).
     Rendering,
+    /// A tile is rendered, with its values (from the worker threads, in any order, each
+    /// just before its [`Event::Tiles`]); in SPD mode the values are the pixel
+    /// corners', and with adaptive antialiasing only the refined pixels are told.
+    Tile(crate::render::TileValues<'a>),
     /// `done` of `total` tiles rendered: `(0, total)` first, then as tiles complete,
     /// from the worker threads in any order.
     Tiles {
@@ -185,6 +199,12 @@ pub enum Event<'a> {
 pub trait Observer: Sync {
     /// `event` happened.
     fn event(&self, event: Event<'_>);
+
+    /// Whether to stop the job: checked between its phases and before each tile; a
+    /// job asked to stop ends with [`JobError::Cancelled`]. Never, by default.
+    fn cancelled(&self) -> bool {
+        false
+    }
 }
 
 impl Observer for () {
@@ -396,10 +416,17 @@ pub fn render(job: &Job, observer: &dyn Observer) -> Result<Rendered, JobError> 
     let t0 = Instant::now();
     let scene = job.scene.load(options.envmap.as_deref())?;
     let load_ms = t0.elapsed().as_secs_f64() * 1e3;
+    if observer.cancelled() {
+        return Err(JobError::Cancelled(name));
+    }
     let resolved = options.resolve(&scene).map_err(|error| JobError::Options {
         scene: name.clone(),
         error,
     })?;
+    observer.event(Event::Resolved {
+        width: resolved.settings.width,
+        height: resolved.settings.height,
+    });
     let extra = if resolved.wants_insight() {
         limits::aov_bytes(&resolved.settings)
     } else {
@@ -506,4 +533,93 @@ pub fn write(job: &Job, rendered: &Rendered, observer: &dyn Observer) -> Result<
         }
     }
     Ok(())
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+    use crate::accel::Backend;
+    use crate::job::values::Res;
+    use glam::Vec3;
+    use std::sync::Mutex;
+    use std::sync::atomic::{AtomicUsize, Ordering};
+
+    /// A 48×40 render of the default scene on the BVH (tiles of 16: 3×3 of them).
+    fn job() -> Job {
+        let options = RenderOptions {
+            backend: Some(Backend::Bvh),
+            res: Some(Res {
+                width: 48,
+                height: 40,
+            }),
+            ..RenderOptions::default()
+        };
+        Job::render(SceneSource::Builtin, options, None)
+    }
+
+    /// The tiles' values, put together, are the rendered image, pixel for pixel.
+    #[test]
+    fn the_tiles_told_make_the_image() {
+        let told = Mutex::new(Film {
+            width: 48,
+            height: 40,
+            pixels: vec![Vec3::splat(-1.0); 48 * 40],
+        });
+        let size = Mutex::new(None);
+        let observer = |e: Event<'_>| {
+            if let Event::Resolved { width, height } = e {
+                *size.lock().unwrap() = Some((width, height));
+            }
+            if let Event::Tile(t) = e {
+                let mut film = told.lock().unwrap();
+                for (j, row) in (t.region.y0..t.region.y1).zip(t.rows()) {
+                    for (i, &v) in (t.region.x0..t.region.x1).zip(row) {
+                        film.set(i, j, v);
+                    }
+                }
+            }
+        };
+        let rendered = render(&job(), &observer).unwrap();
+        let (film, _) = rendered.image().unwrap();
+        assert_eq!(*film, told.into_inner().unwrap());
+        assert_eq!(size.into_inner().unwrap(), Some((48, 40)));
+    }
+
+    /// Stops after its first tile.
+    struct StopAfterOne(AtomicUsize);
+
+    impl Observer for StopAfterOne {
+        fn event(&self, event: Event<'_>) {
+            if let Event::Tile(_) = event {
+                self.0.fetch_add(1, Ordering::SeqCst);
+            }
+        }
+        fn cancelled(&self) -> bool {
+            self.0.load(Ordering::SeqCst) > 0
+        }
+    }
+
+    /// A job whose observer asks it to stop renders no more tiles and says it stopped.
+    #[test]
+    fn a_stopped_job_ends_early_with_cancelled() {
+        let single = rayon::ThreadPoolBuilder::new()
+            .num_threads(1)
+            .build()
+            .unwrap();
+        for aa in [None, Some(super::super::AaMode::Adaptive)] {
+            let mut job = job();
+            job.options.aa = aa;
+            let stop = StopAfterOne(AtomicUsize::new(0));
+            let r = single.install(|| render(&job, &stop));
+            assert!(matches!(r, Err(JobError::Cancelled(_))), "{aa:?}: {r:?}");
+            assert_eq!(
+                stop.0.load(Ordering::SeqCst),
+                1,
+                "{aa:?}: one tile, then none"
+            );
+        }
+        let stop = StopAfterOne(AtomicUsize::new(1));
+        let r = render(&job(), &stop);
+        assert!(matches!(r, Err(JobError::Cancelled(_))), "before the build");
+    }
 }

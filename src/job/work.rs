@@ -82,6 +82,10 @@ impl WithAccel for Work<'_> {
     type Output = Result<Made, JobError>;
     fn run<A: Accel>(self, accel: &A, build_ms: f64) -> Self::Output {
         let r = self.resolved;
+        let cancelled = || JobError::Cancelled(self.name.to_string());
+        if self.observer.cancelled() {
+            return Err(cancelled());
+        }
         self.observer.event(Event::Rendering);
         if let Task::RadiosityView = self.task {
             return self.radiosity_view(accel, build_ms);
@@ -91,8 +95,7 @@ impl WithAccel for Work<'_> {
             None => None,
         };
         let gi = solution.as_ref().map(|s| s as &dyn GlobalIllumination);
-        let progress =
-            |done: usize, total: usize| self.observer.event(Event::Tiles { done, total });
+        let progress = Watched(self.observer);
         let (product, stats) = match self.task {
             Task::Explain { x, y } => {
                 let t0 = Instant::now();
@@ -111,7 +114,11 @@ impl WithAccel for Work<'_> {
                     gi,
                     Some(&progress),
                     r.gathered(),
-                )?;
+                )
+                .map_err(|e| match e {
+                    aov::AovError::Cancelled => cancelled(),
+                    e => e.into(),
+                })?;
                 // The layers written are the ones asked for; the heat maps' are
                 // gathered for them alone.
                 aov.set = r.layers;
@@ -129,6 +136,9 @@ impl WithAccel for Work<'_> {
                 (Product::Image { film, aov: None }, stats)
             }
         };
+        if self.observer.cancelled() {
+            return Err(cancelled());
+        }
         self.observer.event(Event::Rendered);
         let t = Timings {
             load: self.load_ms,
@@ -146,6 +156,24 @@ impl WithAccel for Work<'_> {
             t,
             &stats,
         ))
+    }
+}
+
+/// A job's [`Observer`] as the renderer's [`render::Watch`]: tiles become events, and
+/// the renderer stops when the observer asks.
+struct Watched<'a>(&'a dyn Observer);
+
+impl render::Watch for Watched<'_> {
+    fn tiles(&self, done: usize, total: usize) {
+        self.0.event(Event::Tiles { done, total })
+    }
+
+    fn tile(&self, tile: render::TileValues<'_>) {
+        self.0.event(Event::Tile(tile))
+    }
+
+    fn cancelled(&self) -> bool {
+        self.0.cancelled()
     }
 }
 

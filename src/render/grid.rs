@@ -5,7 +5,7 @@
 
 use super::record::Recorder;
 use super::whitted::Tracer;
-use super::{Film, Progress, RayCounts, RayGen, Region, RenderSettings};
+use super::{Film, Progress, RayCounts, RayGen, Region, RenderSettings, TileValues, Watch};
 use crate::accel::Accel;
 use glam::Vec3;
 use rayon::prelude::*;
@@ -89,13 +89,15 @@ pub(super) fn adaptive_render<A: Accel>(
     let raygen = RayGen::new(&tracer.scene.camera, w, h);
     let (cw, ch) = (r.width() + 1, r.height() + 1);
     let corner = per_position(|i, j, c| tracer.sample(&raygen, i as f32, j as f32, c));
+    // The corners are not the image: they are counted as no tiles, but they stop too.
+    let stop = progress.map(Stop);
     let (corners, tiles) = sample_grid(
         r.x0,
         r.y0,
         cw,
         ch,
         settings.tile_size,
-        None,
+        stop.as_ref().map(|s| s as &dyn Watch),
         RayCounts::default,
         corner,
     );
@@ -126,6 +128,17 @@ pub(super) fn adaptive_render<A: Accel>(
         rays += counts;
     }
     (film, rays)
+}
+
+/// A [`Watch`] that tells nothing but passes on whether to stop.
+struct Stop<'a>(Progress<'a>);
+
+impl Watch for Stop<'_> {
+    fn tiles(&self, _done: usize, _total: usize) {}
+
+    fn cancelled(&self) -> bool {
+        self.0.cancelled()
+    }
 }
 
 /// A per-position function `f(i, j, counts)` as a tile function for [`sample_grid`]:
@@ -218,7 +231,7 @@ where
     let rows = tile_rows(&mut film.pixels, gw, ts);
     // The count first, so that a progress bar starts at 0 of it.
     if let Some(p) = progress {
-        p(0, total);
+        p.tiles(0, total);
     }
     // One task per tile: rayon otherwise splits the list only as far as it sees
     // threads steal, and a run of costly tiles (glass, mirrors) left in one thread's
@@ -235,11 +248,15 @@ where
                 x1: ox + (x0 + ts).min(gw),
                 y1: oy + (y0 + ts).min(gh),
             };
+            if progress.is_some_and(|p| p.cancelled()) {
+                return rec;
+            }
             let mut out = TileRows::new(rows);
             f(t, &mut out, &mut rec);
             debug_assert!(out.is_full(), "a tile function gave too few values");
             if let Some(p) = progress {
-                p(done.fetch_add(1, Ordering::Relaxed) + 1, total);
+                p.tile(TileValues::new(t, &out.rows));
+                p.tiles(done.fetch_add(1, Ordering::Relaxed) + 1, total);
             }
             rec
         })

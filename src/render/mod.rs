@@ -29,6 +29,7 @@ pub(crate) use grid::tile_of;
 
 use crate::accel::Accel;
 use crate::scene::Scene;
+use glam::Vec3;
 
 /// How to render.
 #[derive(Clone, Debug, PartialEq)]
@@ -212,9 +213,56 @@ impl RenderStats {
     }
 }
 
-/// Told `(0, total)` before the first tile, then `(done, total)` as tiles complete
-/// (from the worker threads, in any order).
-pub type Progress<'a> = &'a (dyn Fn(usize, usize) + Sync);
+/// What a render tells as it goes, from the worker threads, and asks whether to stop
+/// ([`Progress`]). A plain `Fn(done, total)` is one that counts tiles alone.
+pub trait Watch: Sync {
+    /// `(0, total)` before the first tile, then `(done, total)` as tiles complete (in
+    /// any order).
+    fn tiles(&self, done: usize, total: usize);
+
+    /// A tile is complete, with its values (called just before its
+    /// [`tiles`](Watch::tiles)); nothing by default.
+    fn tile(&self, tile: TileValues<'_>) {
+        let _ = tile;
+    }
+
+    /// Whether to stop: once it says yes, tiles not yet started are skipped (their
+    /// pixels stay black) and the render returns early; the caller, who asked, knows
+    /// to discard the film. Checked before each tile; never, by default.
+    fn cancelled(&self) -> bool {
+        false
+    }
+}
+
+impl<F: Fn(usize, usize) + Sync> Watch for F {
+    fn tiles(&self, done: usize, total: usize) {
+        self(done, total)
+    }
+}
+
+/// What a render tells as it goes: tiles done, tiles' values, and whether to stop.
+pub type Progress<'a> = &'a dyn Watch;
+
+/// A complete tile of a render: its positions in the render's sample grid (the
+/// image's pixels, or in SPD mode its pixel corners, one more row and column) and
+/// their linear values, row by row.
+#[derive(Clone, Copy, Debug, PartialEq)]
+pub struct TileValues<'a> {
+    /// The tile's positions in the grid.
+    pub region: Region,
+    rows: &'a [&'a mut [Vec3]],
+}
+
+impl<'a> TileValues<'a> {
+    pub(crate) fn new(region: Region, rows: &'a [&'a mut [Vec3]]) -> Self {
+        TileValues { region, rows }
+    }
+
+    /// The values, one slice per row of the region, top to bottom.
+    pub fn rows(&self) -> impl Iterator<Item = &[Vec3]> + '_ {
+        self.rows.iter().map(|r| &**r)
+    }
+}
 
 /// Render `scene` through `accel` on the current rayon pool.
 pub fn render<A: Accel>(

@@ -5,10 +5,10 @@
 use super::Error;
 use super::args::LogArgs;
 use super::error::{job_error, print};
-use emray::job::{self, Job, Outputs, Product, RenderOptions, SceneSource, Task};
+use emray::job::{self, Job, JobError, Outputs, Product, RenderOptions, SceneSource, Task};
 use emray::render::explain::{Explanation, text};
 use serde::Serialize;
-use std::path::PathBuf;
+use std::path::{Path, PathBuf};
 
 /// `emray explain`.
 #[derive(clap::Args, Debug, Clone)]
@@ -44,33 +44,70 @@ struct Output<'a> {
 
 /// Explain the pixel and print the tree.
 pub fn run(a: Args) -> Result<(), Error> {
-    let job = Job {
-        name: a.scene.display().to_string(),
-        scene: SceneSource::File(a.scene.clone()),
-        options: a.options.clone(),
-        task: Task::Explain { x: a.x, y: a.y },
-        outputs: Outputs::default(),
-    };
-    job.check().map_err(job_error)?;
-    let rendered = job::run(&job, &()).map_err(job_error)?;
+    if a.json {
+        let json = json(&a.scene, &a.options, a.x, a.y).map_err(job_error)?;
+        return Ok(print(format_args!("{json}"))?);
+    }
+    let source = SceneSource::File(a.scene.clone());
+    let (job, rendered) = explain(&a.scene, source, &a.options, a.x, a.y).map_err(job_error)?;
     let Product::Explanation(explanation) = &rendered.product else {
         unreachable!("an explain job explains");
     };
-    let backend = rendered.resolved.backend.backend.name();
-    if a.json {
-        let out = Output {
-            scene: job.name,
-            backend,
-            explanation,
-        };
-        let json = serde_json::to_string_pretty(&out).expect("an explanation serialises");
-        print(format_args!("{json}\n"))?;
-    } else {
-        print(format_args!(
-            "scene {}, backend {backend}\n{}",
-            job.name,
-            text::format(explanation)
-        ))?;
-    }
+    print(format_args!(
+        "scene {}, backend {}\n{}",
+        job.name,
+        rendered.resolved.backend.backend.name(),
+        text::format(explanation)
+    ))?;
     Ok(())
+}
+
+/// The tree of pixel `(x, y)` of `scene` rendered with `options`, as `--json` prints
+/// it (a final newline included); `emray view` serves the same.
+pub fn json(scene: &Path, options: &RenderOptions, x: u32, y: u32) -> Result<String, JobError> {
+    let source = SceneSource::File(scene.to_path_buf());
+    Ok(explained(scene, source, options, x, y)?.0)
+}
+
+/// [`json`] with the scene of file `scene` from `source` (which may hold it loaded
+/// already), and the explanation itself beside its JSON.
+pub fn explained(
+    scene: &Path,
+    source: SceneSource,
+    options: &RenderOptions,
+    x: u32,
+    y: u32,
+) -> Result<(String, Explanation), JobError> {
+    let (job, rendered) = explain(scene, source, options, x, y)?;
+    let Product::Explanation(explanation) = rendered.product else {
+        unreachable!("an explain job explains");
+    };
+    let out = Output {
+        scene: job.name,
+        backend: rendered.resolved.backend.backend.name(),
+        explanation: &explanation,
+    };
+    let json = serde_json::to_string_pretty(&out).expect("an explanation serialises");
+    Ok((json + "\n", *explanation))
+}
+
+/// Check and run the job explaining pixel `(x, y)` of the file `scene`, had from
+/// `source`.
+fn explain(
+    scene: &Path,
+    source: SceneSource,
+    options: &RenderOptions,
+    x: u32,
+    y: u32,
+) -> Result<(Job, job::Rendered), JobError> {
+    let job = Job {
+        name: scene.display().to_string(),
+        scene: source,
+        options: options.clone(),
+        task: Task::Explain { x, y },
+        outputs: Outputs::default(),
+    };
+    job.check()?;
+    let rendered = job::run(&job, &())?;
+    Ok((job, rendered))
 }

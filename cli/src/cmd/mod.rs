@@ -24,6 +24,7 @@ mod radiosity;
 mod render;
 mod stress;
 mod study;
+mod view;
 
 pub use error::Error;
 
@@ -70,6 +71,9 @@ pub enum Command {
     /// One pixel's whole ray tree: each ray, what it hit and where that was defined,
     /// the light at each hit term by term, and what each ray brings back.
     Explain(explain::Args),
+    /// Serve a page on this machine that shows the render as it progresses, re-renders
+    /// with the options changed or the scene saved, and explains the pixel clicked.
+    View(view::Args),
 }
 
 /// Run the command line's command (a bare `emray` renders the default scene), Ctrl-C
@@ -93,6 +97,7 @@ pub fn run(cli: Cli) -> Result<(), Error> {
         Some(Command::Study(a)) => study::run(a),
         Some(Command::Radiosity(a)) => radiosity::run(a),
         Some(Command::Explain(a)) => explain::run(a),
+        Some(Command::View(a)) => view::run(a),
     }
 }
 
@@ -110,6 +115,7 @@ impl Command {
             Command::Study(a) => a.log,
             Command::Radiosity(a) => a.log,
             Command::Explain(a) => a.log,
+            Command::View(a) => a.log,
         }
     }
 }

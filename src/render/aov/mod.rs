@@ -204,6 +204,9 @@ pub enum AovError {
          its rays between pixels"
     )]
     Adaptive,
+    /// The render was stopped ([`Watch::cancelled`](super::Watch::cancelled)).
+    #[error("the render was stopped")]
+    Cancelled,
     /// Too many primitives for 32-bit ids.
     #[error(transparent)]
     TooManyIds(#[from] TooManyIds),
@@ -227,6 +230,10 @@ pub fn render_aov<A: Accel>(
     let tracer = Tracer::new(scene, accel, settings).with_gi(gi);
     let new = || AovRecorder::new(&map, set);
     let (film, recs) = grid::uniform_render(&tracer, settings, progress, new);
+    if progress.is_some_and(|p| p.cancelled()) {
+        // The skipped tiles recorded nothing.
+        return Err(AovError::Cancelled);
+    }
     let mut rays = RayCounts::default();
     for r in &recs {
         rays += r.counts();
