@@ -391,3 +391,83 @@ fn the_backends_are_compared_or_the_build_says_why_not() {
     assert_eq!(st["image"]["layers"], serde_json::json!(["colour"]));
     assert!(st["image"]["compare"].is_null());
 }
+
+/// A unit sphere at the origin seen from `z = 5`, looking down -z, on black.
+const SPHERE: &str = "v\nfrom 0 0 5\nat 0 0 0\nup 0 1 0\nangle 40\nhither 1\nresolution 64 64\n\
+                      b 0 0 0\nl 5 5 5\nf 0.8 0.3 0.2 1 0 0 0 1\ns 0 0 0 1\n";
+
+#[test]
+fn each_output_variable_is_a_layer() {
+    let dir = tempfile::tempdir().unwrap();
+    std::fs::write(dir.path().join("sphere.nff"), SPHERE).unwrap();
+    let server = start(
+        dir.path(),
+        &["sphere.nff", "--res", "64x48", "--backend", "bvh"],
+    );
+    server.wait(|st| finished(st, 1));
+    assert_eq!(server.get("/image.png?layer=aov-normal").status, 404);
+    let g = server.get("/render?aovs=1").json()["generation"]
+        .as_u64()
+        .unwrap();
+    let st = server.wait(|st| finished(st, g));
+    assert_eq!(st["request"]["aovs"], true);
+    let layers = st["image"]["layers"].as_array().unwrap();
+    for name in [
+        "colour",
+        "aov-depth",
+        "aov-normal",
+        "aov-albedo",
+        "aov-position",
+        "aov-id",
+        "aov-rays",
+        "aov-time",
+    ] {
+        assert!(layers.iter().any(|l| l == name), "{name}: {layers:?}");
+    }
+    let layer = |name: &str| {
+        let png = server.get(&format!("/image.png?layer={name}"));
+        assert_eq!(png.status, 200, "{name}");
+        let img = image::load_from_memory(&png.body).unwrap().to_rgb8();
+        assert_eq!(img.dimensions(), (64, 48), "{name}");
+        img
+    };
+    // The sphere's centre faces the eye, down the view's -z: its normal is +z, blue.
+    let normal = layer("aov-normal");
+    let c = normal.get_pixel(32, 24).0;
+    assert!(c[2] >= 245, "{c:?}");
+    assert!(
+        c[0].abs_diff(128) <= 12 && c[1].abs_diff(128) <= 12,
+        "{c:?}"
+    );
+    assert_eq!(normal.get_pixel(1, 1).0, [0, 0, 0], "the background");
+    // Depth: nearer is lighter; the background is black; the range is told.
+    let depth = layer("aov-depth");
+    let near = depth.get_pixel(32, 24).0[0];
+    let far = depth.get_pixel(32, 24 - 12).0[0];
+    assert!(near > far && far > 0, "near {near}, far {far}");
+    assert_eq!(depth.get_pixel(1, 1).0, [0, 0, 0], "the background");
+    let range = &st["image"]["aov"]["depth"];
+    let (min, max) = (
+        range["min"].as_f64().unwrap(),
+        range["max"].as_f64().unwrap(),
+    );
+    assert!(
+        (3.9..4.1).contains(&min) && min < max && max < 5.0,
+        "{range}"
+    );
+    // Gathering them leaves the colour `emray render`'s, byte for byte.
+    let out = dir.path().join("render.png");
+    let args = ["render", "sphere.nff", "-q", "-o", out.to_str().unwrap()];
+    let o = emray(
+        dir.path(),
+        &[&args[..], &OPTIONS[2..], &["--res", "64x48"]].concat(),
+    );
+    assert!(o.status.success(), "{}", common::stderr(&o));
+    assert!(server.get("/image.png").body == std::fs::read(&out).unwrap());
+    // The albedo is the material's colour, sRGB encoded; the id one colour on the sphere.
+    assert!(layer("aov-albedo").get_pixel(32, 24).0[0] > 200);
+    let id = layer("aov-id");
+    assert_ne!(id.get_pixel(32, 24).0, [0, 0, 0]);
+    assert_eq!(id.get_pixel(32, 24), id.get_pixel(30, 20));
+    assert_eq!(id.get_pixel(1, 1).0, [0, 0, 0]);
+}

@@ -1,6 +1,6 @@
 //! `emray view`: a local web server showing one scene's render as it progresses, with
-//! the render options users change most, heat-map layers, a pixel's explain tree at a
-//! click, and the scene file watched (docs/view.md).
+//! the render options users change most, heat-map and output-variable layers, a
+//! pixel's explain tree at a click, and the scene file watched (docs/view.md).
 //!
 //! - [`http`]: the little HTTP/1.1 it speaks, over `std::net`;
 //! - [`auth`]: the token and the `Host` check every request passes;
@@ -8,9 +8,11 @@
 //! - [`session`]: the render, its progress and its last image;
 //! - [`rays`]: a pixel's rays projected into the image;
 //! - [`difference`]: Embree's render against the BVH's;
+//! - [`aov`]: the output variables as images;
 //! - [`watch`]: the scene file polled for changes;
 //! - [`assets`]: the page, embedded.
 
+mod aov;
 mod assets;
 mod auth;
 mod difference;

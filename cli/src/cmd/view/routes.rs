@@ -3,12 +3,12 @@
 //! - `/`, `/view.js`, `/view.css`: the page (`/?token=…` also sets the cookie);
 //! - `/status?gen=G&since=N`: the render under way and the last image, as JSON, with
 //!   the tiles of render `G` from the `N`th on;
-//! - `/render?backend=&res=&spp=&max-depth=&aa=&heatmaps=0|1&compare=0|1`: render
+//! - `/render?backend=&res=&spp=&max-depth=&aa=&heatmaps=0|1&aovs=0|1&compare=0|1`: render
 //!   with these options now (400 and the message `emray render` gives for options it
 //!   refuses); `/compare?…` is `/render?…&compare=1`, Embree's render and the BVH's
 //!   with their difference;
-//! - `/image.png?layer=colour|rays|time|depth|bvh|difference`: a layer of the last
-//!   image;
+//! - `/image.png?layer=colour|rays|time|depth|bvh|difference|aov-NAME`: a layer of
+//!   the last image (`aov-NAME`: output variable `NAME`, rendered with `aovs=1`);
 //! - `/explain?x=&y=`: pixel `(x, y)`'s tree, as `emray explain --json` prints it;
 //! - `/rays?x=&y=`: its rays projected into the image, and the same tree.
 
@@ -51,8 +51,9 @@ pub fn handle(app: &App, req: &Request) -> Response {
         }
         "/render" | "/compare" => {
             let heatmaps = req.param("heatmaps").is_some_and(|v| v == "1");
+            let aovs = req.param("aovs").is_some_and(|v| v == "1");
             let compare = req.path == "/compare" || req.param("compare").is_some_and(|v| v == "1");
-            match s.parse(&req.query, heatmaps, compare) {
+            match s.parse(&req.query, heatmaps, aovs, compare) {
                 Ok(request) => Response::json(200, &json!({"generation": s.submit(request)})),
                 Err(e) => Response::json(400, &json!({"error": e})),
             }

@@ -10,11 +10,15 @@
 //! one. A render that fails leaves the last image in place, beside the error.
 
 use super::super::explain;
+use super::aov;
 use super::difference;
 use super::rays;
 use clap::Parser;
 use emray::Backend;
-use emray::job::{self, Event, Job, JobError, Observer, RenderOptions, SceneSource};
+use emray::job::{
+    self, AovList, Event, Job, JobError, Observer, Product, RenderOptions, SceneSource,
+};
+use emray::render::aov::AovSet;
 use emray::render::color::srgb8;
 use serde_json::{Value, json};
 use std::collections::BTreeMap;
@@ -61,6 +65,8 @@ pub struct Request {
     pub fields: BTreeMap<String, String>,
     /// Whether to gather the heat maps too.
     pub heatmaps: bool,
+    /// Whether to gather the output variables too (each one a layer, [`aov::LAYERS`]).
+    pub aovs: bool,
     /// Whether to render on both backends and show their difference.
     pub compare: bool,
     /// The options: the fields over the command line's.
@@ -145,6 +151,9 @@ pub struct Image {
     report: Value,
     /// The backends' difference, in a render that compares them.
     compare: Option<difference::Difference>,
+    /// The range each output variable's layer maps, by variable, in a render that
+    /// gathers them.
+    aov: Option<BTreeMap<&'static str, Value>>,
 }
 
 /// What the renderer and the page share.
@@ -179,7 +188,7 @@ fn message(e: impl Into<anyhow::Error>) -> String {
 
 impl Session {
     /// A session rendering `scene` with the command line's `options` (their heat maps
-    /// become the page's switch) on `pool`, its files in `dir`; the first render is
+    /// and output variables become the page's switches) on `pool`, its files in `dir`; the first render is
     /// checked as `emray render` checks it (a usage error before anything is served).
     pub fn new(
         scene: PathBuf,
@@ -188,9 +197,11 @@ impl Session {
         dir: PathBuf,
     ) -> Result<Session, JobError> {
         let heatmaps = !std::mem::take(&mut base.heatmap).is_empty();
+        let aovs = std::mem::take(&mut base.aov).is_some_and(|a| a.0.any());
         let request = Request {
             fields: BTreeMap::new(),
             heatmaps,
+            aovs,
             compare: false,
             options: base.clone(),
         };
@@ -207,7 +218,7 @@ impl Session {
             }),
             wake: Condvar::new(),
         };
-        s.job(&request, None, "colour", heatmaps)?;
+        s.job(&request, None, "colour", heatmaps, aovs)?;
         s.lock().request = request;
         Ok(s)
     }
@@ -227,13 +238,17 @@ impl Session {
     }
 
     /// The job of `request` (on `backend`, when given) writing its image to layer
-    /// `layer` (and the heat maps with `heatmaps`), checked as `emray render` checks it.
+    /// `layer` (and the heat maps with `heatmaps`), checked as `emray render` checks it;
+    /// with `aovs` it gathers every output variable too, checked as `emray render
+    /// --aov all` checks a render to an EXR file (the variables are not written: the
+    /// render's [`aov`] layers are made from them).
     fn job(
         &self,
         request: &Request,
         backend: Option<Backend>,
         layer: &str,
         heatmaps: bool,
+        aovs: bool,
     ) -> Result<Job, JobError> {
         let mut options = request.options.clone();
         if backend.is_some() {
@@ -247,19 +262,32 @@ impl Session {
         }
         let colour = self.file(layer).display().to_string();
         let source = SceneSource::File(self.scene.clone());
-        let mut jobs = job::plan(vec![source], Some(&colour), &options)?;
-        let job = jobs.pop().expect("one scene, one job");
+        let mut jobs = job::plan(vec![source.clone()], Some(&colour), &options)?;
+        let mut job = jobs.pop().expect("one scene, one job");
         job.check()?;
+        if aovs {
+            let all = Some(AovList(all_aovs()));
+            let exr = self.dir.join("aov.exr").display().to_string();
+            let with = RenderOptions {
+                aov: all,
+                ..options
+            };
+            for j in job::plan(vec![source], Some(&exr), &with)? {
+                j.check()?;
+            }
+            job.options.aov = all;
+        }
         Ok(job)
     }
 
     /// The request of the page's `fields` (the render options of [`FIELDS`], as
-    /// `emray render` takes them), `heatmaps` and `compare`, checked as `emray render`
-    /// checks its own; a field with an empty value keeps the command line's.
+    /// `emray render` takes them), `heatmaps`, `aovs` and `compare`, checked as `emray
+    /// render` checks its own; a field with an empty value keeps the command line's.
     pub fn parse(
         &self,
         fields: &[(String, String)],
         heatmaps: bool,
+        aovs: bool,
         compare: bool,
     ) -> Result<Request, String> {
         if compare && !cfg!(feature = "embree") {
@@ -281,11 +309,12 @@ impl Session {
         let request = Request {
             fields,
             heatmaps,
+            aovs,
             compare,
             options: parsed.options.over(&self.base),
         };
-        for (backend, layer, heatmaps) in self.passes(&request) {
-            self.job(&request, backend, layer, heatmaps)
+        for p in self.passes(&request) {
+            self.job(&request, p.backend, p.layer, p.heatmaps, p.aovs)
                 .map_err(message)?;
         }
         Ok(request)
@@ -345,16 +374,30 @@ impl Session {
         }
     }
 
-    /// The renders `request` makes: each one's backend (`None`: the options'), layer
-    /// and whether it gathers the heat maps.
-    fn passes(&self, request: &Request) -> Vec<(Option<Backend>, &'static str, bool)> {
+    /// The renders `request` makes: the first one gathers the heat maps and the output
+    /// variables asked for; the second, in a comparison, renders on the BVH.
+    fn passes(&self, request: &Request) -> Vec<Pass> {
+        let first = Pass {
+            backend: None,
+            layer: "colour",
+            heatmaps: request.heatmaps,
+            aovs: request.aovs,
+        };
         if request.compare {
             vec![
-                (Some(Backend::Embree), "colour", request.heatmaps),
-                (Some(Backend::Bvh), "bvh", false),
+                Pass {
+                    backend: Some(Backend::Embree),
+                    ..first
+                },
+                Pass {
+                    backend: Some(Backend::Bvh),
+                    layer: "bvh",
+                    heatmaps: false,
+                    aovs: false,
+                },
             ]
         } else {
-            vec![(None, "colour", request.heatmaps)]
+            vec![first]
         }
     }
 
@@ -364,24 +407,30 @@ impl Session {
             session: self,
             generation,
         };
+        let failed = |e: JobError| match e {
+            JobError::Cancelled(_) => Failure::Stopped,
+            e => Failure::Error(message(e)),
+        };
         let mut renders = Vec::new();
         let mut names = Vec::new();
-        for (backend, layer, heatmaps) in self.passes(request) {
+        let mut ranges = None;
+        for p in self.passes(request) {
             if request.compare {
-                self.pass(generation, backend.map(Backend::name));
+                self.pass(generation, p.backend.map(Backend::name));
             }
             let job = self
-                .job(request, backend, layer, heatmaps)
+                .job(request, p.backend, p.layer, p.heatmaps, p.aovs)
                 .map_err(|e| Failure::Error(message(e)))?;
-            renders.push(match job::run(&job, &watcher) {
-                Ok(r) => r,
-                Err(JobError::Cancelled(_)) => return Err(Failure::Stopped),
-                Err(e) => return Err(Failure::Error(message(e))),
-            });
-            names.push(layer);
-            if heatmaps {
+            let mut rendered = job::render(&job, &watcher).map_err(failed)?;
+            names.push(p.layer);
+            if p.heatmaps {
                 names.extend(HEATMAPS);
             }
+            if p.aovs {
+                ranges = Some(self.aov_layers(&mut rendered, &mut names)?);
+            }
+            job::write(&job, &rendered, &watcher).map_err(failed)?;
+            renders.push(rendered);
         }
         let rendered = &renders[0];
         let (film, _) = rendered.image().expect("a render makes an image");
@@ -413,7 +462,36 @@ impl Session {
             layers,
             report: serde_json::to_value(&rendered.report).unwrap_or(Value::Null),
             compare,
+            aov: ranges,
         })
+    }
+
+    /// Write the layers of the output variables `rendered` gathered, adding their names
+    /// to `names`; the variables are then left out of what the job writes (its colour
+    /// is the PNG `emray render` writes); the range of each variable's layer.
+    fn aov_layers(
+        &self,
+        rendered: &mut job::Rendered,
+        names: &mut Vec<&'static str>,
+    ) -> Result<BTreeMap<&'static str, Value>, Failure> {
+        let Product::Image {
+            aov: Some(film), ..
+        } = &mut rendered.product
+        else {
+            return Err(Failure::Error(
+                "this render gathers no output variables".into(),
+            ));
+        };
+        let mut ranges = BTreeMap::new();
+        for (layer, (var, _)) in aov::layers(film).into_iter().zip(aov::LAYERS) {
+            let path = self.file(layer.name);
+            emray::output::write_png_rgb8(&path, film.width, film.height, &layer.rgb)
+                .map_err(|e| Failure::Error(message(e)))?;
+            names.push(layer.name);
+            ranges.insert(var, layer.range);
+        }
+        film.set = AovSet::default();
+        Ok(ranges)
     }
 
     /// Render `generation` goes on with `backend`: its tiles are counted afresh.
@@ -483,6 +561,7 @@ impl Session {
                 "layers": i.layers.iter().map(|(n, _)| *n).collect::<Vec<_>>(),
                 "report": i.report,
                 "compare": i.compare,
+                "aov": i.aov,
             })
         });
         json!({
@@ -492,6 +571,7 @@ impl Session {
             "request": {
                 "fields": s.request.fields,
                 "heatmaps": s.request.heatmaps,
+                "aovs": s.request.aovs,
                 "compare": s.request.compare,
             },
             "render": {
@@ -510,6 +590,28 @@ impl Session {
             "image": image,
         })
     }
+}
+
+/// One render of a request.
+#[derive(Clone, Copy)]
+struct Pass {
+    /// Its backend (`None`: the options').
+    backend: Option<Backend>,
+    /// The layer of its colour.
+    layer: &'static str,
+    /// Whether it gathers the heat maps.
+    heatmaps: bool,
+    /// Whether it gathers the output variables.
+    aovs: bool,
+}
+
+/// Every output variable `--aov all` gathers.
+fn all_aovs() -> AovSet {
+    let mut set = AovSet::default();
+    for (name, _) in aov::LAYERS {
+        set.add(name);
+    }
+    set
 }
 
 /// The observer of render `generation`: phases, tiles and whether to stop.
