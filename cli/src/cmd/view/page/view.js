@@ -1,7 +1,8 @@
 // emray view: polls /status, draws the tiles of the render under way on the canvas,
 // then the finished PNG; sends the options to /render; shows the tree of the pixel
 // clicked and draws its rays over the image where they project (/rays); compares the
-// backends (the `compare` box: Embree's render, the BVH's and their difference).
+// backends (the `compare` box: Embree's render, the BVH's and their difference); shows
+// an output variable (the `output variables` choice: a render that gathers them all).
 // `?autoclick=X,Y` explains pixel (X, Y) once the first image is done, `?layer=NAME`
 // picks the first layer and `?rays=0` leaves the rays undrawn (for tests and links).
 'use strict';
@@ -15,7 +16,7 @@ history.replaceState(null, '', location.pathname + (params.toString() ? '?' + pa
 
 const canvas = $('canvas');
 const ctx = canvas.getContext('2d');
-let gen = 0, since = 0, shown = 0, image = null, filled = false, heatmaps = false;
+let gen = 0, since = 0, shown = 0, image = null, filled = false, heatmaps = false, aovs = false;
 // The clicked pixel's rays (/rays), and the tree path of the one to highlight.
 let rays = null, highlight = null;
 const HEATMAPS = ['rays', 'time', 'depth'], COMPARED = ['bvh', 'difference'];
@@ -67,13 +68,34 @@ function showLayer() {
   }
   for (const r of document.querySelectorAll('input[name=layer]')) r.checked = r.value === layer;
   for (const l of document.querySelectorAll('#layers .compared')) l.hidden = !(image && image.layers.includes('bvh'));
+  $('options').elements['aov'].value = layer.startsWith('aov-') ? layer : '';
+  showRange();
   drawRays();
 }
 
-// The layer `name` needs a render that makes it: the heat maps, or the comparison.
+// What the output variable shown spans: its layer maps that range linearly.
+function showRange() {
+  const el = $('aov-range'), name = layer.slice(4);
+  const r = layer.startsWith('aov-') && image && image.aov ? image.aov[name] : null;
+  el.hidden = !r;
+  if (!r) return;
+  const num = (v) => Number(v.toPrecision(4));
+  const span = (a, b) => `${num(a)} to ${num(b)}`;
+  if (name === 'position') {
+    el.textContent = 'xyz'.split('').map((a, k) => `${a} ${span(r.min[k], r.max[k])}`).join(', ');
+  } else if (name === 'depth') {
+    el.textContent = `${span(r.min, r.max)} (near light, far dark)`;
+  } else {
+    el.textContent = `${span(r.min, r.max)} (black to white)`;
+  }
+}
+
+// The layer `name` needs a render that makes it: the heat maps, the output variables,
+// or the comparison.
 function ask(name) {
   if (image && image.layers.includes(name)) return false;
   if (HEATMAPS.includes(name)) heatmaps = true;
+  else if (name.startsWith('aov-')) aovs = true;
   else if (COMPARED.includes(name) && !$('options').elements['compare'].disabled) $('options').elements['compare'].checked = true;
   else return false;
   return true;
@@ -86,6 +108,7 @@ function update(st) {
     const form = $('options');
     for (const [k, v] of Object.entries(st.request.fields)) if (form.elements[k]) form.elements[k].value = v;
     heatmaps = st.request.heatmaps;
+    aovs = st.request.aovs;
     const box = form.elements['compare'];
     box.checked = st.request.compare;
     if (!st.backends.includes('embree')) {
@@ -159,7 +182,9 @@ function showCompare(c) {
 function render() {
   const q = new URLSearchParams(new FormData($('options')));
   q.delete('layer');
+  q.delete('aov');
   q.set('heatmaps', heatmaps ? '1' : '0');
+  q.set('aovs', aovs ? '1' : '0');
   q.set('compare', $('options').elements['compare'].checked ? '1' : '0');
   fetch('/render?' + q).then((r) => r.json()).then((j) => {
     const err = $('error');
@@ -169,8 +194,8 @@ function render() {
 }
 
 $('options').addEventListener('change', (e) => {
-  if (e.target.name === 'layer') {
-    layer = e.target.value;
+  if (e.target.name === 'layer' || e.target.name === 'aov') {
+    layer = e.target.value || 'colour';
     if (layer !== 'colour' && ask(layer)) render();
     showLayer();
     return;
