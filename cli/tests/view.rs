@@ -470,4 +470,8 @@ fn each_output_variable_is_a_layer() {
     assert_ne!(id.get_pixel(32, 24).0, [0, 0, 0]);
     assert_eq!(id.get_pixel(32, 24), id.get_pixel(30, 20));
     assert_eq!(id.get_pixel(1, 1).0, [0, 0, 0]);
+    // Refused as `emray render --aov` refuses it.
+    let bad = server.get("/render?aovs=1&aa=adaptive");
+    assert_eq!(bad.status, 400);
+    assert!(bad.text().contains("--aa adaptive"), "{}", bad.text());
 }
