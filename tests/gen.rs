@@ -56,6 +56,37 @@ fn databases_parse_with_the_expected_counts() {
     }
 }
 
+/// Counting a database without generating it (`Database::count`, what a job checks
+/// against its memory limit first) gives the primitives and resolution its scene has:
+/// the same count, or an upper bound where the loader drops degenerate triangles (the
+/// teapot's, where a patch closes to a point: 58 counted, 54 loaded at size 1).
+#[test]
+fn counting_a_database_gives_its_scenes_primitives() {
+    for db in Database::ALL {
+        for size in [1, 2] {
+            let count = db.count(size);
+            let text = db.generate(size);
+            let s = emray::load::nff::parse_str(&text, Path::new(db.name())).unwrap();
+            let prims = s.prim_count_with_instances() as u64;
+            assert!(
+                count.prims >= prims && count.prims - prims <= prims / 10,
+                "{} size {size}: counted {}, loaded {prims}",
+                db.name(),
+                count.prims
+            );
+            assert_eq!(
+                (count.res.0 as u32, count.res.1 as u32),
+                (s.camera.width, s.camera.height),
+                "{} size {size}",
+                db.name()
+            );
+        }
+    }
+    // Balls at size 8 without generating it: Σ 9^k spheres, k = 0..=8, and the floor.
+    let balls = Database::Balls.count(8);
+    assert_eq!(balls.prims, (9u64.pow(9) - 1) / 8 + 2);
+}
+
 #[test]
 fn databases_render_on_every_backend() {
     let backends = common::backends();

@@ -58,6 +58,10 @@ const PARSE_ONLY: &[(&str, &str)] = &[
         "4.8 million spheres: 45 s and gigabytes",
     ),
     (
+        "spd:balls?size=8",
+        "counts 48 million spheres, then is refused (exits 1, as documented)",
+    ),
+    (
         "scenes/ice-cube.toml -o",
         "depth 10, 19 million rays: about 6 s",
     ),

@@ -209,6 +209,33 @@ fn every_malformed_file_fails_cleanly() {
     );
 }
 
+/// A generated database over the memory limit is refused after being counted, before
+/// any of it is generated: 48 million spheres are not built to find out.
+#[test]
+fn a_database_over_the_memory_limit_is_refused_before_it_is_generated() {
+    let dir = tempfile::tempdir().unwrap();
+    let d = dir.path();
+    let o = emray(
+        d,
+        &[
+            "render",
+            "spd:balls?size=8",
+            "--max-memory",
+            "1G",
+            "-o",
+            "o.png",
+        ],
+    );
+    let err = String::from_utf8_lossy(&o.stderr);
+    assert_eq!(o.status.code(), Some(1), "{err}");
+    assert!(
+        err.contains("spd:balls?size=8: rendering 512x512 with 48427563 primitives")
+            && err.contains("--max-memory"),
+        "{err}"
+    );
+    assert!(!d.join("o.png").exists());
+}
+
 #[test]
 fn memory_limit_refuses_before_rendering() {
     let dir = tempfile::tempdir().unwrap();

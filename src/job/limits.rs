@@ -111,9 +111,58 @@ pub fn check(
     Ok(())
 }
 
+/// Bytes per primitive the loaded scene holds besides the acceleration structure: the
+/// primitive, its material index and where it was defined, with room to spare.
+pub const SCENE_BYTES_PER_PRIM: u64 = 64;
+
+/// Refuse, before generating it, a database whose primitives alone (the scene and the
+/// acceleration structure, [`count`](crate::spd::Database::count)ed without
+/// generating) would be over `max` bytes; `res` is the image size the render asks for,
+/// for the message.
+pub fn check_generated(
+    spec: &Path,
+    count: &crate::spd::PrimCount,
+    res: (u32, u32),
+    max: u64,
+) -> Result<(), MemoryLimitError> {
+    let need = count
+        .prims
+        .saturating_mul(ACCEL_BYTES_PER_PRIM + SCENE_BYTES_PER_PRIM);
+    if need > max {
+        return Err(MemoryLimitError {
+            scene: spec.to_path_buf(),
+            width: res.0,
+            height: res.1,
+            prims: usize::try_from(count.prims).unwrap_or(usize::MAX),
+            need,
+            limit: max,
+        });
+    }
+    Ok(())
+}
+
 #[cfg(test)]
 mod tests {
     use super::*;
+
+    #[test]
+    fn a_database_over_the_limit_is_refused_before_it_is_generated() {
+        let count = crate::spd::PrimCount {
+            prims: 48_427_563,
+            res: (512, 512),
+        };
+        let spec = Path::new("spd:balls?size=8");
+        let need = 48_427_563 * (ACCEL_BYTES_PER_PRIM + SCENE_BYTES_PER_PRIM);
+        assert!(check_generated(spec, &count, (512, 512), need).is_ok());
+        let e = check_generated(spec, &count, (512, 512), need - 1)
+            .unwrap_err()
+            .to_string();
+        assert!(
+            e.starts_with("spd:balls?size=8: rendering 512x512 with 48427563 primitives"),
+            "{e}"
+        );
+        assert!(e.ends_with("(--max-memory)"), "{e}");
+    }
 
     #[test]
     fn big_images_are_refused_with_numbers() {

@@ -407,6 +407,22 @@ pub fn run(job: &Job, observer: &dyn Observer) -> Result<Rendered, JobError> {
     Ok(rendered)
 }
 
+/// Refuse a generated database too large for the memory limit before generating it
+/// (its primitives counted without building them); the full estimate, with the
+/// image's buffers, follows once the scene is there.
+fn check_database_size(job: &Job, options: &RenderOptions) -> Result<(), JobError> {
+    let Some((db, size)) = job.scene.database() else {
+        return Ok(());
+    };
+    let count = db.count(size);
+    let res = options.res.map_or(
+        (count.res.0.max(0) as u32, count.res.1.max(0) as u32),
+        |r| (r.width, r.height),
+    );
+    limits::check_generated(job.scene.path(), &count, res, options.memory_limit())?;
+    Ok(())
+}
+
 /// The first half of [`run`]: load, resolve, check the memory, build and do the task;
 /// nothing is written.
 pub fn render(job: &Job, observer: &dyn Observer) -> Result<Rendered, JobError> {
@@ -414,6 +430,7 @@ pub fn render(job: &Job, observer: &dyn Observer) -> Result<Rendered, JobError> 
     let options = job.options();
     observer.event(Event::Loading);
     let t0 = Instant::now();
+    check_database_size(job, &options)?;
     let scene = job.scene.load(options.envmap.as_deref())?;
     let load_ms = t0.elapsed().as_secs_f64() * 1e3;
     if observer.cancelled() {

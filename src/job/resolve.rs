@@ -322,10 +322,14 @@ impl RenderOptions {
             layers: self.aov.map(|a| a.0).unwrap_or_default(),
             heatmaps: self.heatmaps()?,
             reference,
-            max_memory: self
-                .max_memory
-                .map_or_else(super::limits::default_max_memory, |b| b.0),
+            max_memory: self.memory_limit(),
         })
+    }
+
+    /// The memory limit in bytes: `--max-memory`, else three quarters of the machine's.
+    pub fn memory_limit(&self) -> u64 {
+        self.max_memory
+            .map_or_else(super::limits::default_max_memory, |b| b.0)
     }
 
     /// The renderer's settings for `scene`.

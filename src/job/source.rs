@@ -78,6 +78,15 @@ impl SceneSource {
         Ok(())
     }
 
+    /// The generated database and size this source names (`spd:NAME[?size=N]`), if it
+    /// names one.
+    pub fn database(&self) -> Option<(Database, u32)> {
+        match self {
+            SceneSource::File(p) => Database::parse_spec(&p.to_string_lossy()).ok().flatten(),
+            _ => None,
+        }
+    }
+
     /// Load the scene, with the environment map `envmap` in place of its own (a loaded
     /// scene is shared, not copied, unless its environment is replaced).
     pub fn load(&self, envmap: Option<&Path>) -> Result<Arc<Scene>, SceneError> {
