@@ -534,7 +534,7 @@ mod tests {
             SpecReason::SizeNotWhole("x".into())
         );
         assert!(matches!(reason("spd:balls?size=0"), SpecReason::Size(e) if e.size == 0));
-        assert!(matches!(reason("spd:balls?size=99"), SpecReason::Size(e) if e.max == 7));
+        assert!(matches!(reason("spd:balls?size=99"), SpecReason::Size(e) if e.max == 8));
         assert_eq!(reason("spd:balls?depth=2"), SpecReason::NoSize);
         assert_eq!(
             Database::parse_spec("spd:balls?size=99")
