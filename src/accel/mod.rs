@@ -91,6 +91,22 @@ pub trait Accel: Sync {
             *hit = self.intersect(ray);
         }
     }
+    /// The nearest hits of a batch of rays in no particular order (`hits[i]` for
+    /// `rays[i]`; the slices have the same length), each as [`Accel::intersect`] would
+    /// find it. The default casts them one at a time.
+    fn intersect_batch(&self, rays: &[Ray], hits: &mut [Option<Hit>]) {
+        for (ray, hit) in rays.iter().zip(hits.iter_mut()) {
+            *hit = self.intersect(ray);
+        }
+    }
+    /// Whether anything lies on each of a batch of rays (`occluded[i]` for `rays[i]`;
+    /// the slices have the same length), each as [`Accel::occluded`] would say: the
+    /// shadow rays of a depth of the wavefront. The default casts them one at a time.
+    fn occluded_batch(&self, rays: &[Ray], occluded: &mut [bool]) {
+        for (ray, o) in rays.iter().zip(occluded.iter_mut()) {
+            *o = self.occluded(ray);
+        }
+    }
     /// Statistics about the built structure.
     fn stats(&self) -> AccelStats;
 }

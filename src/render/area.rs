@@ -6,7 +6,6 @@
 //! irradiance from the light divided by π, so that a diffuse surface of reflectance
 //! `ρ` shows `ρ ×` it, the same units as the radiosity solution's `B`.
 
-use super::record::Recorder;
 use crate::accel::Accel;
 use crate::math::{Ray, Vec3, gamma, hash, hash_unit as unit, next_float_down, offset_ray_origin};
 use crate::scene::{INHERIT, Scene};
@@ -97,17 +96,18 @@ pub fn direct<A: Accel>(
     n: u32,
     seed: u32,
 ) -> (Vec3, u64) {
-    direct_recorded(accel, lights, at, n, seed, &mut super::RayCounts::default())
+    direct_recorded(accel, lights, at, n, seed, &mut |_, _, _, _| {})
 }
 
-/// [`direct`], each light's share reported to `rec` ([`Recorder::area_light`]).
-pub fn direct_recorded<A: Accel, R: Recorder>(
+/// [`direct`], each light's share reported to `report(light, rays, visible, value)`:
+/// the shadow rays it cast, how many reached it, and its direct term.
+pub fn direct_recorded<A: Accel>(
     accel: &A,
     lights: &[AreaLight],
     at: &Receiver,
     n: u32,
     seed: u32,
-    rec: &mut R,
+    report: &mut impl FnMut(usize, u32, u32, Vec3),
 ) -> (Vec3, u64) {
     let Receiver { p, err, ng, ns } = *at;
     let n = n.max(1);
@@ -143,13 +143,11 @@ pub fn direct_recorded<A: Accel, R: Recorder>(
             if accel.occluded(&ray) {
                 continue;
             }
-            if R::ACTIVE {
-                visible += 1;
-            }
+            visible += 1;
             acc += cos_s * cos_l / (dist2 * dist2);
         }
         let term = l.emission * (FRAC_1_PI * acc * l.area / (n * n) as f32);
-        rec.area_light(li, (rays - first) as u32, visible, term);
+        report(li, (rays - first) as u32, visible, term);
         sum += term;
     }
     (sum, rays)

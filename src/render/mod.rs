@@ -16,9 +16,11 @@ mod grid;
 mod local;
 pub(crate) mod media;
 mod optics;
+mod path;
 pub(crate) mod record;
 pub mod reference;
 mod shade;
+mod wavefront;
 mod whitted;
 
 pub use camera::RayGen;

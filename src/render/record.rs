@@ -1,11 +1,20 @@
 //! The tracer's recording hook: everything the Whitted tracer does for a sample, as
 //! it does it, for whoever wants to look inside a render.
 //!
-//! The tracer ([`super::whitted`]) is generic over a [`Recorder`] and calls it at each
-//! step: a ray cast, what it hit or that it missed, the material and shading normal,
-//! each term of the local light (ambient, emission, area lights, radiosity, each point
-//! light with its shadow ray), the reflection and refraction rays with their weights,
-//! and what each ray brings back. An ordinary render records with [`RayCounts`], whose
+//! The tracer ([`super::whitted`], [`super::wavefront`]) is generic over a [`Recorder`]
+//! and calls it at each step: a ray cast, what it hit or that it missed, the material
+//! and shading normal, each term of the local light (ambient, emission, area lights,
+//! radiosity, each point light with its shadow ray), the reflection and refraction rays
+//! with their weights, and what each ray brings back.
+//!
+//! The tracer is a wavefront: the rays of a whole batch (a tile's samples) are cast
+//! depth by depth, so the steps of different rays interleave. Every ray is a node of
+//! the batch's ray tree, numbered from 0 in the order the rays are spawned (a child
+//! after its parent); each hook names the node it is about, and [`Traced`] names the
+//! ray's parent (a link, not a nesting of calls) and its position. A ray's radiance is
+//! known only once its subtree is cast: [`Recorder::ray_end`] comes for every node
+//! after all the batch's rays were cast, children before parents, and then
+//! [`Recorder::position`] and [`Recorder::position_end`] for each position, in order. An ordinary render records with [`RayCounts`], whose
 //! hooks are empty `#[inline(always)]` functions: the calls compile away and the render
 //! is the code it would be without them. `emray explain` ([`super::explain`]) builds the
 //! whole ray tree of a pixel from the same calls, and the output variables and heat
@@ -49,6 +58,12 @@ impl RayKind {
 /// A ray the tracer is about to follow (an eye, reflection or refraction ray).
 #[derive(Clone, Copy, Debug)]
 pub struct Traced<'a> {
+    /// Its node in the batch's ray tree.
+    pub node: u32,
+    /// The node of the ray whose hit spawned it (`None` for an eye ray).
+    pub parent: Option<u32>,
+    /// The sample-grid position it is for.
+    pub position: (u32, u32),
     /// What it is for.
     pub kind: RayKind,
     /// Its depth in the ray tree, the eye ray being 1.
@@ -150,56 +165,60 @@ pub trait Recorder {
     /// The ray counters.
     fn counts(&mut self) -> &mut RayCounts;
 
-    /// A sample-grid position `(i, j)` begins (all its samples follow).
+    /// A batch of samples begins: its nodes are numbered from 0 again.
+    #[inline(always)]
+    fn batch(&mut self) {}
+    /// A sample-grid position `(i, j)` is complete (its rays all ended); its value
+    /// follows in [`Recorder::position_end`].
     #[inline(always)]
     fn position(&mut self, _i: u32, _j: u32) {}
     /// The position's value, as the film gets it.
     #[inline(always)]
     fn position_end(&mut self, _value: Vec3) {}
-    /// The eye rays of a tile are about to be cast together (`start`), or were.
+    /// The rays of `nodes` are about to be cast together (`start`), or were.
     #[inline(always)]
-    fn coherent(&mut self, _start: bool, _rays: usize) {}
-    /// A ray is followed.
+    fn cast(&mut self, _start: bool, _nodes: &[u32]) {}
+    /// A ray is spawned (it is cast with the others of its depth).
     #[inline(always)]
     fn ray(&mut self, _ray: &Traced) {}
-    /// The ray followed last came back with this radiance (after saturation).
+    /// Ray `node` came back with this radiance (after saturation).
     #[inline(always)]
-    fn ray_end(&mut self, _radiance: Vec3) {}
-    /// The ray left the scene: the background or environment radiance.
+    fn ray_end(&mut self, _node: u32, _radiance: Vec3) {}
+    /// Ray `node` left the scene: the background or environment radiance.
     #[inline(always)]
-    fn miss(&mut self, _radiance: Vec3) {}
-    /// The ray went on through a surface that is not optically there (a lower-priority
-    /// medium inside a higher one).
+    fn miss(&mut self, _node: u32, _radiance: Vec3) {}
+    /// Ray `node` went on through a surface that is not optically there (a
+    /// lower-priority medium inside a higher one).
     #[inline(always)]
-    fn pass_through(&mut self, _at: &Met) {}
-    /// The ray hit a surface it is shaded at.
+    fn pass_through(&mut self, _node: u32, _at: &Met) {}
+    /// Ray `node` hit a surface it is shaded at.
     #[inline(always)]
-    fn hit(&mut self, _at: &Met) {}
+    fn hit(&mut self, _node: u32, _at: &Met) {}
     /// The material after textures and the shading normal after its maps, facing the
     /// ray.
     #[inline(always)]
-    fn shading(&mut self, _m: &Material, _ns: Vec3) {}
+    fn shading(&mut self, _node: u32, _m: &Material, _ns: Vec3) {}
     /// A term of the local light.
     #[inline(always)]
-    fn term(&mut self, _term: Term, _value: Vec3) {}
+    fn term(&mut self, _node: u32, _term: Term, _value: Vec3) {}
     /// Area light `light` cast `rays` shadow rays, of which `visible` reached it, and
     /// sends `value` (its direct term, before the surface's `colour × Kd`).
     #[inline(always)]
-    fn area_light(&mut self, _light: usize, _rays: u32, _visible: u32, _value: Vec3) {}
-    /// A point light's contribution.
+    fn area_light(&mut self, _node: u32, _light: usize, _rays: u32, _visible: u32, _value: Vec3) {}
+    /// A point light's contribution (after its shadow ray was cast with the batch's).
     #[inline(always)]
-    fn light(&mut self, _term: &LightTerm) {}
+    fn light(&mut self, _node: u32, _term: &LightTerm) {}
     /// The local light of the hit, every term summed: what the reflection and
     /// refraction are added to.
     #[inline(always)]
-    fn local(&mut self, _color: Vec3) {}
+    fn local(&mut self, _node: u32, _color: Vec3) {}
     /// A transmissive surface: the indices on either side and whether the ray is
     /// totally reflected.
     #[inline(always)]
-    fn boundary(&mut self, _b: &Boundary) {}
+    fn boundary(&mut self, _node: u32, _b: &Boundary) {}
     /// A reflection or refraction ray was not cast.
     #[inline(always)]
-    fn not_cast(&mut self, _kind: RayKind, _why: NotCast, _weight: Vec3) {}
+    fn not_cast(&mut self, _node: u32, _kind: RayKind, _why: NotCast, _weight: Vec3) {}
 }
 
 /// An ordinary render records the counts alone.

@@ -1,14 +1,13 @@
-//! The Whitted tracer: samples through the film, eye rays (cast a tile at a time with
-//! one sample per pixel), and each ray followed to the surface it is shaded at, through
-//! the surfaces of nested media it passes; the shading itself is in [`super::shade`].
-//! Every step is reported to a [`Recorder`] (a plain render's records the counts
-//! alone, and compiles to the tracer without hooks).
+//! The Whitted tracer: samples through the film and their eye rays, each batch of
+//! them (a tile's) traced by the wavefront ([`super::wavefront`]) and shaded by
+//! [`super::shade`]. Every step is reported to a [`Recorder`] (a plain render's
+//! records the counts alone, and compiles to the tracer without hooks).
 
-use super::media::{MAX_SKIPS, Media};
-use super::record::{Met, RayKind, Recorder, Traced};
+use super::record::Recorder;
+use super::wavefront::Eye;
 use super::{GlobalIllumination, RayCounts, RayGen, Region, RenderSettings, area};
-use crate::accel::{Accel, Hit};
-use crate::math::{Ray, Vec3, hash, hash_unit as unit, offset_ray_origin};
+use crate::accel::Accel;
+use crate::math::{Vec3, hash, hash_unit as unit};
 use crate::scene::Scene;
 
 /// The Whitted tracer over one scene and backend, with a render's settings.
@@ -22,7 +21,7 @@ pub(super) struct Tracer<'a, A: Accel> {
     /// Shadow rays per area light: `area_strata²` (`area_strata` per axis).
     pub(super) area_strata: u32,
     /// Two-pass mode: the diffuse term of the surfaces this solution covers.
-    gi: Option<&'a dyn GlobalIllumination>,
+    pub(super) gi: Option<&'a dyn GlobalIllumination>,
     /// Hall & Greenberg's adaptive tree depth: no secondary ray whose weight (largest
     /// channel) is below this; 0 = off.
     bailout: f32,
@@ -75,28 +74,6 @@ fn radical_inverse(i: u32) -> f32 {
     unit(i.reverse_bits())
 }
 
-/// A ray's radiance as f32 can hold it. Finite inputs can still overflow (a light of
-/// 10³⁸ on a white surface, weights above 1 multiplied down a deep ray tree), and an
-/// infinite channel times a zero weight further up the tree would be NaN. So an
-/// infinite channel saturates at ±`f32::MAX` and a NaN one (∞ − ∞, only possible with
-/// negative NFF colours) counts as 0; either is counted in [`RayCounts::saturated`].
-/// Finite radiance passes unchanged.
-#[inline]
-pub(super) fn saturate(c: Vec3, counts: &mut RayCounts) -> Vec3 {
-    if c.is_finite() {
-        return c;
-    }
-    counts.saturated += 1;
-    let f = |x: f32| {
-        if x.is_nan() {
-            0.0
-        } else {
-            x.clamp(-f32::MAX, f32::MAX)
-        }
-    };
-    Vec3::new(f(c.x), f(c.y), f(c.z))
-}
-
 impl<'a, A: Accel> Tracer<'a, A> {
     pub(super) fn new(scene: &'a Scene, accel: &'a A, s: &RenderSettings) -> Self {
         Tracer {
@@ -123,29 +100,28 @@ impl<'a, A: Accel> Tracer<'a, A> {
         self
     }
 
-    /// The value of sample-grid position `(i, j)`: its centre with one sample, else the
-    /// mean of `spp` stratified samples (a Hammersley set rotated per pixel by a hash
-    /// of its coordinates, so the result does not depend on the thread schedule).
-    pub(super) fn pixel<R: Recorder>(&self, raygen: &RayGen, i: u32, j: u32, rec: &mut R) -> Vec3 {
-        if self.spp == 1 {
-            return self.eye(raygen, i as f32 + 0.5, j as f32 + 0.5, rec);
-        }
+    /// The film positions of the samples of grid position `(i, j)`: its centre with
+    /// one sample, else `spp` stratified samples (a Hammersley set rotated per pixel by
+    /// a hash of its coordinates, so the result does not depend on the thread
+    /// schedule).
+    fn samples(&self, i: u32, j: u32) -> impl Iterator<Item = (f32, f32)> {
+        let n = self.spp;
         let seed = hash(i.wrapping_mul(0x9e37_79b9) ^ hash(j));
         let (ox, oy) = (unit(hash(seed)), unit(hash(seed ^ 0x5bd1_e995)));
-        let n = self.spp;
-        let mut sum = Vec3::ZERO;
-        for s in 0..n {
+        (0..n).map(move |s| {
+            if n == 1 {
+                return (i as f32 + 0.5, j as f32 + 0.5);
+            }
             let sx = ((s as f32 + ox) / n as f32).fract();
             let sy = (radical_inverse(s) + oy).fract();
-            sum += self.eye(raygen, i as f32 + sx, j as f32 + sy, rec);
-        }
-        sum / n as f32
+            (i as f32 + sx, j as f32 + sy)
+        })
     }
 
-    /// The values of the grid positions of tile `t`, row by row, given to `out`: as
-    /// [`Tracer::pixel`] gives them, but with one sample per pixel the tile's eye rays
-    /// are cast together first (packets on backends that have them; see
-    /// [`Accel::intersect_coherent`]), then each is shaded from its hit.
+    /// The values of the grid positions of tile `t`, row by row, given to `out`: each
+    /// the mean of its samples (its centre alone with one sample). The tile is one
+    /// batch of the wavefront; with one sample per pixel its eye rays are cast in
+    /// packets of 4×2 pixels ([`Accel::intersect_coherent`]).
     pub(super) fn tile<R: Recorder>(
         &self,
         raygen: &RayGen,
@@ -153,45 +129,49 @@ impl<'a, A: Accel> Tracer<'a, A> {
         out: &mut impl FnMut(Vec3),
         rec: &mut R,
     ) {
-        if self.spp != 1 {
-            for j in t.y0..t.y1 {
-                for i in t.x0..t.x1 {
-                    rec.position(i, j);
-                    let v = self.pixel(raygen, i, j, rec);
-                    rec.position_end(v);
-                    out(v);
-                }
-            }
-            return;
-        }
-        // Cast in blocks of 4×2 pixels (a packet of 8 is one block: rays closer
-        // together than a row's 8 visit fewer nodes), shaded row by row.
-        let order = block_order(t);
-        let rays: Vec<Ray> = order
-            .iter()
-            .map(|&(i, j)| raygen.ray(i as f32 + 0.5, j as f32 + 0.5))
+        let width = t.x1 - t.x0;
+        let positions: Vec<(u32, u32)> = (t.y0..t.y1)
+            .flat_map(|j| (t.x0..t.x1).map(move |i| (i, j)))
             .collect();
-        let mut cast = vec![None; rays.len()];
-        rec.coherent(true, rays.len());
-        self.accel.intersect_coherent(&rays, &mut cast);
-        rec.coherent(false, rays.len());
-        let width = (t.x1 - t.x0) as usize;
-        let mut row_major = vec![0; rays.len()];
-        for (k, &(i, j)) in order.iter().enumerate() {
-            row_major[(j - t.y0) as usize * width + (i - t.x0) as usize] = k;
+        let slot = |i: u32, j: u32| (j - t.y0) * width + (i - t.x0);
+        // With one sample, the eyes in blocks of 4×2 pixels (a packet of 8 is one
+        // block: rays closer together than a row's 8 visit fewer nodes).
+        let order = if self.spp == 1 {
+            block_order(t)
+        } else {
+            positions.clone()
+        };
+        let eyes: Vec<Eye> = order
+            .iter()
+            .flat_map(|&(i, j)| {
+                self.samples(i, j)
+                    .map(move |(x, y)| eye(raygen, x, y, slot(i, j)))
+            })
+            .collect();
+        let values = self.trace_batch(&eyes, &positions, self.spp == 1, rec);
+        // The eyes of each position, in sample order, for the sums.
+        let mut of_slot = vec![Vec::new(); positions.len()];
+        for (k, e) in eyes.iter().enumerate() {
+            of_slot[e.slot as usize].push(k);
         }
-        for k in row_major {
-            let (ray, hit) = (&rays[k], cast[k]);
-            let (x, y) = (order[k].0 as f32 + 0.5, order[k].1 as f32 + 0.5);
-            rec.position(x as u32, y as u32);
-            rec.counts().eye += 1;
-            rec.ray(&Traced::eye(ray));
-            let path = eye_path(x, y);
-            let v = self.trace_from(ray, hit, 1, path, Media::AIR, Vec3::ONE, rec);
-            rec.ray_end(v);
+        for (&(i, j), eyes) in positions.iter().zip(&of_slot) {
+            rec.position(i, j);
+            let v = self.mean(eyes.iter().map(|&k| values[k]));
             rec.position_end(v);
             out(v);
         }
+    }
+
+    /// The value of a position from its samples' values.
+    fn mean(&self, mut values: impl Iterator<Item = Vec3>) -> Vec3 {
+        if self.spp == 1 {
+            return values.next().unwrap_or(Vec3::ZERO);
+        }
+        let mut sum = Vec3::ZERO;
+        for v in values {
+            sum += v;
+        }
+        sum / self.spp as f32
     }
 
     /// The value of the eye ray through continuous film position `(px, py)`.
@@ -202,18 +182,9 @@ impl<'a, A: Accel> Tracer<'a, A> {
         py: f32,
         rec: &mut R,
     ) -> Vec3 {
-        self.eye(raygen, px, py, rec)
-    }
-
-    /// The value of the eye ray through film position `(px, py)`.
-    fn eye<R: Recorder>(&self, raygen: &RayGen, px: f32, py: f32, rec: &mut R) -> Vec3 {
-        rec.counts().eye += 1;
-        let path = eye_path(px, py);
-        let ray = raygen.ray(px, py);
-        rec.ray(&Traced::eye(&ray));
-        let v = self.trace(&ray, 1, path, Media::AIR, Vec3::ONE, rec);
-        rec.ray_end(v);
-        v
+        let position = [(px as u32, py as u32)];
+        let eyes = [eye(raygen, px, py, 0)];
+        self.trace_batch(&eyes, &position, false, rec)[0]
     }
 
     /// Whether a secondary ray of accumulated `weight` is worth casting.
@@ -225,105 +196,14 @@ impl<'a, A: Accel> Tracer<'a, A> {
         }
         true
     }
-
-    /// Radiance along `ray` at ray-tree depth `depth` (the eye ray is depth 1), which
-    /// travels inside `media`; `weight` is the product of the coefficients between this
-    /// ray and the eye (what its radiance is multiplied by in the pixel).
-    #[allow(clippy::too_many_arguments)]
-    pub(super) fn trace<R: Recorder>(
-        &self,
-        ray: &Ray,
-        depth: u32,
-        path: u32,
-        media: Media,
-        weight: Vec3,
-        rec: &mut R,
-    ) -> Vec3 {
-        let first = self.accel.intersect(ray);
-        self.trace_from(ray, first, depth, path, media, weight, rec)
-    }
-
-    /// [`Tracer::trace`] given the ray's nearest hit, `first`.
-    #[allow(clippy::too_many_arguments)]
-    fn trace_from<R: Recorder>(
-        &self,
-        ray: &Ray,
-        first: Option<Hit>,
-        depth: u32,
-        path: u32,
-        media: Media,
-        weight: Vec3,
-        rec: &mut R,
-    ) -> Vec3 {
-        let scene = self.scene;
-        let mut ray = *ray;
-        let mut media = media;
-        let mut next = first;
-        // Surfaces of lower-priority media inside a higher-priority one are skipped
-        // (nested dielectrics): the ray goes on through them, at most this many times.
-        let mut skips = 0;
-        loop {
-            let Some(hit) = next else {
-                let sky = scene.escape(ray.dir);
-                rec.miss(sky);
-                return sky;
-            };
-            let surf = scene.surface_of(&hit, &ray, self.accel.exact_triangle_hits());
-            let m = &scene.materials[surf.material as usize];
-            let d = ray.dir.normalize();
-            let entering = surf.point.ng.dot(d) < 0.0;
-            let met = Met {
-                hit: &hit,
-                surf: &surf,
-                entering,
-                media: &media,
-            };
-            if m.t > 0.0
-                && skips < MAX_SKIPS
-                && media.is_false_boundary(scene, surf.material, entering)
-            {
-                rec.pass_through(&met);
-                skips += 1;
-                media = if entering {
-                    media.enter(surf.material)
-                } else {
-                    media.leave(surf.material)
-                };
-                let ng = if entering {
-                    -surf.point.ng
-                } else {
-                    surf.point.ng
-                };
-                ray = Ray::new(
-                    offset_ray_origin(surf.point.p, surf.point.err, ng, d),
-                    ray.dir,
-                );
-                next = self.accel.intersect(&ray);
-                continue;
-            }
-            rec.hit(&met);
-            if depth == 1 {
-                rec.counts().eye_hit += 1;
-            }
-            let gi = self.gi.and_then(|g| g.radiosity_at(&hit, surf.point.p, d));
-            let radiance = self.shade(&surf, d, entering, depth, path, media, weight, gi, rec);
-            return saturate(radiance, rec.counts());
-        }
-    }
 }
 
-impl<'a> Traced<'a> {
-    /// An eye ray.
-    #[inline(always)]
-    fn eye(ray: &'a Ray) -> Self {
-        Traced {
-            kind: RayKind::Eye,
-            depth: 1,
-            ray,
-            local_weight: Vec3::ONE,
-            weight: Vec3::ONE,
-            discarded: false,
-        }
+/// The eye ray through film position `(px, py)`, for position slot `slot`.
+fn eye(raygen: &RayGen, px: f32, py: f32, slot: u32) -> Eye {
+    Eye {
+        ray: raygen.ray(px, py),
+        slot,
+        path: eye_path(px, py),
     }
 }
 

@@ -1,14 +1,18 @@
 //! The recorder that gathers the output variables of each sample-grid position of a
 //! tile from the tracer's hooks: the first surface each eye ray is shaded at (its
 //! distance, point, shading normal, albedo and primitive), the rays cast for the
-//! position, the deepest of them, and the time spent on it.
+//! position, the deepest of them, and the time spent on it. The wavefront interleaves
+//! the positions of a tile, so every ray is filed under its position by its node, and
+//! the time between two hooks goes to the position of the first; a batch cast's time
+//! is shared among its rays' positions.
 
 use super::ids::{IdMap, NO_ID};
 use super::{AovSet, Cell};
 use crate::math::Vec3;
 use crate::render::RayCounts;
-use crate::render::record::{Met, RayKind, Recorder, Traced};
+use crate::render::record::{LightTerm, Met, Recorder, Traced};
 use crate::scene::Material;
+use std::collections::HashMap;
 use std::time::Instant;
 
 /// Gathers one [`Cell`] per position of a tile, in the tile's order.
@@ -18,50 +22,34 @@ pub(super) struct AovRecorder<'a> {
     counts: RayCounts,
     /// The finished positions.
     pub(super) cells: Vec<Cell>,
-    /// The position being traced.
-    cur: Cell,
-    /// Its samples' ids with how many samples saw each.
-    votes: Vec<(u32, u32)>,
-    /// Rays counted before the position began.
-    rays_before: u64,
-    /// When the position began (only when time is wanted).
-    start: Option<Instant>,
-    /// When the tile's coherent eye rays began to be cast.
-    coherent_start: Option<Instant>,
-    /// Each position's share of that cast, in nanoseconds.
-    coherent_share_ns: f64,
-    /// How many rays are being followed (1: the eye ray).
-    level: u32,
-    /// The eye ray's origin.
-    eye: Vec3,
-    /// The eye ray was shaded at a surface whose material is still to come.
-    pending: bool,
+    /// The batch's rays, by node.
+    nodes: Vec<RayOf>,
+    /// The batch's positions being gathered.
+    pending: HashMap<(u32, u32), Pending>,
+    /// The position being completed.
+    current: (u32, u32),
+    /// When the last hook came (only when time is wanted), and for which node.
+    clock: Option<(Instant, Option<u32>)>,
 }
 
-impl<'a> AovRecorder<'a> {
-    pub(super) fn new(ids: &'a IdMap, want: AovSet) -> Self {
-        AovRecorder {
-            ids,
-            want,
-            counts: RayCounts::default(),
-            cells: Vec::new(),
-            cur: Cell::default(),
-            votes: Vec::new(),
-            rays_before: 0,
-            start: None,
-            coherent_start: None,
-            coherent_share_ns: 0.0,
-            level: 0,
-            eye: Vec3::ZERO,
-            pending: false,
-        }
-    }
+/// What the recorder keeps of a ray.
+#[derive(Clone, Copy, Debug)]
+struct RayOf {
+    position: (u32, u32),
+    depth: u32,
+    /// Its origin (an eye ray's: the eye).
+    org: Vec3,
+}
 
-    /// The counts of the tile.
-    pub(super) fn counts(&self) -> RayCounts {
-        self.counts
-    }
+/// A position being gathered: its cell, and its samples' ids with how many samples
+/// saw each.
+#[derive(Clone, Debug, Default)]
+struct Pending {
+    cell: Cell,
+    votes: Vec<(u32, u32)>,
+}
 
+impl Pending {
     /// The id most of the position's samples saw (the earliest seen among equals).
     fn winner(&self) -> u32 {
         let mut best = (NO_ID, 0);
@@ -74,6 +62,45 @@ impl<'a> AovRecorder<'a> {
     }
 }
 
+impl<'a> AovRecorder<'a> {
+    pub(super) fn new(ids: &'a IdMap, want: AovSet) -> Self {
+        AovRecorder {
+            ids,
+            want,
+            counts: RayCounts::default(),
+            cells: Vec::new(),
+            nodes: Vec::new(),
+            pending: HashMap::new(),
+            current: (0, 0),
+            clock: None,
+        }
+    }
+
+    /// The counts of the tile.
+    pub(super) fn counts(&self) -> RayCounts {
+        self.counts
+    }
+
+    /// The cell of ray `node`'s position.
+    fn cell(&mut self, node: u32) -> &mut Cell {
+        let position = self.nodes[node as usize].position;
+        &mut self.pending.entry(position).or_default().cell
+    }
+
+    /// A hook about `node` (`None`: no node): the time since the last hook goes to the
+    /// last hook's position.
+    fn tick(&mut self, node: Option<u32>) {
+        let Some((then, last)) = self.clock else {
+            return;
+        };
+        let now = Instant::now();
+        if let Some(last) = last {
+            self.cell(last).time += (now - then).as_nanos() as f32;
+        }
+        self.clock = Some((now, node));
+    }
+}
+
 impl Recorder for AovRecorder<'_> {
     const ACTIVE: bool = true;
 
@@ -81,73 +108,96 @@ impl Recorder for AovRecorder<'_> {
         &mut self.counts
     }
 
-    fn coherent(&mut self, start: bool, rays: usize) {
-        if !self.want.time {
-            return;
-        }
-        if start {
-            self.coherent_start = Some(Instant::now());
-        } else if let Some(t) = self.coherent_start.take() {
-            self.coherent_share_ns = t.elapsed().as_nanos() as f64 / rays.max(1) as f64;
-        }
+    fn batch(&mut self) {
+        self.nodes.clear();
+        self.pending.clear();
+        self.clock = self.want.time.then(|| (Instant::now(), None));
     }
 
-    fn position(&mut self, _i: u32, _j: u32) {
-        self.cur = Cell::default();
-        self.votes.clear();
-        self.rays_before = self.counts.total();
-        self.level = 0;
-        self.pending = false;
-        if self.want.time {
-            self.start = Some(Instant::now());
+    fn cast(&mut self, start: bool, nodes: &[u32]) {
+        if start {
+            self.tick(None);
+            return;
         }
+        let Some((then, _)) = self.clock else {
+            return;
+        };
+        let now = Instant::now();
+        let share = (now - then).as_nanos() as f32 / nodes.len().max(1) as f32;
+        for &node in nodes {
+            self.cell(node).time += share;
+        }
+        self.clock = Some((now, None));
+    }
+
+    fn position(&mut self, i: u32, j: u32) {
+        self.current = (i, j);
     }
 
     fn position_end(&mut self, _value: Vec3) {
-        self.cur.rays = (self.counts.total() - self.rays_before) as f32;
-        if let Some(t) = self.start.take() {
-            let ns = t.elapsed().as_nanos() as f64 + self.coherent_share_ns;
-            self.cur.time = ns as f32;
-        }
-        self.cur.id = self.winner();
-        self.cells.push(self.cur);
+        let p = self.pending.remove(&self.current).unwrap_or_default();
+        let mut cell = p.cell;
+        cell.id = p.winner();
+        self.cells.push(cell);
     }
 
     fn ray(&mut self, t: &Traced) {
-        self.level += 1;
-        self.cur.depth = self.cur.depth.max(t.depth);
-        if t.kind == RayKind::Eye {
-            self.eye = t.ray.org;
-        }
+        debug_assert_eq!(t.node as usize, self.nodes.len());
+        self.nodes.push(RayOf {
+            position: t.position,
+            depth: t.depth,
+            org: t.ray.org,
+        });
+        self.tick(Some(t.node));
+        let c = self.cell(t.node);
+        c.depth = c.depth.max(t.depth);
+        c.rays += 1.0;
     }
 
-    fn ray_end(&mut self, _radiance: Vec3) {
-        self.level = self.level.saturating_sub(1);
+    fn miss(&mut self, node: u32, _radiance: Vec3) {
+        self.tick(Some(node));
     }
 
-    fn hit(&mut self, at: &Met) {
-        if self.level != 1 {
+    fn hit(&mut self, node: u32, at: &Met) {
+        self.tick(Some(node));
+        let ray = self.nodes[node as usize];
+        if ray.depth != 1 {
             return;
         }
         let p = at.surf.point.p;
-        let c = &mut self.cur;
-        c.hits += 1;
-        c.z += (p - self.eye).length();
-        c.p += p;
         let id = self.ids.id(at.hit);
-        match self.votes.iter_mut().find(|(v, _)| *v == id) {
+        let pending = self.pending.entry(ray.position).or_default();
+        let c = &mut pending.cell;
+        c.hits += 1;
+        c.z += (p - ray.org).length();
+        c.p += p;
+        match pending.votes.iter_mut().find(|(v, _)| *v == id) {
             Some((_, n)) => *n += 1,
-            None => self.votes.push((id, 1)),
+            None => pending.votes.push((id, 1)),
         }
-        self.pending = true;
     }
 
-    fn shading(&mut self, m: &Material, ns: Vec3) {
-        if self.level != 1 || !self.pending {
+    fn shading(&mut self, node: u32, m: &Material, ns: Vec3) {
+        if self.nodes[node as usize].depth != 1 {
             return;
         }
-        self.pending = false;
-        self.cur.n += ns;
-        self.cur.albedo += m.color * m.kd;
+        let c = self.cell(node);
+        c.n += ns;
+        c.albedo += m.color * m.kd;
+    }
+
+    fn area_light(&mut self, node: u32, _light: usize, rays: u32, _visible: u32, _value: Vec3) {
+        self.cell(node).rays += rays as f32;
+    }
+
+    fn light(&mut self, node: u32, term: &LightTerm) {
+        self.tick(Some(node));
+        if term.shadow.is_some() {
+            self.cell(node).rays += 1.0;
+        }
+    }
+
+    fn local(&mut self, node: u32, _color: Vec3) {
+        self.tick(Some(node));
     }
 }

@@ -1,7 +1,9 @@
-//! The recorder that builds `emray explain`'s ray tree from the tracer's hooks: a
-//! stack of the rays being followed, each finished ray attached to the hit that
-//! spawned it, or to its position when it is an eye ray. Only the wanted sample-grid
-//! positions are recorded; the others of their tile are traced and forgotten.
+//! The recorder that builds `emray explain`'s ray tree from the tracer's hooks: every
+//! ray of a wanted sample-grid position recorded under its node number as the
+//! wavefront reaches it, and once the position is complete its rays put together into
+//! trees by their parent links (each ray under the hit that spawned it, children in
+//! the order they were spawned). The other positions of the tile are traced and
+//! forgotten.
 
 use super::{
     AreaNode, BoundaryNode, HitNode, LightNode, MaterialNode, Medium, NotCastNode, Passed,
@@ -12,6 +14,7 @@ use crate::render::RayCounts;
 use crate::render::media::Media;
 use crate::render::record::{Boundary, LightTerm, Met, NotCast, RayKind, Recorder, Term, Traced};
 use crate::scene::{Hit, Material, NO_INSTANCE, Scene};
+use std::collections::HashMap;
 
 /// Records the ray trees of the wanted positions.
 pub(super) struct ExplainRecorder<'s> {
@@ -20,12 +23,18 @@ pub(super) struct ExplainRecorder<'s> {
     /// What one sample weighs in the pixel.
     share: f32,
     counts: RayCounts,
-    /// Whether the current position is wanted.
-    active: bool,
-    /// The rays being followed, the eye ray first.
-    stack: Vec<RayNode>,
-    current: Option<Position>,
+    /// The rays of the batch's wanted positions, by node.
+    rays: HashMap<u32, Recorded>,
+    /// The position being completed, when it is wanted.
+    current: Option<(u32, u32)>,
     done: Vec<Position>,
+}
+
+/// A recorded ray with its links.
+struct Recorded {
+    ray: RayNode,
+    parent: Option<u32>,
+    position: (u32, u32),
 }
 
 impl<'s> ExplainRecorder<'s> {
@@ -35,8 +44,7 @@ impl<'s> ExplainRecorder<'s> {
             wanted,
             share,
             counts: RayCounts::default(),
-            active: false,
-            stack: Vec::new(),
+            rays: HashMap::new(),
             current: None,
             done: Vec::new(),
         }
@@ -62,12 +70,52 @@ impl<'s> ExplainRecorder<'s> {
             .collect()
     }
 
-    /// The hit of the ray being followed.
-    fn hit_mut(&mut self) -> Option<&mut HitNode> {
-        if !self.active {
-            return None;
+    /// Ray `node`, if it is recorded.
+    fn ray_mut(&mut self, node: u32) -> Option<&mut RayNode> {
+        self.rays.get_mut(&node).map(|r| &mut r.ray)
+    }
+
+    /// The hit of ray `node`, if it is recorded.
+    fn hit_mut(&mut self, node: u32) -> Option<&mut HitNode> {
+        self.ray_mut(node)?.hit.as_deref_mut()
+    }
+
+    /// Ray `node` with its subtree, taken out of the records (`children[k]`: the nodes
+    /// spawned at `k`'s hit, in order).
+    fn take_tree(&mut self, node: u32, children: &HashMap<u32, Vec<u32>>) -> Option<RayNode> {
+        let mut ray = self.rays.remove(&node)?.ray;
+        let subtrees: Vec<RayNode> = children
+            .get(&node)
+            .into_iter()
+            .flatten()
+            .filter_map(|&c| self.take_tree(c, children))
+            .collect();
+        if let Some(hit) = ray.hit.as_deref_mut() {
+            hit.children = subtrees;
         }
-        self.stack.last_mut()?.hit.as_deref_mut()
+        Some(ray)
+    }
+
+    /// The eye rays of `position` with their trees, in sample order.
+    fn trees_of(&mut self, position: (u32, u32)) -> Vec<RayNode> {
+        let mut eyes = Vec::new();
+        let mut children: HashMap<u32, Vec<u32>> = HashMap::new();
+        for (&node, r) in &self.rays {
+            if r.position != position {
+                continue;
+            }
+            match r.parent {
+                None => eyes.push(node),
+                Some(p) => children.entry(p).or_default().push(node),
+            }
+        }
+        eyes.sort_unstable();
+        for list in children.values_mut() {
+            list.sort_unstable();
+        }
+        eyes.into_iter()
+            .filter_map(|e| self.take_tree(e, &children))
+            .collect()
     }
 
     /// Primitive `hit` with where it and its instance were defined.
@@ -175,30 +223,32 @@ impl Recorder for ExplainRecorder<'_> {
         &mut self.counts
     }
 
+    fn batch(&mut self) {
+        self.rays.clear();
+    }
+
     fn position(&mut self, i: u32, j: u32) {
-        self.active = self.wanted.contains(&(i, j));
-        self.stack.clear();
-        self.current = self.active.then(|| Position {
-            grid: [i, j],
-            value: [0.0; 3],
-            share: self.share,
-            samples: Vec::new(),
-        });
+        self.current = self.wanted.contains(&(i, j)).then_some((i, j));
     }
 
     fn position_end(&mut self, value: Vec3) {
-        if let Some(mut p) = self.current.take() {
-            p.value = arr(value);
-            self.done.push(p);
-        }
-        self.active = false;
+        let Some(grid) = self.current.take() else {
+            return;
+        };
+        let samples = self.trees_of(grid);
+        self.done.push(Position {
+            grid: [grid.0, grid.1],
+            value: arr(value),
+            share: self.share,
+            samples,
+        });
     }
 
     fn ray(&mut self, t: &Traced) {
-        if !self.active {
+        if !self.wanted.contains(&t.position) {
             return;
         }
-        self.stack.push(RayNode {
+        let ray = RayNode {
             kind: t.kind,
             depth: t.depth,
             origin: self.world(t.ray.org),
@@ -211,38 +261,31 @@ impl Recorder for ExplainRecorder<'_> {
             background: None,
             contribution: [0.0; 3],
             radiance: [0.0; 3],
-        });
-    }
-
-    fn ray_end(&mut self, radiance: Vec3) {
-        let Some(mut node) = self.active.then(|| self.stack.pop()).flatten() else {
-            return;
         };
-        node.radiance = arr(radiance);
-        match self.stack.last_mut() {
-            Some(parent) => {
-                if let Some(hit) = parent.hit.as_deref_mut() {
-                    hit.children.push(node);
-                }
-            }
-            None => {
-                if let Some(p) = self.current.as_mut() {
-                    p.samples.push(node);
-                }
-            }
+        let recorded = Recorded {
+            ray,
+            parent: t.parent,
+            position: t.position,
+        };
+        self.rays.insert(t.node, recorded);
+    }
+
+    fn ray_end(&mut self, node: u32, radiance: Vec3) {
+        if let Some(ray) = self.ray_mut(node) {
+            ray.radiance = arr(radiance);
         }
     }
 
-    fn miss(&mut self, radiance: Vec3) {
+    fn miss(&mut self, node: u32, radiance: Vec3) {
         let share = self.share;
-        if let Some(top) = self.stack.last_mut().filter(|_| self.active) {
-            top.background = Some(arr(radiance));
-            top.contribution = arr(Vec3::from(top.weight) * radiance * share);
+        if let Some(ray) = self.ray_mut(node) {
+            ray.background = Some(arr(radiance));
+            ray.contribution = arr(Vec3::from(ray.weight) * radiance * share);
         }
     }
 
-    fn pass_through(&mut self, at: &Met) {
-        if !self.active {
+    fn pass_through(&mut self, node: u32, at: &Met) {
+        if !self.rays.contains_key(&node) {
             return;
         }
         let passed = Passed {
@@ -250,17 +293,17 @@ impl Recorder for ExplainRecorder<'_> {
             point: self.world(at.surf.point.p),
             entering: at.entering,
         };
-        if let Some(top) = self.stack.last_mut() {
-            top.passed.push(passed);
+        if let Some(ray) = self.ray_mut(node) {
+            ray.passed.push(passed);
         }
     }
 
-    fn hit(&mut self, at: &Met) {
-        if !self.active {
+    fn hit(&mut self, node: u32, at: &Met) {
+        if !self.rays.contains_key(&node) {
             return;
         }
         let material = &self.scene.materials[at.surf.material as usize];
-        let node = HitNode {
+        let hit = HitNode {
             t: at.hit.t,
             point: self.world(at.surf.point.p),
             prim: self.prim(at.hit),
@@ -277,24 +320,24 @@ impl Recorder for ExplainRecorder<'_> {
             not_cast: Vec::new(),
             children: Vec::new(),
         };
-        if let Some(top) = self.stack.last_mut() {
-            top.hit = Some(Box::new(node));
+        if let Some(ray) = self.ray_mut(node) {
+            ray.hit = Some(Box::new(hit));
         }
     }
 
-    fn shading(&mut self, m: &Material, ns: Vec3) {
-        let Some(index) = self.hit_mut().map(|h| h.material.index) else {
+    fn shading(&mut self, node: u32, m: &Material, ns: Vec3) {
+        let Some(index) = self.hit_mut(node).map(|h| h.material.index) else {
             return;
         };
         let material = self.material(index, m);
-        if let Some(hit) = self.hit_mut() {
+        if let Some(hit) = self.hit_mut(node) {
             hit.material = material;
             hit.normal = arr(ns);
         }
     }
 
-    fn term(&mut self, term: Term, value: Vec3) {
-        if let Some(hit) = self.hit_mut() {
+    fn term(&mut self, node: u32, term: Term, value: Vec3) {
+        if let Some(hit) = self.hit_mut(node) {
             hit.terms.push(TermNode {
                 term,
                 value: arr(value),
@@ -302,8 +345,8 @@ impl Recorder for ExplainRecorder<'_> {
         }
     }
 
-    fn area_light(&mut self, light: usize, rays: u32, visible: u32, value: Vec3) {
-        if let Some(hit) = self.hit_mut() {
+    fn area_light(&mut self, node: u32, light: usize, rays: u32, visible: u32, value: Vec3) {
+        if let Some(hit) = self.hit_mut(node) {
             hit.area_lights.push(AreaNode {
                 light,
                 rays,
@@ -313,33 +356,33 @@ impl Recorder for ExplainRecorder<'_> {
         }
     }
 
-    fn light(&mut self, term: &LightTerm) {
-        if !self.active {
+    fn light(&mut self, node: u32, term: &LightTerm) {
+        if !self.rays.contains_key(&node) {
             return;
         }
-        let node = self.light_node(term);
-        if let Some(hit) = self.hit_mut() {
-            hit.lights.push(node);
+        let light = self.light_node(term);
+        if let Some(hit) = self.hit_mut(node) {
+            hit.lights.push(light);
         }
     }
 
-    fn local(&mut self, color: Vec3) {
+    fn local(&mut self, node: u32, color: Vec3) {
         let share = self.share;
-        let Some(top) = self.stack.last_mut().filter(|_| self.active) else {
+        let Some(ray) = self.ray_mut(node) else {
             return;
         };
-        top.contribution = arr(Vec3::from(top.weight) * color * share);
-        if let Some(hit) = top.hit.as_deref_mut() {
+        ray.contribution = arr(Vec3::from(ray.weight) * color * share);
+        if let Some(hit) = ray.hit.as_deref_mut() {
             hit.local = arr(color);
         }
     }
 
-    fn boundary(&mut self, b: &Boundary) {
-        if !self.active {
+    fn boundary(&mut self, node: u32, b: &Boundary) {
+        if !self.rays.contains_key(&node) {
             return;
         }
         let beyond = self.media(&b.inside);
-        if let Some(hit) = self.hit_mut() {
+        if let Some(hit) = self.hit_mut(node) {
             hit.boundary = Some(BoundaryNode {
                 n1: b.n1,
                 n2: b.n2,
@@ -349,8 +392,8 @@ impl Recorder for ExplainRecorder<'_> {
         }
     }
 
-    fn not_cast(&mut self, kind: RayKind, why: NotCast, weight: Vec3) {
-        if let Some(hit) = self.hit_mut() {
+    fn not_cast(&mut self, node: u32, kind: RayKind, why: NotCast, weight: Vec3) {
+        if let Some(hit) = self.hit_mut(node) {
             hit.not_cast.push(NotCastNode {
                 kind,
                 why,

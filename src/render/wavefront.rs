@@ -1,0 +1,235 @@
+//! The wavefront: a batch of eye rays (a tile's samples) traced depth by depth. Each
+//! depth is a queue of path states cast together ([`Accel::intersect_coherent`] for
+//! the eye rays, [`Accel::intersect_batch`] after); each hit is shaded at once into
+//! its node of the batch's tree, the point lights' shadow rays of the whole depth are
+//! cast together as one any-hit batch, and the reflection and refraction rays go to
+//! the next depth's queue. When the queues are empty, the tree gives every ray's
+//! radiance bottom-up ([`Tree::resolve`]): the same sums, in the same order, as a
+//! recursive tracer returns, so the pixels are the same bit for bit.
+
+use super::local::LightQueue;
+use super::media::MAX_SKIPS;
+use super::path::{PathState, Tree};
+use super::record::{Met, RayKind, Recorder, Traced};
+use super::shade::{Arrival, Child};
+use super::whitted::Tracer;
+use crate::accel::{Accel, Hit};
+use crate::math::{Ray, Vec3, offset_ray_origin};
+
+/// An eye ray of a batch.
+#[derive(Clone, Copy, Debug)]
+pub(super) struct Eye {
+    /// The ray.
+    pub ray: Ray,
+    /// The index of its sample-grid position in the batch's positions.
+    pub slot: u32,
+    /// The identity of its path through the ray tree.
+    pub path: u32,
+}
+
+/// The depth of the wavefront being shaded: the batch's tree, the next depth's
+/// queue, and the point lights' shadow rays waiting to be cast.
+pub(super) struct Depth<'p> {
+    pub tree: Tree,
+    pub next: Vec<PathState>,
+    pub lights: LightQueue,
+    /// The batch's sample-grid positions, by slot.
+    positions: &'p [(u32, u32)],
+}
+
+impl Depth<'_> {
+    /// Spawn `child` at the hit of `parent` into the next depth's queue; its node.
+    #[inline]
+    pub fn spawn<R: Recorder>(&mut self, parent: &PathState, child: Child, rec: &mut R) -> u32 {
+        let node = self.tree.push();
+        let position = self.positions[parent.slot as usize];
+        rec.ray(&Traced::child(parent, &child, node, position));
+        self.next.push(PathState {
+            ray: child.ray,
+            node,
+            slot: parent.slot,
+            depth: parent.depth + 1,
+            path: child.path,
+            media: child.media,
+            weight: parent.weight * child.local_weight,
+            skips: 0,
+        });
+        node
+    }
+}
+
+impl<A: Accel> Tracer<'_, A> {
+    /// The radiance of each of `eyes` (for the sample-grid positions `positions`,
+    /// indexed by their slots), the eye rays cast as packets when `coherent`.
+    pub(super) fn trace_batch<R: Recorder>(
+        &self,
+        eyes: &[Eye],
+        positions: &[(u32, u32)],
+        coherent: bool,
+        rec: &mut R,
+    ) -> Vec<Vec3> {
+        rec.batch();
+        let mut depth = Depth {
+            tree: Tree::default(),
+            next: Vec::new(),
+            lights: LightQueue::default(),
+            positions,
+        };
+        let mut queue: Vec<PathState> = eyes.iter().map(|e| self.eye(e, &mut depth, rec)).collect();
+        let mut coherent = coherent;
+        while !queue.is_empty() {
+            self.cast_depth(queue, coherent, &mut depth, rec);
+            coherent = false;
+            self.finish_lights(&mut depth.lights, &mut depth.tree, rec);
+            queue = std::mem::take(&mut depth.next);
+        }
+        let mut values = depth.tree.resolve(rec);
+        values.truncate(eyes.len());
+        values
+    }
+
+    /// The path state of eye ray `e`, as node `tree.len()`.
+    fn eye<R: Recorder>(&self, e: &Eye, depth: &mut Depth, rec: &mut R) -> PathState {
+        let node = depth.tree.push();
+        rec.counts().eye += 1;
+        rec.ray(&Traced {
+            node,
+            parent: None,
+            position: depth.positions[e.slot as usize],
+            kind: RayKind::Eye,
+            depth: 1,
+            ray: &e.ray,
+            local_weight: Vec3::ONE,
+            weight: Vec3::ONE,
+            discarded: false,
+        });
+        PathState {
+            ray: e.ray,
+            node,
+            slot: e.slot,
+            depth: 1,
+            path: e.path,
+            media: super::media::Media::AIR,
+            weight: Vec3::ONE,
+            skips: 0,
+        }
+    }
+
+    /// Cast the rays of one depth and shade their hits; the rays that pass through a
+    /// surface that is not optically there are cast again, until none is left.
+    fn cast_depth<R: Recorder>(
+        &self,
+        mut round: Vec<PathState>,
+        coherent: bool,
+        depth: &mut Depth,
+        rec: &mut R,
+    ) {
+        let mut coherent = coherent;
+        let mut hits = Vec::new();
+        loop {
+            self.cast(&round, coherent, &mut hits, rec);
+            let mut again = Vec::new();
+            for (s, hit) in round.iter().zip(&hits) {
+                self.arrive(s, *hit, depth, &mut again, rec);
+            }
+            if again.is_empty() {
+                return;
+            }
+            round = again;
+            coherent = false;
+        }
+    }
+
+    /// The nearest hits of `round`'s rays into `hits`.
+    fn cast<R: Recorder>(
+        &self,
+        round: &[PathState],
+        coherent: bool,
+        hits: &mut Vec<Option<Hit>>,
+        rec: &mut R,
+    ) {
+        let rays: Vec<Ray> = round.iter().map(|s| s.ray).collect();
+        hits.clear();
+        hits.resize(rays.len(), None);
+        let nodes: Vec<u32> = if R::ACTIVE {
+            round.iter().map(|s| s.node).collect()
+        } else {
+            Vec::new()
+        };
+        rec.cast(true, &nodes);
+        if coherent {
+            self.accel.intersect_coherent(&rays, hits);
+        } else {
+            self.accel.intersect_batch(&rays, hits);
+        }
+        rec.cast(false, &nodes);
+    }
+
+    /// Ray `s` met `first`: the background, a surface it goes on through (queued
+    /// `again`), or a surface it is shaded at.
+    fn arrive<R: Recorder>(
+        &self,
+        s: &PathState,
+        first: Option<Hit>,
+        depth: &mut Depth,
+        again: &mut Vec<PathState>,
+        rec: &mut R,
+    ) {
+        let scene = self.scene;
+        let Some(hit) = first else {
+            let sky = scene.escape(s.ray.dir);
+            rec.miss(s.node, sky);
+            let node = depth.tree.node(s.node);
+            node.local = sky;
+            node.missed = true;
+            return;
+        };
+        let surf = scene.surface_of(&hit, &s.ray, self.accel.exact_triangle_hits());
+        let m = &scene.materials[surf.material as usize];
+        let d = s.ray.dir.normalize();
+        let entering = surf.point.ng.dot(d) < 0.0;
+        let met = Met {
+            hit: &hit,
+            surf: &surf,
+            entering,
+            media: &s.media,
+        };
+        // Surfaces of lower-priority media inside a higher-priority one are skipped
+        // (nested dielectrics): the ray goes on through them, at most MAX_SKIPS times.
+        if m.t > 0.0
+            && s.skips < MAX_SKIPS
+            && s.media.is_false_boundary(scene, surf.material, entering)
+        {
+            rec.pass_through(s.node, &met);
+            let (media, ng) = if entering {
+                (s.media.enter(surf.material), -surf.point.ng)
+            } else {
+                (s.media.leave(surf.material), surf.point.ng)
+            };
+            let ray = Ray::new(
+                offset_ray_origin(surf.point.p, surf.point.err, ng, d),
+                s.ray.dir,
+            );
+            again.push(PathState {
+                ray,
+                media,
+                skips: s.skips + 1,
+                ..*s
+            });
+            return;
+        }
+        rec.hit(s.node, &met);
+        if s.depth == 1 {
+            rec.counts().eye_hit += 1;
+        }
+        let gi = self.gi.and_then(|g| g.radiosity_at(&hit, surf.point.p, d));
+        let at = Arrival {
+            state: s,
+            surf: &surf,
+            d,
+            entering,
+            gi,
+        };
+        self.shade(&at, depth, rec);
+    }
+}
