@@ -157,10 +157,16 @@ pub struct BackendOptions {
     /// one. Analytic shapes give the same hits either way; Embree's packet triangle
     /// test may round a ray through a shared edge to the other triangle.
     pub packet_width: u32,
+    /// The shadow rays of a depth of the wavefront (ordered light by light) are cast
+    /// in packets of this many (4, 8 or 16: Embree's `rtcOccluded4/8/16`); 0 casts them
+    /// one by one. Either gives the same answers.
+    pub shadow_packet_width: u32,
 }
 
 /// Eye rays per Embree packet by default.
 pub const DEFAULT_PACKET_WIDTH: u32 = 8;
+/// Shadow rays per Embree packet by default.
+pub const DEFAULT_SHADOW_PACKET_WIDTH: u32 = 8;
 
 impl BackendOptions {
     /// `backend` with the default options: medium build quality, robust (watertight)
@@ -171,6 +177,7 @@ impl BackendOptions {
             embree_quality: EmbreeQuality::default(),
             embree_robust: true,
             packet_width: DEFAULT_PACKET_WIDTH,
+            shadow_packet_width: DEFAULT_SHADOW_PACKET_WIDTH,
         }
     }
 }

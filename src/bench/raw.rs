@@ -14,19 +14,33 @@ use std::time::Instant;
 pub struct Query {
     /// The ray as the renderer passed it.
     pub ray: Ray,
-    /// `true` for [`Accel::occluded`], `false` for [`Accel::intersect`].
+    /// `true` for [`Accel::occluded`] or [`Accel::occluded_batch`], `false` for the
+    /// nearest-hit queries.
     pub occluded: bool,
-    /// Set on the first query of a batch of `len` nearest-hit queries the renderer cast
-    /// together through [`Accel::intersect_coherent`] (the batch's other queries follow
-    /// it; the backend casts them in its own packet width); `None` for everything else.
+    /// Set on the first query of a batch of `len` queries the renderer cast together
+    /// (the batch's other queries follow it; the backend casts them its own way,
+    /// packets or one by one); `None` for a query cast alone.
     pub batch: Option<Batch>,
 }
 
-/// A batch of coherent rays (see [`Query::batch`]).
+/// A batch of rays cast together (see [`Query::batch`]).
 #[derive(Clone, Copy, Debug, PartialEq, Eq)]
 pub struct Batch {
     /// Queries in the batch, this one included.
     pub len: u32,
+    /// How the batch was cast.
+    pub kind: BatchKind,
+}
+
+/// The batch queries of [`Accel`].
+#[derive(Clone, Copy, Debug, PartialEq, Eq)]
+pub enum BatchKind {
+    /// [`Accel::intersect_coherent`]: eye rays.
+    Coherent,
+    /// [`Accel::intersect_batch`]: reflection and refraction rays.
+    Nearest,
+    /// [`Accel::occluded_batch`]: shadow rays.
+    Shadow,
 }
 
 /// A backend that records every query passed through it, per worker thread (one
@@ -53,6 +67,19 @@ impl<'a, A: Accel> Recorder<'a, A> {
         // A poisoned buffer only means another thread panicked; its data is intact.
         let mut b = self.buffers[k].lock().unwrap_or_else(|e| e.into_inner());
         b.extend(queries);
+    }
+
+    /// Record `rays` as one batch of `kind`.
+    fn push_batch(&self, rays: &[Ray], kind: BatchKind) {
+        let batch = Batch {
+            len: u32::try_from(rays.len()).unwrap_or(u32::MAX),
+            kind,
+        };
+        self.push(rays.iter().enumerate().map(|(i, ray)| Query {
+            ray: *ray,
+            occluded: kind == BatchKind::Shadow,
+            batch: (i == 0).then_some(batch),
+        }));
     }
 
     /// The recorded queries, thread by thread.
@@ -84,15 +111,18 @@ impl<A: Accel> Accel for Recorder<'_, A> {
     }
 
     fn intersect_coherent(&self, rays: &[Ray], hits: &mut [Option<Hit>]) {
-        let batch = Batch {
-            len: u32::try_from(rays.len()).unwrap_or(u32::MAX),
-        };
-        self.push(rays.iter().enumerate().map(|(i, ray)| Query {
-            ray: *ray,
-            occluded: false,
-            batch: (i == 0).then_some(batch),
-        }));
+        self.push_batch(rays, BatchKind::Coherent);
         self.inner.intersect_coherent(rays, hits);
+    }
+
+    fn intersect_batch(&self, rays: &[Ray], hits: &mut [Option<Hit>]) {
+        self.push_batch(rays, BatchKind::Nearest);
+        self.inner.intersect_batch(rays, hits);
+    }
+
+    fn occluded_batch(&self, rays: &[Ray], occluded: &mut [bool]) {
+        self.push_batch(rays, BatchKind::Shadow);
+        self.inner.occluded_batch(rays, occluded);
     }
 
     fn exact_triangle_hits(&self) -> bool {
@@ -137,19 +167,14 @@ pub fn cast<A: Accel>(accel: &A, queries: &[Query]) -> RawCast {
         .par_windows(2)
         .map(|w| {
             let chunk = &queries[w[0]..w[1]];
-            let (mut rays, mut found) = (Vec::new(), Vec::new());
+            let mut batch = BatchBuffers::default();
             let mut n = 0u64;
             let mut k = 0;
             while k < chunk.len() {
                 let q = &chunk[k];
                 if let Some(b) = q.batch {
                     let len = (b.len as usize).clamp(1, chunk.len() - k);
-                    rays.clear();
-                    rays.extend(chunk[k..k + len].iter().map(|q| q.ray));
-                    found.clear();
-                    found.resize(len, None);
-                    accel.intersect_coherent(&rays, &mut found);
-                    n += found.iter().filter(|h| h.is_some()).count() as u64;
+                    n += batch.cast(accel, b.kind, &chunk[k..k + len]);
                     k += len;
                     continue;
                 }
@@ -168,6 +193,38 @@ pub fn cast<A: Accel>(accel: &A, queries: &[Query]) -> RawCast {
         queries: queries.len() as u64,
         hits,
         ms: start.elapsed().as_secs_f64() * 1e3,
+    }
+}
+
+/// The buffers of a replayed batch.
+#[derive(Default)]
+struct BatchBuffers {
+    rays: Vec<Ray>,
+    hits: Vec<Option<Hit>>,
+    occluded: Vec<bool>,
+}
+
+impl BatchBuffers {
+    /// Cast `queries` as one batch of `kind` through `accel`; how many hit (or were
+    /// occluded).
+    fn cast<A: Accel>(&mut self, accel: &A, kind: BatchKind, queries: &[Query]) -> u64 {
+        self.rays.clear();
+        self.rays.extend(queries.iter().map(|q| q.ray));
+        let n = self.rays.len();
+        if kind == BatchKind::Shadow {
+            self.occluded.clear();
+            self.occluded.resize(n, false);
+            accel.occluded_batch(&self.rays, &mut self.occluded);
+            return self.occluded.iter().filter(|&&o| o).count() as u64;
+        }
+        self.hits.clear();
+        self.hits.resize(n, None);
+        if kind == BatchKind::Coherent {
+            accel.intersect_coherent(&self.rays, &mut self.hits);
+        } else {
+            accel.intersect_batch(&self.rays, &mut self.hits);
+        }
+        self.hits.iter().filter(|h| h.is_some()).count() as u64
     }
 }
 
@@ -204,10 +261,23 @@ mod tests {
         assert_eq!(queries.len() as u64, counts.total());
         let shadow = queries.iter().filter(|q| q.occluded).count() as u64;
         assert_eq!(shadow, counts.shadow);
-        // The eye rays went in batches, one per tile, which raw casting replays as batches.
+        // The eye rays went in one batch per tile, then the shadow rays of each depth
+        // and the reflections of each depth as batches, which raw casting replays as
+        // batches.
         let batches: Vec<Batch> = queries.iter().filter_map(|q| q.batch).collect();
-        assert_eq!(batches.len(), 1, "13x13 corner rays: one 16x16 tile");
-        assert_eq!(batches[0], Batch { len: 169 });
+        assert_eq!(
+            batches[0],
+            Batch {
+                len: 169,
+                kind: BatchKind::Coherent
+            },
+            "13x13 corner rays: one 16x16 tile"
+        );
+        let in_batches: u32 = batches.iter().map(|b| b.len).sum();
+        assert_eq!(in_batches as usize, queries.len(), "every ray in a batch");
+        let kinds = |k: BatchKind| batches.iter().filter(|b| b.kind == k).count();
+        assert_eq!(kinds(BatchKind::Coherent), 1);
+        assert!(kinds(BatchKind::Shadow) >= 2 && kinds(BatchKind::Nearest) >= 1);
         let cast = pool.install(|| cast(&accel, &queries));
         assert_eq!(cast.queries, counts.total());
         // Eye rays that hit, reflection rays that hit and occluded shadow rays, found again

@@ -308,6 +308,12 @@ pub struct RenderOptions {
     #[cfg_attr(feature = "cli", arg(long, value_name = "N", help_heading = "Backend"))]
     #[serde(skip_serializing_if = "Option::is_none")]
     pub packet_width: Option<u32>,
+    /// Cast the shadow rays of each depth of a tile together, light by light, as
+    /// Embree packets of this many rays (4, 8 or 16: `rtcOccluded4/8/16`); 0 casts them
+    /// one by one [default: 8]. The answers are the same either way.
+    #[cfg_attr(feature = "cli", arg(long, value_name = "N", help_heading = "Backend"))]
+    #[serde(skip_serializing_if = "Option::is_none")]
+    pub shadow_packet_width: Option<u32>,
 }
 
 impl RadiosityOptions {
@@ -423,6 +429,7 @@ mod tests {
             embree_quality: Some(EmbreeQuality::High),
             embree_fast: Some(true),
             packet_width: Some(16),
+            shadow_packet_width: Some(4),
         };
         assert_eq!(all.over(&RenderOptions::default()), all);
         let text = toml::to_string(&all).unwrap();

@@ -22,8 +22,16 @@ pub(super) struct LightQueue {
     hits: Vec<Lit>,
     queries: Vec<Query>,
     rays: Vec<Ray>,
+    /// The light of each shadow ray.
+    ray_light: Vec<u32>,
     /// The node of each shadow ray (for the recorder's [`Recorder::cast`]).
     ray_nodes: Vec<u32>,
+    /// The answers, by ray.
+    occluded: Vec<bool>,
+    /// The rays light by light (`rays[by_light[k]]` is cast `k`-th), and their answers.
+    by_light: Vec<u32>,
+    sorted: Vec<Ray>,
+    sorted_occluded: Vec<bool>,
 }
 
 /// A shaded hit waiting for its point lights.
@@ -98,6 +106,7 @@ impl<A: Accel> Tracer<'_, A> {
                 ray.tmax = next_float_down(1.0);
                 shadow = queue.rays.len() as u32;
                 queue.rays.push(ray);
+                queue.ray_light.push(index as u32);
                 if R::ACTIVE {
                     queue.ray_nodes.push(at.node);
                 }
@@ -132,15 +141,14 @@ impl<A: Accel> Tracer<'_, A> {
         tree: &mut Tree,
         rec: &mut R,
     ) {
-        let mut occluded = vec![false; queue.rays.len()];
         rec.cast(true, &queue.ray_nodes);
-        self.accel.occluded_batch(&queue.rays, &mut occluded);
+        self.cast_shadows(queue);
         rec.cast(false, &queue.ray_nodes);
         for hit in &queue.hits {
             let node = tree.node(hit.node);
             let mut color = node.local;
             for q in &queue.queries[hit.first as usize..hit.end as usize] {
-                color += phong(hit, q, &queue.rays, &occluded, rec);
+                color += phong(hit, q, &queue.rays, &queue.occluded, rec);
             }
             node.local = color;
             rec.local(hit.node, color);
@@ -148,7 +156,48 @@ impl<A: Accel> Tracer<'_, A> {
         queue.hits.clear();
         queue.queries.clear();
         queue.rays.clear();
+        queue.ray_light.clear();
         queue.ray_nodes.clear();
+    }
+
+    /// Answer the queued shadow rays into `queue.occluded`: cast light by light (the
+    /// rays to one light from neighbouring hits are coherent: packets of them share
+    /// most of their way), as one batch.
+    fn cast_shadows(&self, queue: &mut LightQueue) {
+        let n = queue.rays.len();
+        queue.occluded.clear();
+        queue.occluded.resize(n, false);
+        let lights = self.scene.lights.len();
+        if lights <= 1 {
+            self.accel.occluded_batch(&queue.rays, &mut queue.occluded);
+            return;
+        }
+        // A counting sort of the rays by light, stable.
+        let mut start = vec![0u32; lights + 1];
+        for &l in &queue.ray_light {
+            start[l as usize + 1] += 1;
+        }
+        for l in 0..lights {
+            start[l + 1] += start[l];
+        }
+        queue.by_light.clear();
+        queue.by_light.resize(n, 0);
+        for (i, &l) in queue.ray_light.iter().enumerate() {
+            let at = &mut start[l as usize];
+            queue.by_light[*at as usize] = i as u32;
+            *at += 1;
+        }
+        queue.sorted.clear();
+        queue
+            .sorted
+            .extend(queue.by_light.iter().map(|&i| queue.rays[i as usize]));
+        queue.sorted_occluded.clear();
+        queue.sorted_occluded.resize(n, false);
+        self.accel
+            .occluded_batch(&queue.sorted, &mut queue.sorted_occluded);
+        for (&i, &o) in queue.by_light.iter().zip(&queue.sorted_occluded) {
+            queue.occluded[i as usize] = o;
+        }
     }
 
     /// Ambient, emission (front side) and the area lights' diffuse light at `at`

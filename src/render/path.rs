@@ -82,10 +82,11 @@ impl Tree {
         &mut self.nodes[k as usize]
     }
 
-    /// The radiance of every node, children first (each told to `rec` as it is
-    /// known).
-    pub fn resolve<R: Recorder>(&self, rec: &mut R) -> Vec<Vec3> {
-        let mut value = vec![Vec3::ZERO; self.nodes.len()];
+    /// The radiance of every node into `value` (`value[k]` for node `k`), children
+    /// first, each told to `rec` as it is known.
+    pub fn resolve<R: Recorder>(&self, rec: &mut R, value: &mut Vec<Vec3>) {
+        value.clear();
+        value.resize(self.nodes.len(), Vec3::ZERO);
         for (k, node) in self.nodes.iter().enumerate().rev() {
             let v = if node.missed {
                 node.local
@@ -102,7 +103,6 @@ impl Tree {
             value[k] = v;
             rec.ray_end(k as u32, v);
         }
-        value
     }
 }
 
@@ -166,7 +166,8 @@ mod tests {
             ..Node::NEW
         };
         let mut counts = RayCounts::default();
-        let v = t.resolve(&mut counts);
+        let mut v = Vec::new();
+        t.resolve(&mut counts, &mut v);
         let refracted = l1 + 0.6 * sky;
         let expected = l0 + wt * refracted + 0.3 * l2;
         assert_eq!(v[3], sky);
@@ -188,7 +189,8 @@ mod tests {
         };
         t.node(1).local = Vec3::new(f32::MAX, 0.0, 0.0);
         let mut counts = RayCounts::default();
-        let v = t.resolve(&mut counts);
+        let mut v = Vec::new();
+        t.resolve(&mut counts, &mut v);
         assert_eq!(v[0], Vec3::new(f32::MAX, 0.0, 1.0));
         assert_eq!(counts.saturated, 1);
     }

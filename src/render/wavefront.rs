@@ -9,12 +9,13 @@
 
 use super::local::LightQueue;
 use super::media::MAX_SKIPS;
-use super::path::{PathState, Tree};
+use super::path::{Node, PathState, Tree};
 use super::record::{Met, RayKind, Recorder, Traced};
 use super::shade::{Arrival, Child};
 use super::whitted::Tracer;
 use crate::accel::{Accel, Hit};
 use crate::math::{Ray, Vec3, offset_ray_origin};
+use std::cell::Cell;
 
 /// An eye ray of a batch.
 #[derive(Clone, Copy, Debug)]
@@ -58,34 +59,64 @@ impl Depth<'_> {
     }
 }
 
+/// The buffers of a batch, kept by each thread from one batch to the next so that a
+/// tile allocates nothing once the first has grown them.
+#[derive(Debug, Default)]
+struct Buffers {
+    tree: Vec<Node>,
+    queue: Vec<PathState>,
+    next: Vec<PathState>,
+    again: Vec<PathState>,
+    rays: Vec<Ray>,
+    hits: Vec<Option<Hit>>,
+    lights: LightQueue,
+}
+
+thread_local! {
+    static BUFFERS: Cell<Buffers> = Cell::new(Buffers::default());
+}
+
 impl<A: Accel> Tracer<'_, A> {
-    /// The radiance of each of `eyes` (for the sample-grid positions `positions`,
-    /// indexed by their slots), the eye rays cast as packets when `coherent`.
+    /// The radiance of each of `eyes` into `values` (for the sample-grid positions
+    /// `positions`, indexed by their slots), the eye rays cast as packets when
+    /// `coherent`.
     pub(super) fn trace_batch<R: Recorder>(
         &self,
         eyes: &[Eye],
         positions: &[(u32, u32)],
         coherent: bool,
         rec: &mut R,
-    ) -> Vec<Vec3> {
+        values: &mut Vec<Vec3>,
+    ) {
         rec.batch();
+        // Taken, not borrowed: a batch started inside this one would get its own.
+        let mut b = BUFFERS.with(Cell::take);
+        b.tree.clear();
         let mut depth = Depth {
-            tree: Tree::default(),
-            next: Vec::new(),
-            lights: LightQueue::default(),
+            tree: Tree {
+                nodes: std::mem::take(&mut b.tree),
+            },
+            next: std::mem::take(&mut b.next),
+            lights: std::mem::take(&mut b.lights),
             positions,
         };
-        let mut queue: Vec<PathState> = eyes.iter().map(|e| self.eye(e, &mut depth, rec)).collect();
+        let mut queue = std::mem::take(&mut b.queue);
+        queue.clear();
+        queue.extend(eyes.iter().map(|e| self.eye(e, &mut depth, rec)));
         let mut coherent = coherent;
         while !queue.is_empty() {
-            self.cast_depth(queue, coherent, &mut depth, rec);
+            self.cast_depth(&mut queue, coherent, &mut depth, &mut b, rec);
             coherent = false;
             self.finish_lights(&mut depth.lights, &mut depth.tree, rec);
-            queue = std::mem::take(&mut depth.next);
+            std::mem::swap(&mut queue, &mut depth.next);
         }
-        let mut values = depth.tree.resolve(rec);
+        depth.tree.resolve(rec, values);
         values.truncate(eyes.len());
-        values
+        b.tree = depth.tree.nodes;
+        b.next = depth.next;
+        b.lights = depth.lights;
+        b.queue = queue;
+        BUFFERS.with(|cell| cell.set(b));
     }
 
     /// The path state of eye ray `e`, as node `tree.len()`.
@@ -115,42 +146,35 @@ impl<A: Accel> Tracer<'_, A> {
         }
     }
 
-    /// Cast the rays of one depth and shade their hits; the rays that pass through a
-    /// surface that is not optically there are cast again, until none is left.
+    /// Cast the rays of one depth (`round`, emptied) and shade their hits; the rays
+    /// that pass through a surface that is not optically there are cast again, until
+    /// none is left.
     fn cast_depth<R: Recorder>(
         &self,
-        mut round: Vec<PathState>,
+        round: &mut Vec<PathState>,
         coherent: bool,
         depth: &mut Depth,
+        b: &mut Buffers,
         rec: &mut R,
     ) {
         let mut coherent = coherent;
-        let mut hits = Vec::new();
-        loop {
-            self.cast(&round, coherent, &mut hits, rec);
-            let mut again = Vec::new();
-            for (s, hit) in round.iter().zip(&hits) {
-                self.arrive(s, *hit, depth, &mut again, rec);
+        while !round.is_empty() {
+            self.cast(round, coherent, b, rec);
+            b.again.clear();
+            for (s, hit) in round.iter().zip(&b.hits) {
+                self.arrive(s, *hit, depth, &mut b.again, rec);
             }
-            if again.is_empty() {
-                return;
-            }
-            round = again;
+            std::mem::swap(round, &mut b.again);
             coherent = false;
         }
     }
 
-    /// The nearest hits of `round`'s rays into `hits`.
-    fn cast<R: Recorder>(
-        &self,
-        round: &[PathState],
-        coherent: bool,
-        hits: &mut Vec<Option<Hit>>,
-        rec: &mut R,
-    ) {
-        let rays: Vec<Ray> = round.iter().map(|s| s.ray).collect();
-        hits.clear();
-        hits.resize(rays.len(), None);
+    /// The nearest hits of `round`'s rays into `b.hits`.
+    fn cast<R: Recorder>(&self, round: &[PathState], coherent: bool, b: &mut Buffers, rec: &mut R) {
+        b.rays.clear();
+        b.rays.extend(round.iter().map(|s| s.ray));
+        b.hits.clear();
+        b.hits.resize(round.len(), None);
         let nodes: Vec<u32> = if R::ACTIVE {
             round.iter().map(|s| s.node).collect()
         } else {
@@ -158,9 +182,9 @@ impl<A: Accel> Tracer<'_, A> {
         };
         rec.cast(true, &nodes);
         if coherent {
-            self.accel.intersect_coherent(&rays, hits);
+            self.accel.intersect_coherent(&b.rays, &mut b.hits);
         } else {
-            self.accel.intersect_batch(&rays, hits);
+            self.accel.intersect_batch(&b.rays, &mut b.hits);
         }
         rec.cast(false, &nodes);
     }

@@ -148,27 +148,33 @@ impl<'a, A: Accel> Tracer<'a, A> {
                     .map(move |(x, y)| eye(raygen, x, y, slot(i, j)))
             })
             .collect();
-        let values = self.trace_batch(&eyes, &positions, self.spp == 1, rec);
-        // The eyes of each position, in sample order, for the sums.
-        let mut of_slot = vec![Vec::new(); positions.len()];
-        for (k, e) in eyes.iter().enumerate() {
-            of_slot[e.slot as usize].push(k);
+        let mut values = Vec::new();
+        self.trace_batch(&eyes, &positions, self.spp == 1, rec, &mut values);
+        // The eyes of each position: `spp` in a row in sample order, or with one
+        // sample the eye of each slot.
+        let mut eye_of = vec![0; positions.len()];
+        if self.spp == 1 {
+            for (k, e) in eyes.iter().enumerate() {
+                eye_of[e.slot as usize] = k;
+            }
         }
-        for (&(i, j), eyes) in positions.iter().zip(&of_slot) {
+        let n = self.spp as usize;
+        for (slot, &(i, j)) in positions.iter().enumerate() {
             rec.position(i, j);
-            let v = self.mean(eyes.iter().map(|&k| values[k]));
+            let v = if n == 1 {
+                values[eye_of[slot]]
+            } else {
+                self.mean(&values[slot * n..(slot + 1) * n])
+            };
             rec.position_end(v);
             out(v);
         }
     }
 
-    /// The value of a position from its samples' values.
-    fn mean(&self, mut values: impl Iterator<Item = Vec3>) -> Vec3 {
-        if self.spp == 1 {
-            return values.next().unwrap_or(Vec3::ZERO);
-        }
+    /// The value of a position from its `spp` samples' values.
+    fn mean(&self, values: &[Vec3]) -> Vec3 {
         let mut sum = Vec3::ZERO;
-        for v in values {
+        for &v in values {
             sum += v;
         }
         sum / self.spp as f32
@@ -184,7 +190,9 @@ impl<'a, A: Accel> Tracer<'a, A> {
     ) -> Vec3 {
         let position = [(px as u32, py as u32)];
         let eyes = [eye(raygen, px, py, 0)];
-        self.trace_batch(&eyes, &position, false, rec)[0]
+        let mut value = Vec::with_capacity(1);
+        self.trace_batch(&eyes, &position, false, rec, &mut value);
+        value[0]
     }
 
     /// Whether a secondary ray of accumulated `weight` is worth casting.

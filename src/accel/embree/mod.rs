@@ -49,6 +49,8 @@ pub struct EmbreeAccel {
     detail: String,
     /// Rays per packet for [`Accel::intersect_coherent`] (0: one by one).
     packet_width: u32,
+    /// Rays per packet for [`Accel::occluded_batch`] (0: one by one).
+    shadow_packet_width: u32,
 }
 
 /// The process's Embree device for `threads` build threads, created at the first
@@ -101,6 +103,7 @@ impl EmbreeAccel {
             prims: scene.prim_count_with_instances(),
             detail,
             packet_width: options.packet_width,
+            shadow_packet_width: options.shadow_packet_width,
         })
     }
 
@@ -108,6 +111,13 @@ impl EmbreeAccel {
     /// or 16; anything else casts them one by one).
     pub fn with_packet_width(mut self, width: u32) -> Self {
         self.packet_width = width;
+        self
+    }
+
+    /// Cast shadow-ray batches ([`Accel::occluded_batch`]) in packets of `width` (4, 8
+    /// or 16; anything else casts them one by one).
+    pub fn with_shadow_packet_width(mut self, width: u32) -> Self {
+        self.shadow_packet_width = width;
         self
     }
 
@@ -137,6 +147,11 @@ impl Accel for EmbreeAccel {
     fn intersect_coherent(&self, rays: &[Ray], hits: &mut [Option<Hit>]) {
         self.scene
             .intersect_packets(rays, hits, self.packet_width as usize);
+    }
+
+    fn occluded_batch(&self, rays: &[Ray], occluded: &mut [bool]) {
+        self.scene
+            .occluded_packets(rays, occluded, self.shadow_packet_width as usize);
     }
 
     fn stats(&self) -> AccelStats {

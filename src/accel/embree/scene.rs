@@ -369,6 +369,26 @@ impl CommittedScene {
             cast(self.top.raw, r, h);
         }
     }
+
+    /// Whether each of `rays` is occluded (`occluded[i]` for `rays[i]`), cast as
+    /// packets of `width` (4, 8 or 16) rays flagged coherent; any other width, or a
+    /// scene with unbounded primitives, casts single rays.
+    pub(super) fn occluded_packets(&self, rays: &[Ray], occluded: &mut [bool], width: usize) {
+        let cast: fn(sys::RTCScene, &[Ray], &mut [bool]) = match width {
+            4 if self.unbounded.is_empty() => shadow4,
+            8 if self.unbounded.is_empty() => shadow8,
+            16 if self.unbounded.is_empty() => shadow16,
+            _ => {
+                for (ray, o) in rays.iter().zip(occluded.iter_mut()) {
+                    *o = self.occluded(ray);
+                }
+                return;
+            }
+        };
+        for (r, o) in rays.chunks(width).zip(occluded.chunks_mut(width)) {
+            cast(self.top.raw, r, o);
+        }
+    }
 }
 
 /// The `tnear` Embree is given for `ray`, `max(tmin, 0)` (Embree requires `tnear >= 0`),
@@ -435,6 +455,37 @@ macro_rules! packet_query {
 packet_query!(packet4, 4, RTCRayHit4, intersect4);
 packet_query!(packet8, 8, RTCRayHit8, intersect8);
 packet_query!(packet16, 16, RTCRayHit16, intersect16);
+
+/// `shadowN(scene, rays, occluded)`: up to N rays through one `rtcOccludedN` call, with
+/// the same conventions as the single-ray query (see [`embree_tnear`]; a ray it refuses
+/// is left out of the packet and is not occluded).
+macro_rules! shadow_query {
+    ($name:ident, $n:literal, $ty:ident, $query:ident) => {
+        fn $name(scene: sys::RTCScene, rays: &[Ray], occluded: &mut [bool]) {
+            let mut r = sys::$ty::default();
+            let mut valid = [0i32; $n];
+            for (i, ray) in rays.iter().enumerate().take($n) {
+                let Some(tnear) = embree_tnear(ray) else {
+                    continue;
+                };
+                valid[i] = -1;
+                (r.org_x[i], r.org_y[i], r.org_z[i]) = (ray.org.x, ray.org.y, ray.org.z);
+                (r.dir_x[i], r.dir_y[i], r.dir_z[i]) = (ray.dir.x, ray.dir.y, ray.dir.z);
+                (r.tnear[i], r.tfar[i], r.time[i]) = (tnear, ray.tmax, 0.0);
+                (r.mask[i], r.id[i], r.flags[i]) = (u32::MAX, 0, 0);
+            }
+            query::$query(&valid, scene, &mut r);
+            rethrow_caught();
+            for (i, out) in occluded.iter_mut().enumerate().take($n) {
+                *out = valid[i] != 0 && r.tfar[i] == f32::NEG_INFINITY;
+            }
+        }
+    };
+}
+
+shadow_query!(shadow4, 4, RTCRay4, occluded4);
+shadow_query!(shadow8, 8, RTCRay8, occluded8);
+shadow_query!(shadow16, 16, RTCRay16, occluded16);
 
 // `rtcIntersect1` requires a 16-byte aligned `RTCRayHit`; bindgen carries the header's
 // `RTC_ALIGN(16)` over, so every `RTCRayHit` value on the stack is aligned.
@@ -528,6 +579,25 @@ mod query {
     packet!(intersect4, 4, RTCRayHit4, rtcIntersect4);
     packet!(intersect8, 8, RTCRayHit8, rtcIntersect8);
     packet!(intersect16, 16, RTCRayHit16, rtcIntersect16);
+
+    /// `occludedN(valid, scene, packet)`: `rtcOccludedN` with a coherent context.
+    macro_rules! shadow_packet {
+        ($name:ident, $n:literal, $ty:ident, $f:ident) => {
+            #[inline(always)]
+            pub(super) fn $name(valid: &[i32; $n], scene: sys::RTCScene, ray: &mut sys::$ty) {
+                let mut ctx = context();
+                ctx.flags = sys::RTCIntersectContextFlags::RTC_INTERSECT_CONTEXT_FLAG_COHERENT;
+                // SAFETY: `scene` is live and committed; `ctx` is initialised as in
+                // `intersect`; `valid` has N entries; `ray` is an aligned packet (its
+                // type carries the header's alignment) whose active rays have mask and
+                // tnear <= tfar set.
+                unsafe { sys::$f(valid.as_ptr(), scene, &mut ctx, ray) }
+            }
+        };
+    }
+    shadow_packet!(occluded4, 4, RTCRay4, rtcOccluded4);
+    shadow_packet!(occluded8, 8, RTCRay8, rtcOccluded8);
+    shadow_packet!(occluded16, 16, RTCRay16, rtcOccluded16);
 }
 
 /// `rtcIntersect1`/`rtcOccluded1`, whose arguments differ between Embree 3 and 4.
@@ -612,6 +682,30 @@ mod query {
     packet!(intersect4, 4, RTCRayHit4, rtcIntersect4);
     packet!(intersect8, 8, RTCRayHit8, rtcIntersect8);
     packet!(intersect16, 16, RTCRayHit16, rtcIntersect16);
+
+    /// `occludedN(valid, scene, packet)`: `rtcOccludedN` flagged coherent.
+    macro_rules! shadow_packet {
+        ($name:ident, $n:literal, $ty:ident, $f:ident) => {
+            #[inline(always)]
+            pub(super) fn $name(valid: &[i32; $n], scene: sys::RTCScene, ray: &mut sys::$ty) {
+                let mut ctx = context();
+                let mut args = sys::RTCOccludedArguments {
+                    flags: sys::RTCRayQueryFlags::RTC_RAY_QUERY_FLAG_COHERENT,
+                    feature_mask: sys::RTCFeatureFlags::RTC_FEATURE_FLAG_ALL,
+                    context: &mut ctx,
+                    filter: None,
+                    occluded: None,
+                    ..Default::default()
+                };
+                // SAFETY: as in `occluded`; `valid` has N entries; `ray` is an aligned
+                // packet whose active rays have mask and tnear <= tfar set.
+                unsafe { sys::$f(valid.as_ptr(), scene, ray, &mut args) }
+            }
+        };
+    }
+    shadow_packet!(occluded4, 4, RTCRay4, rtcOccluded4);
+    shadow_packet!(occluded8, 8, RTCRay8, rtcOccluded8);
+    shadow_packet!(occluded16, 16, RTCRay16, rtcOccluded16);
 }
 
 /// One native triangle mesh holding all triangles, three vertices each, so that

@@ -609,6 +609,37 @@ fn packets_find_what_single_rays_find() {
     }
 }
 
+/// Shadow rays in packets of 4, 8 and 16 are answered as one by one, with and without
+/// an unbounded primitive (then cast one by one), rays with empty or NaN intervals
+/// included.
+#[test]
+fn shadow_packets_answer_as_single_rays() {
+    let mut with_plane = triangles_spheres_cones();
+    let plane = crate::geometry::Plane::new(Vec3::new(0.0, 0.0, -1.0), -7.0).expect("plane");
+    with_plane
+        .geometry
+        .add_shape(crate::geometry::Shape::Plane(plane), 0);
+    let mut rays = packet_rays();
+    // Shorter rays too, so that some are occluded and some are not.
+    for r in rays.iter_mut().step_by(3) {
+        r.tmax = r.tmax.min(5.2);
+    }
+    for s in [triangles_spheres_cones(), with_plane] {
+        let single: Vec<bool> = {
+            let accel = build(&s);
+            rays.iter().map(|r| accel.occluded(r)).collect()
+        };
+        let occluded = single.iter().filter(|&&o| o).count();
+        assert!(occluded > 50 && occluded + 20 < rays.len(), "{occluded}");
+        for width in [0, 4, 8, 16] {
+            let accel = build(&s).with_shadow_packet_width(width);
+            let mut answers = vec![false; rays.len()];
+            accel.occluded_batch(&rays, &mut answers);
+            assert_eq!(answers, single, "width {width}");
+        }
+    }
+}
+
 /// With an unbounded primitive (tested outside Embree) the batch falls back to single
 /// rays and still finds the plane and everything in front of it.
 #[test]
