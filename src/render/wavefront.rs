@@ -1,11 +1,11 @@
 //! The wavefront: a batch of eye rays (a tile's samples) traced depth by depth. Each
 //! depth is a queue of path states cast together ([`Accel::intersect_coherent`] for
-//! the eye rays, [`Accel::intersect_batch`] after); each hit is shaded at once into
-//! its node of the batch's tree, the point lights' shadow rays of the whole depth are
-//! cast together as one any-hit batch, and the reflection and refraction rays go to
-//! the next depth's queue. When the queues are empty, the tree gives every ray's
-//! radiance bottom-up ([`Tree::resolve`]): the same sums, in the same order, as a
-//! recursive tracer returns, so the pixels are the same bit for bit.
+//! the eye rays, [`Accel::intersect_batch`] after); the hits are shaded kind by kind,
+//! each at once into its node of the batch's tree; the point lights' shadow rays of the
+//! whole depth are cast together as one any-hit batch, and the reflection and
+//! refraction rays go to the next depth's queue. When the queues are empty, the tree
+//! gives every ray's radiance bottom-up ([`Tree::resolve`]): the same sums, in the same
+//! order, as a recursive tracer returns, so the pixels are the same bit for bit.
 
 use super::local::LightQueue;
 use super::media::MAX_SKIPS;
@@ -14,6 +14,7 @@ use super::record::{Met, RayKind, Recorder, Traced};
 use super::shade::{Arrival, Child};
 use super::whitted::Tracer;
 use crate::accel::{Accel, Hit};
+use crate::geometry::Kind;
 use crate::math::{Ray, Vec3, offset_ray_origin};
 use std::cell::Cell;
 
@@ -69,11 +70,36 @@ struct Buffers {
     again: Vec<PathState>,
     rays: Vec<Ray>,
     hits: Vec<Option<Hit>>,
+    /// The order the hits are shaded in.
+    order: Vec<u32>,
     lights: LightQueue,
 }
 
 thread_local! {
     static BUFFERS: Cell<Buffers> = Cell::new(Buffers::default());
+}
+
+/// The indices of `hits` grouped by what was hit (the misses first, then kind by
+/// kind in [`Kind`] order, each group in cast order) into `order`, so that each
+/// kind's surface and shading code runs over a run of hits. The order in which hits
+/// are shaded changes no value: each writes its own node.
+fn by_kind(hits: &[Option<Hit>], order: &mut Vec<u32>) {
+    const GROUPS: usize = Kind::ALL.len() + 1;
+    let group = |h: &Option<Hit>| h.map_or(0, |h| (h.geom_id as usize + 1).min(GROUPS - 1));
+    let mut start = [0u32; GROUPS + 1];
+    for h in hits {
+        start[group(h) + 1] += 1;
+    }
+    for g in 0..GROUPS {
+        start[g + 1] += start[g];
+    }
+    order.clear();
+    order.resize(hits.len(), 0);
+    for (i, h) in hits.iter().enumerate() {
+        let at = &mut start[group(h)];
+        order[*at as usize] = i as u32;
+        *at += 1;
+    }
 }
 
 impl<A: Accel> Tracer<'_, A> {
@@ -161,8 +187,10 @@ impl<A: Accel> Tracer<'_, A> {
         while !round.is_empty() {
             self.cast(round, coherent, b, rec);
             b.again.clear();
-            for (s, hit) in round.iter().zip(&b.hits) {
-                self.arrive(s, *hit, depth, &mut b.again, rec);
+            by_kind(&b.hits, &mut b.order);
+            for &i in &b.order {
+                let i = i as usize;
+                self.arrive(&round[i], b.hits[i], depth, &mut b.again, rec);
             }
             std::mem::swap(round, &mut b.again);
             coherent = false;
@@ -255,5 +283,33 @@ impl<A: Accel> Tracer<'_, A> {
             gi,
         };
         self.shade(&at, depth, rec);
+    }
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+
+    fn hit(kind: Kind) -> Option<Hit> {
+        Some(Hit {
+            t: 1.0,
+            geom_id: kind as u32,
+            prim_id: 0,
+            u: 0.0,
+            v: 0.0,
+            ng: Vec3::Z,
+            inst_id: crate::accel::NO_INSTANCE,
+        })
+    }
+
+    #[test]
+    fn hits_are_shaded_misses_first_then_kind_by_kind_in_cast_order() {
+        let (s, t) = (hit(Kind::Sphere), hit(Kind::Triangle));
+        let hits = [s, None, t, s, t, None, s];
+        let mut order = Vec::new();
+        by_kind(&hits, &mut order);
+        assert_eq!(order, [1, 5, 2, 4, 0, 3, 6]);
+        by_kind(&[], &mut order);
+        assert!(order.is_empty());
     }
 }
