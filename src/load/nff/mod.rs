@@ -29,7 +29,7 @@ mod parser;
 mod part;
 mod split;
 
-use super::{LoadError, text};
+use super::{LoadError, LoadProgress, text};
 use crate::math::DVec3;
 use crate::scene::Scene;
 use lexer::Lexer;
@@ -61,7 +61,18 @@ pub const MAX_PIXELS: u64 = 1 << 28;
 /// UTF-8 byte-order mark is skipped, and bytes that are not UTF-8 (in comments, say)
 /// are replaced, which leaves line and column numbers intact (see `super::text`).
 pub fn load(path: &Path) -> Result<Scene, LoadError> {
-    let scene = parse_str(&text::read_lossy(path)?, path)?;
+    load_with(path, &LoadProgress::silent())
+}
+
+/// [`load`], telling `progress` how many of the file's bytes are parsed.
+///
+/// # Errors
+/// As [`load`].
+pub fn load_with(path: &Path, progress: &LoadProgress<'_>) -> Result<Scene, LoadError> {
+    let src = text::read_lossy(path)?;
+    progress.expect(src.len() as u64);
+    let origin = eye_of(&src).unwrap_or(DVec3::ZERO);
+    let scene = parse_in_stretches(&src, path, origin, STRETCH, progress)?;
     super::warn_if_empty(&scene, path);
     Ok(scene)
 }
@@ -82,7 +93,7 @@ pub fn parse_str(src: &str, path: &Path) -> Result<Scene, LoadError> {
 /// # Errors
 /// As [`parse_str`].
 pub fn parse_str_at(src: &str, path: &Path, origin: DVec3) -> Result<Scene, LoadError> {
-    parse_in_stretches(src, path, origin, STRETCH)
+    parse_in_stretches(src, path, origin, STRETCH, &LoadProgress::silent())
 }
 
 /// [`parse_str`], with the text cut into stretches of about `stretch` bytes that are
@@ -92,7 +103,8 @@ pub fn parse_str_at(src: &str, path: &Path, origin: DVec3) -> Result<Scene, Load
 /// # Errors
 /// As [`parse_str`].
 pub fn parse_str_in_stretches(src: &str, path: &Path, stretch: usize) -> Result<Scene, LoadError> {
-    parse_in_stretches(src, path, eye_of(src).unwrap_or(DVec3::ZERO), stretch)
+    let origin = eye_of(src).unwrap_or(DVec3::ZERO);
+    parse_in_stretches(src, path, origin, stretch, &LoadProgress::silent())
 }
 
 /// Cut `src` into stretches ([`split::cut`]), parse them a batch at a time in
@@ -100,12 +112,13 @@ pub fn parse_str_in_stretches(src: &str, path: &Path, stretch: usize) -> Result<
 /// before stopped (the cut fell inside an entity) is read again from there, with the
 /// rest of the file, as one stretch; the first error in file order is the one that
 /// sequential reading reports, since every stretch before it was read from an entity's
-/// start.
+/// start. Each stretch parsed advances `progress` by its bytes.
 fn parse_in_stretches(
     src: &str,
     path: &Path,
     origin: DVec3,
     stretch: usize,
+    progress: &LoadProgress<'_>,
 ) -> Result<Scene, LoadError> {
     let source = Source { src, path, origin };
     let file: Arc<str> = Arc::from(path.display().to_string());
@@ -121,7 +134,9 @@ fn parse_in_stretches(
             .enumerate()
             .map(|(i, &from)| {
                 let end = ends.get(k0 + i).copied().unwrap_or(usize::MAX);
-                parser::parse(source, file.clone(), from, end)
+                let parsed = parser::parse(source, file.clone(), from, end);
+                progress.advance((end.min(src.len()) - from.pos) as u64);
+                parsed
             })
             .collect();
         for (i, parsed) in parsed.into_iter().enumerate() {
