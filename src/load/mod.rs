@@ -3,6 +3,7 @@
 pub mod nff;
 pub mod obj;
 pub mod progress;
+mod read;
 pub(crate) mod text;
 pub mod toml;
 
