@@ -8,8 +8,9 @@
 //!
 //! A large file is cut into stretches at lines that start an entity (`split`), the
 //! stretches are parsed in parallel (`parser`, into a `part::Part` each), and the parts
-//! are joined in file order (`merge`): the scene, the warnings and the first error are
-//! those of reading the file from start to end, whatever the cut.
+//! are joined in file order (`merge`), each batch while the next is parsed
+//! (`stretches`): the scene, the warnings and the first error are those of reading the
+//! file from start to end, whatever the cut.
 //!
 //! Entities: `v` (viewpoint: `from`, `at`, `up`, `angle`, `hither`, `resolution` in
 //! that order), `b` (background), `l x y z [r g b]` (point light), `f` (material),
