@@ -537,5 +537,35 @@ fn the_progress_bar_names_the_phases_on_a_terminal() {
     assert!(o.status.success(), "{}", stderr(&o));
     let screen = String::from_utf8_lossy(&o.stdout);
     assert!(screen.contains("a.nff: loading …"), "{screen:?}");
+    assert!(screen.contains("a.nff: loading 100% …"), "{screen:?}");
     assert!(dir.path().join("out.png").exists());
+}
+
+/// A load shows how far it has come: a generated database of 66 000 spheres tells its
+/// first share when 16 384 are made, long before the end.
+#[test]
+fn the_progress_bar_shows_the_share_loaded() {
+    let dir = tempfile::tempdir().unwrap();
+    let command = format!(
+        "'{}' render 'spd:balls?size=5' -o out.png --res 8x8",
+        env!("CARGO_BIN_EXE_emray")
+    );
+    let run = Command::new("script")
+        .args(["-qec", &command, "/dev/null"])
+        .current_dir(dir.path())
+        .output();
+    let Ok(o) = run else {
+        eprintln!("skipped: no `script` to give the render a terminal");
+        return;
+    };
+    assert!(o.status.success(), "{}", stderr(&o));
+    let screen = String::from_utf8_lossy(&o.stdout);
+    let shares: Vec<u32> = screen
+        .split("spd:balls?size=5: loading ")
+        .skip(1)
+        .filter_map(|s| s.split('%').next()?.parse().ok())
+        .collect();
+    assert!(shares.iter().any(|&p| p < 100), "{screen:?}");
+    assert!(shares.windows(2).all(|w| w[0] <= w[1]), "{shares:?}");
+    assert_eq!(shares.last(), Some(&100), "{screen:?}");
 }

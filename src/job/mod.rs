@@ -32,7 +32,7 @@ pub use pipeline::{
 };
 pub use report::{Report, Timings};
 pub use resolve::{Heatmap, OptionsError, Resolved};
-pub use source::{SceneError, SceneSource, load_scene};
+pub use source::{SceneError, SceneSource, load_scene, load_scene_with};
 pub use values::{AovList, Band, ByteSize, Crop, Res};
 pub use work::Product;
 

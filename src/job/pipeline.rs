@@ -18,6 +18,7 @@ use super::source::{SceneError, SceneSource};
 use super::template::{OUTPUT_KEYS, OutputName, TemplateError, has_placeholder};
 use super::work::{Product, Work, reference};
 use crate::accel::{self, AccelError, AccelStats};
+use crate::load::LoadProgress;
 use crate::output::part::PartInfo;
 use crate::output::{self, Format, OutputError};
 use crate::radiosity::RadiosityError;
@@ -166,6 +167,16 @@ impl JobError {
 pub enum Event<'a> {
     /// Reading (or generating) the scene.
     Loading,
+    /// `done` of `total` units of the scene are loaded: bytes of an NFF or OBJ file,
+    /// primitives of a generated database. Told a few dozen times a second at most,
+    /// from any thread, `done` growing, and `(total, total)` once the load is done;
+    /// never for a TOML scene or the built-in one.
+    Loaded {
+        /// Units done.
+        done: u64,
+        /// Units in all.
+        total: u64,
+    },
     /// The options are resolved against the scene: the image is `width × height`.
     Resolved {
         /// Width in pixels.
@@ -409,10 +420,10 @@ pub fn run(job: &Job, observer: &dyn Observer) -> Result<Rendered, JobError> {
 
 /// Refuse a generated database too large for the memory limit before generating it
 /// (its primitives counted without building them); the full estimate, with the
-/// image's buffers, follows once the scene is there.
-fn check_database_size(job: &Job, options: &RenderOptions) -> Result<(), JobError> {
+/// image's buffers, follows once the scene is there. Returns the primitives counted.
+fn check_database_size(job: &Job, options: &RenderOptions) -> Result<Option<u64>, JobError> {
     let Some((db, size)) = job.scene.database() else {
-        return Ok(());
+        return Ok(None);
     };
     let count = db.count(size);
     let res = options.res.map_or(
@@ -420,7 +431,22 @@ fn check_database_size(job: &Job, options: &RenderOptions) -> Result<(), JobErro
         |r| (r.width, r.height),
     );
     limits::check_generated(job.scene.path(), &count, res, options.memory_limit())?;
-    Ok(())
+    Ok(Some(count.prims))
+}
+
+/// Load the job's scene, telling `observer` how far the load has come.
+fn load(
+    job: &Job,
+    options: &RenderOptions,
+    observer: &dyn Observer,
+) -> Result<std::sync::Arc<Scene>, JobError> {
+    let prims = check_database_size(job, options)?;
+    let tell = |done, total| observer.event(Event::Loaded { done, total });
+    let progress = LoadProgress::new(&tell);
+    progress.expect(prims.unwrap_or(0));
+    let scene = job.scene.load_with(options.envmap.as_deref(), &progress)?;
+    progress.finish();
+    Ok(scene)
 }
 
 /// The first half of [`run`]: load, resolve, check the memory, build and do the task;
@@ -430,8 +456,7 @@ pub fn render(job: &Job, observer: &dyn Observer) -> Result<Rendered, JobError> 
     let options = job.options();
     observer.event(Event::Loading);
     let t0 = Instant::now();
-    check_database_size(job, &options)?;
-    let scene = job.scene.load(options.envmap.as_deref())?;
+    let scene = load(job, &options, observer)?;
     let load_ms = t0.elapsed().as_secs_f64() * 1e3;
     if observer.cancelled() {
         return Err(JobError::Cancelled(name));

@@ -3,7 +3,7 @@
 //! environment map in place of its own when the options ask for one.
 
 use super::template::scene_stem;
-use crate::load::{self, LoadError};
+use crate::load::{self, LoadError, LoadProgress};
 use crate::scene::{Environment, Scene};
 use crate::spd::Database;
 use std::path::{Path, PathBuf};
@@ -90,8 +90,18 @@ impl SceneSource {
     /// Load the scene, with the environment map `envmap` in place of its own (a loaded
     /// scene is shared, not copied, unless its environment is replaced).
     pub fn load(&self, envmap: Option<&Path>) -> Result<Arc<Scene>, SceneError> {
+        self.load_with(envmap, &LoadProgress::silent())
+    }
+
+    /// [`SceneSource::load`], telling `progress` how far the load of a scene file or
+    /// generated database has come.
+    pub fn load_with(
+        &self,
+        envmap: Option<&Path>,
+        progress: &LoadProgress<'_>,
+    ) -> Result<Arc<Scene>, SceneError> {
         let mut scene = match self {
-            SceneSource::File(p) => Arc::new(load_scene(p)?),
+            SceneSource::File(p) => Arc::new(load_scene_with(p, progress)?),
             SceneSource::Builtin => Arc::new(load::nff::parse_str(
                 DEFAULT_SCENE,
                 Path::new("<default scene>"),
@@ -109,9 +119,20 @@ impl SceneSource {
 /// Load a scene file or generate an `spd:NAME[?size=N]` scene; errors name the file
 /// (and line and column where there is one).
 pub fn load_scene(spec: impl AsRef<Path>) -> Result<Scene, SceneError> {
+    load_scene_with(spec, &LoadProgress::silent())
+}
+
+/// [`load_scene`], telling `progress` how many bytes of the file are read, or how many
+/// primitives of the database are made, and that all are once the scene is there.
+pub fn load_scene_with(
+    spec: impl AsRef<Path>,
+    progress: &LoadProgress<'_>,
+) -> Result<Scene, SceneError> {
     let spec = spec.as_ref();
-    match Database::parse_spec(&spec.to_string_lossy())? {
-        Some((db, size)) => Ok(super::spd_scene::scene(db, size, spec)?),
-        None => Ok(load::load_path(spec)?),
-    }
+    let scene = match Database::parse_spec(&spec.to_string_lossy())? {
+        Some((db, size)) => super::spd_scene::scene(db, size, spec, progress)?,
+        None => load::load_path_with(spec, progress)?,
+    };
+    progress.finish();
+    Ok(scene)
 }

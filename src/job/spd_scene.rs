@@ -11,11 +11,11 @@
 //! as failed: the caller then writes the text and reads it.
 
 use crate::geometry::{Cone, Intersect, Kind, Sphere};
-use crate::load::LoadError;
 use crate::load::nff::{
     MAX_PIXELS, MAX_RESOLUTION_SIDE, Merger, Note, Part, fill, unit_normal, up_is_usable,
     world_bounds,
 };
+use crate::load::{LoadError, LoadProgress};
 use crate::math::{DVec3, Vec3};
 use crate::scene::{Camera, Light, Scene, range};
 use crate::spd::{Database, NffSink, g_f32, g_f64};
@@ -25,12 +25,22 @@ use std::sync::Arc;
 
 /// The scene of database `db` at size factor `size`: the scene the NFF loader reads from
 /// [`Database::generate`]'s text (named `path`, the file name of its sources and
-/// messages), built without the text when it can be (it nearly always can).
+/// messages), built without the text when it can be (it nearly always can). `progress`
+/// is told how many primitives are made, of the total it expects ([`Database::count`],
+/// counted here unless the caller has set it).
 ///
 /// # Errors
 /// What the loader reports for the text, if anything.
-pub(crate) fn scene(db: Database, size: u32, path: &Path) -> Result<Scene, LoadError> {
-    let mut builder = SceneBuilder::new(path);
+pub(crate) fn scene(
+    db: Database,
+    size: u32,
+    path: &Path,
+    progress: &LoadProgress<'_>,
+) -> Result<Scene, LoadError> {
+    if progress.is_watched() && progress.total() == 0 {
+        progress.expect(db.count(size).prims);
+    }
+    let mut builder = SceneBuilder::new(path, progress);
     db.emit(size, &mut builder);
     match builder.finish() {
         Some(scene) => scene,
@@ -38,9 +48,15 @@ pub(crate) fn scene(db: Database, size: u32, path: &Path) -> Result<Scene, LoadE
     }
 }
 
+/// How many primitives are made between two advances of the load's progress.
+const PROGRESS_CHUNK: u64 = 1 << 14;
+
 /// Builds the scene of a database's entities (see the module documentation).
-struct SceneBuilder<'p> {
+struct SceneBuilder<'p, 'w> {
     path: &'p Path,
+    progress: &'p LoadProgress<'w>,
+    /// Primitives made since `progress` was last advanced.
+    made: u64,
     part: Part,
     /// The first viewpoint's eye, once it is known.
     origin: Option<DVec3>,
@@ -53,11 +69,13 @@ struct SceneBuilder<'p> {
     nrm: Vec<Vec3>,
 }
 
-impl<'p> SceneBuilder<'p> {
+impl<'p, 'w> SceneBuilder<'p, 'w> {
     /// No entities yet; `path` names the scene as the loader's file name does.
-    fn new(path: &'p Path) -> Self {
+    fn new(path: &'p Path, progress: &'p LoadProgress<'w>) -> Self {
         SceneBuilder {
             path,
+            progress,
+            made: 0,
             part: Part::new(Arc::from(path.display().to_string())),
             origin: None,
             line: 1,
@@ -75,6 +93,15 @@ impl<'p> SceneBuilder<'p> {
         let mut merger = Merger::new(self.path, self.origin.unwrap_or(DVec3::ZERO));
         merger.add(self.part);
         Some(merger.finish())
+    }
+
+    /// `n` more primitives are made (as [`Database::count`] counts them).
+    fn made(&mut self, n: usize) {
+        self.made += n as u64;
+        if self.made >= PROGRESS_CHUNK {
+            self.progress.advance(self.made);
+            self.made = 0;
+        }
     }
 
     /// The line of an entity of `lines` lines, the next one's after it.
@@ -136,7 +163,7 @@ impl<'p> SceneBuilder<'p> {
     }
 }
 
-impl NffSink for SceneBuilder<'_> {
+impl NffSink for SceneBuilder<'_, '_> {
     fn viewpoint(&mut self, from: D, at: D, up: D, angle: f64, hither: f64, res: (i32, i32)) {
         let line = self.entity(7) as usize;
         self.part.notes.push(Note::Viewpoint { line, col: 1 });
@@ -189,6 +216,7 @@ impl NffSink for SceneBuilder<'_> {
     }
 
     fn sphere(&mut self, center: D, radius: f64) {
+        self.made(1);
         let line = self.entity(1);
         let (center, r) = (self.point(center), self.num(radius));
         self.check(r != 0.0);
@@ -201,6 +229,7 @@ impl NffSink for SceneBuilder<'_> {
     }
 
     fn cone(&mut self, base: D, base_radius: f64, apex: D, apex_radius: f64) {
+        self.made(1);
         let line = self.entity(1);
         let (base, rb) = (self.point(base), self.num(base_radius));
         let (apex, ra) = (self.point(apex), self.num(apex_radius));
@@ -226,9 +255,10 @@ impl NffSink for SceneBuilder<'_> {
     }
 }
 
-impl SceneBuilder<'_> {
+impl SceneBuilder<'_, '_> {
     /// `p` (no normals) or `pp`: one line for the count, one per vertex.
     fn polygon_with(&mut self, verts: &[D], normals: Option<&[D]>) {
+        self.made(verts.len().saturating_sub(2));
         let line = self.entity(1 + verts.len());
         self.check(!verts.is_empty() && normals.is_none_or(|n| n.len() >= verts.len()));
         if self.failed {
@@ -263,6 +293,9 @@ mod tests {
     use super::*;
     use crate::load::nff::parse_str;
 
+    static SILENT: std::sync::LazyLock<LoadProgress<'static>> =
+        std::sync::LazyLock::new(LoadProgress::silent);
+
     /// The scene built from each database's entities is the scene read from its text,
     /// down to every primitive's line, and it is built without the text.
     #[test]
@@ -270,7 +303,7 @@ mod tests {
         for db in Database::ALL {
             for size in [1, 2] {
                 let path = Path::new("spd:db");
-                let mut builder = SceneBuilder::new(path);
+                let mut builder = SceneBuilder::new(path, &SILENT);
                 db.emit(size, &mut builder);
                 let built = builder.finish().expect("built directly").unwrap();
                 let read = parse_str(&db.generate(size), path).unwrap();
@@ -284,7 +317,11 @@ mod tests {
                         .same_origins(&read.sources.materials)
                 );
                 assert!(built.sources.lights.same_origins(&read.sources.lights));
-                assert_eq!(scene(db, size, path).unwrap(), read, "{what}");
+                assert_eq!(
+                    scene(db, size, path, &LoadProgress::silent()).unwrap(),
+                    read,
+                    "{what}"
+                );
             }
         }
     }
@@ -292,11 +329,11 @@ mod tests {
     /// A point before the first viewpoint is in a frame not yet known: the text decides.
     #[test]
     fn a_point_before_the_viewpoint_fails_the_build() {
-        let mut builder = SceneBuilder::new(Path::new("x"));
+        let mut builder = SceneBuilder::new(Path::new("x"), &SILENT);
         builder.sphere(D::ZERO, 1.0);
         builder.viewpoint(D::Z, D::ZERO, D::Y, 45.0, 0.0, (8, 8));
         assert!(builder.finish().is_none());
-        let mut builder = SceneBuilder::new(Path::new("x"));
+        let mut builder = SceneBuilder::new(Path::new("x"), &SILENT);
         builder.viewpoint(D::Z, D::ZERO, D::Y, 45.0, 0.0, (8, 8));
         builder.sphere(D::ZERO, 1.0);
         builder.polygon(&[D::ZERO, D::X, D::Y]);

@@ -2,9 +2,12 @@
 
 pub mod nff;
 pub mod obj;
+pub mod progress;
+mod read;
 pub(crate) mod text;
 pub mod toml;
 
+pub use progress::LoadProgress;
 use std::fmt;
 use std::path::{Path, PathBuf};
 
@@ -57,12 +60,23 @@ pub(crate) fn warn_if_empty(scene: &crate::scene::Scene, path: &Path) {
 /// and light ([`obj::load`]); anything else is read as NFF (`.nff`, and the classic
 /// benchmark files have no fixed extension).
 pub fn load_path(path: &Path) -> Result<crate::scene::Scene, LoadError> {
+    load_path_with(path, &LoadProgress::silent())
+}
+
+/// [`load_path`], telling `progress` how many bytes of an NFF or OBJ file are read,
+/// and that all are once the scene is loaded (a TOML scene tells nothing).
+pub fn load_path_with(
+    path: &Path,
+    progress: &LoadProgress<'_>,
+) -> Result<crate::scene::Scene, LoadError> {
     let ext = |e: &str| path.extension().is_some_and(|x| x.eq_ignore_ascii_case(e));
-    if ext("toml") {
+    let scene = if ext("toml") {
         self::toml::load(path)
     } else if ext("obj") {
-        obj::load(path)
+        obj::load_with(path, progress)
     } else {
-        nff::load(path)
-    }
+        nff::load_with(path, progress)
+    }?;
+    progress.finish();
+    Ok(scene)
 }

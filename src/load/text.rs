@@ -73,7 +73,7 @@ pub(crate) fn read_lossy(path: &Path) -> Result<String, LoadError> {
 /// `path: cannot read: …` when the file cannot be read, else as [`body`].
 pub(crate) fn read_body(path: &Path) -> Result<Vec<u8>, LoadError> {
     let mut bytes =
-        std::fs::read(path).map_err(|e| whole_file(path, format!("cannot read: {e}")))?;
+        super::read::read(path).map_err(|e| whole_file(path, format!("cannot read: {e}")))?;
     let skip = bytes.len() - body(&bytes, path)?.len();
     bytes.drain(..skip);
     Ok(bytes)

@@ -1,8 +1,8 @@
 //! Progress bars on a terminal: the tiles of one render, and the jobs of a batch with
 //! a bar per running job and a line per finished one. A render's bar spins, naming the
-//! phase (loading, building, rendering), while the scene loads and the backend builds,
-//! counts the tiles from 0 once the render tells how many there are, with
-//! the time left ([`eta`]), and names the file being written.
+//! phase (loading, with the share loaded, building, rendering), while the scene loads
+//! and the backend builds, counts the tiles from 0 once the render tells how many there
+//! are, with the time left ([`eta`]), and names the file being written.
 
 use super::error::error_line;
 use super::eta;
@@ -100,6 +100,18 @@ impl Tiles {
         }
     }
 
+    /// `done` of `total` units of the scene are loaded: say what share, drawn at once
+    /// (the load tells a few dozen times a second at most).
+    fn loaded(&self, done: u64, total: u64) {
+        if !self.started.is_completed() && total > 0 {
+            let percent = done.min(total) * 100 / total;
+            let name = &self.name;
+            self.bar
+                .set_message(format!("{name}: loading {percent}% …"));
+            self.bar.force_draw();
+        }
+    }
+
     /// The render is done and `path` is being written.
     fn writing(&self, path: &Path) {
         spin(&self.bar, format!("writing {} …", path.display()));
@@ -136,6 +148,14 @@ impl TileBar {
     pub fn phase(&self, phase: &str) {
         if let Some(t) = &self.0 {
             t.phase(phase);
+        }
+    }
+
+    /// `done` of `total` units of the scene are loaded: show the percentage beside
+    /// the phase.
+    pub fn loaded(&self, done: u64, total: u64) {
+        if let Some(t) = &self.0 {
+            t.loaded(done, total);
         }
     }
 

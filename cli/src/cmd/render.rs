@@ -106,6 +106,7 @@ fn render_one(args: &Args, job: &Job) -> Result<(), Error> {
     let bar = TileBar::new(&job.scene.name(), args.log.quiet);
     let observer = |e: Event<'_>| match e {
         Event::Loading => bar.phase("loading"),
+        Event::Loaded { done, total } => bar.loaded(done, total),
         Event::Building => bar.phase("building"),
         Event::Rendering => bar.phase("rendering"),
         Event::Tiles { done, total } => bar.set(done, total),

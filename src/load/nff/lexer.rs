@@ -81,6 +81,7 @@ impl<'a> Lexer<'a> {
         }
     }
 
+    #[inline(always)]
     fn scan(&mut self) -> Option<Tok<'a>> {
         let b = self.src.as_bytes();
         loop {
@@ -121,7 +122,7 @@ impl<'a> Lexer<'a> {
         })
     }
 
-    #[inline]
+    #[inline(always)]
     pub fn next(&mut self) -> Option<Tok<'a>> {
         let t = match self.peeked.take() {
             Some(t) => Some(t),
@@ -136,7 +137,7 @@ impl<'a> Lexer<'a> {
     /// The next token when it is a plain decimal on the same line (after blanks),
     /// read in the same pass, and handed out as [`Lexer::next`] would; `None`, with
     /// nothing consumed, for anything else.
-    #[inline]
+    #[inline(always)]
     pub fn next_plain(&mut self) -> Option<(Tok<'a>, Plain)> {
         if self.peeked.is_some() {
             return None;

@@ -8,8 +8,9 @@
 //!
 //! A large file is cut into stretches at lines that start an entity (`split`), the
 //! stretches are parsed in parallel (`parser`, into a `part::Part` each), and the parts
-//! are joined in file order (`merge`): the scene, the warnings and the first error are
-//! those of reading the file from start to end, whatever the cut.
+//! are joined in file order (`merge`), each batch while the next is parsed
+//! (`stretches`): the scene, the warnings and the first error are those of reading the
+//! file from start to end, whatever the cut.
 //!
 //! Entities: `v` (viewpoint: `from`, `at`, `up`, `angle`, `hither`, `resolution` in
 //! that order), `b` (background), `l x y z [r g b]` (point light), `f` (material),
@@ -28,18 +29,17 @@ mod number;
 mod parser;
 mod part;
 mod split;
+mod stretches;
 
-use super::{LoadError, text};
+use super::{LoadError, LoadProgress, text};
 use crate::math::DVec3;
 use crate::scene::Scene;
 use lexer::Lexer;
 pub(crate) use merge::Merger;
-use parser::{Parsed, Place, Source};
 pub(crate) use parser::{fill, unit_normal, up_is_usable, world_bounds};
 pub(crate) use part::{Note, Part};
-use rayon::prelude::*;
 use std::path::Path;
-use std::sync::Arc;
+use stretches::parse_in_stretches;
 
 /// Where the loader's warnings come from (the same wherever in the loader they are
 /// logged).
@@ -61,7 +61,18 @@ pub const MAX_PIXELS: u64 = 1 << 28;
 /// UTF-8 byte-order mark is skipped, and bytes that are not UTF-8 (in comments, say)
 /// are replaced, which leaves line and column numbers intact (see `super::text`).
 pub fn load(path: &Path) -> Result<Scene, LoadError> {
-    let scene = parse_str(&text::read_lossy(path)?, path)?;
+    load_with(path, &LoadProgress::silent())
+}
+
+/// [`load`], telling `progress` how many of the file's bytes are parsed.
+///
+/// # Errors
+/// As [`load`].
+pub fn load_with(path: &Path, progress: &LoadProgress<'_>) -> Result<Scene, LoadError> {
+    let src = text::read_lossy(path)?;
+    progress.expect(src.len() as u64);
+    let origin = eye_of(&src).unwrap_or(DVec3::ZERO);
+    let scene = parse_in_stretches(&src, path, origin, STRETCH, progress)?;
     super::warn_if_empty(&scene, path);
     Ok(scene)
 }
@@ -82,7 +93,7 @@ pub fn parse_str(src: &str, path: &Path) -> Result<Scene, LoadError> {
 /// # Errors
 /// As [`parse_str`].
 pub fn parse_str_at(src: &str, path: &Path, origin: DVec3) -> Result<Scene, LoadError> {
-    parse_in_stretches(src, path, origin, STRETCH)
+    parse_in_stretches(src, path, origin, STRETCH, &LoadProgress::silent())
 }
 
 /// [`parse_str`], with the text cut into stretches of about `stretch` bytes that are
@@ -92,96 +103,8 @@ pub fn parse_str_at(src: &str, path: &Path, origin: DVec3) -> Result<Scene, Load
 /// # Errors
 /// As [`parse_str`].
 pub fn parse_str_in_stretches(src: &str, path: &Path, stretch: usize) -> Result<Scene, LoadError> {
-    parse_in_stretches(src, path, eye_of(src).unwrap_or(DVec3::ZERO), stretch)
-}
-
-/// Cut `src` into stretches ([`split::cut`]), parse them a batch at a time in
-/// parallel, and join them in order. A stretch whose first token is not where the one
-/// before stopped (the cut fell inside an entity) is read again from there, with the
-/// rest of the file, as one stretch; the first error in file order is the one that
-/// sequential reading reports, since every stretch before it was read from an entity's
-/// start.
-fn parse_in_stretches(
-    src: &str,
-    path: &Path,
-    origin: DVec3,
-    stretch: usize,
-) -> Result<Scene, LoadError> {
-    let source = Source { src, path, origin };
-    let file: Arc<str> = Arc::from(path.display().to_string());
-    let places = places(src, &split::cut(src, stretch));
-    let ends: Vec<usize> = places.iter().skip(1).map(|p| p.pos).collect();
-    let mut merger = Merger::new(path, origin);
-    let mut resume: Option<Place> = None;
-    let batch = rayon::current_num_threads().max(1) * 4;
-    for (b, group) in places.chunks(batch).enumerate() {
-        let k0 = b * batch;
-        let parsed: Vec<Parsed> = group
-            .par_iter()
-            .enumerate()
-            .map(|(i, &from)| {
-                let end = ends.get(k0 + i).copied().unwrap_or(usize::MAX);
-                parser::parse(source, file.clone(), from, end)
-            })
-            .collect();
-        for (i, parsed) in parsed.into_iter().enumerate() {
-            if k0 + i > 0 {
-                // Where the stretch before stopped: `None` when it read to the end.
-                let Some(stop) = resume else {
-                    return merger.finish();
-                };
-                if parsed.first != Some(stop.pos) {
-                    let tail = parser::parse(source, file.clone(), stop, usize::MAX);
-                    join(&mut merger, tail)?;
-                    return merger.finish();
-                }
-            }
-            resume = parsed.stop;
-            join(&mut merger, parsed)?;
-        }
-    }
-    merger.finish()
-}
-
-/// Join a parsed stretch, or stop at its error (after its warnings).
-fn join(merger: &mut Merger<'_>, parsed: Parsed) -> Result<(), LoadError> {
-    match parsed.error {
-        Some(e) => {
-            merger.notes(&parsed.part.notes);
-            Err(e)
-        }
-        None => {
-            merger.add(parsed.part);
-            Ok(())
-        }
-    }
-}
-
-/// The stretches starting at `starts` (line starts), with their line numbers.
-fn places(src: &str, starts: &[usize]) -> Vec<Place> {
-    let b = src.as_bytes();
-    let breaks: Vec<usize> = starts
-        .par_iter()
-        .enumerate()
-        .map(|(k, &s)| {
-            let end = starts.get(k + 1).copied().unwrap_or(b.len());
-            split::line_breaks(b, s, end)
-        })
-        .collect();
-    let mut line = 1;
-    starts
-        .iter()
-        .zip(&breaks)
-        .map(|(&pos, &n)| {
-            let place = Place {
-                pos,
-                line,
-                line_start: pos,
-            };
-            line += n;
-            place
-        })
-        .collect()
+    let origin = eye_of(src).unwrap_or(DVec3::ZERO);
+    parse_in_stretches(src, path, origin, stretch, &LoadProgress::silent())
 }
 
 /// The eye (`from`) of the file's first viewpoint, found by a quick scan of the tokens

@@ -31,7 +31,7 @@ pub(super) struct Plain {
 /// The plain decimal that starts `s` and runs to its end or to the first byte that
 /// ends a token (a blank, a line end, `#`), with its length; `None` when the token has
 /// another form (or more than 19 digits).
-#[inline]
+#[inline(always)]
 pub(super) fn scan_plain(s: &[u8]) -> Option<(Plain, usize)> {
     let (negative, mut i) = match s.first()? {
         b'-' => (true, 1),

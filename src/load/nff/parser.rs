@@ -128,7 +128,7 @@ impl<'a> Parser<'a, '_> {
     }
 
     /// The next token as a finite `f32`. `what` names it for errors (built only then).
-    #[inline]
+    #[inline(always)]
     fn num_with(&mut self, what: &dyn Fn() -> String) -> Result<(f32, Tok<'a>), LoadError> {
         let (t, v) = match self.lex.next_plain() {
             Some((t, p)) => (t, plain_f32(p).or_else(|| parse_f32(t.text))),
@@ -146,7 +146,7 @@ impl<'a> Parser<'a, '_> {
 
     /// The next token as an `f64` that is also finite as an `f32` (so that the file's
     /// numbers are refused alike whether they are points or not).
-    #[inline]
+    #[inline(always)]
     fn num64_with(&mut self, what: &dyn Fn() -> String) -> Result<(f64, Tok<'a>), LoadError> {
         let (t, v) = match self.lex.next_plain() {
             Some((t, p)) => (t, plain_f64(p).or_else(|| parse_f64(t.text))),
@@ -165,6 +165,7 @@ impl<'a> Parser<'a, '_> {
     /// A point: three numbers read in double precision, checked against the traceable
     /// range in world coordinates, and returned in the scene's frame, with the first
     /// number's token.
+    #[inline(always)]
     fn point(&mut self, what: &str) -> Result<(Vec3, Tok<'a>), LoadError> {
         let (x, tok) = self.num64_with(&|| format!("{what} x"))?;
         let (y, _) = self.num64_with(&|| format!("{what} y"))?;

@@ -170,7 +170,7 @@ pub use framing::{
     AUTO_RESOLUTION, frame,
 };
 
-use super::{LoadError, text};
+use super::{LoadError, LoadProgress, text};
 use crate::math::{Aabb, DVec3, Vec3};
 use crate::scene::{Environment, Geometry, LoadStats, Material, Scene, Texture};
 use build::Builder;
@@ -233,7 +233,15 @@ pub enum Origin {
 /// Whatever [`load_geometry`] reports, or `path: …` when the model has no
 /// non-degenerate face to frame.
 pub fn load(path: &Path) -> Result<Scene, LoadError> {
-    let data = load_geometry_at(path, Origin::Centre)?;
+    load_with(path, &LoadProgress::silent())
+}
+
+/// [`load`], telling `progress` how many of the file's bytes are parsed.
+///
+/// # Errors
+/// As [`load`].
+pub fn load_with(path: &Path, progress: &LoadProgress<'_>) -> Result<Scene, LoadError> {
+    let data = read_geometry(path, Origin::Centre, progress)?;
     for w in &data.warnings {
         log::warn!("{w}");
     }
@@ -279,10 +287,20 @@ pub fn load_geometry(path: &Path) -> Result<ObjData, LoadError> {
 /// # Errors
 /// As [`load_geometry`].
 pub fn load_geometry_at(path: &Path, origin: Origin) -> Result<ObjData, LoadError> {
+    read_geometry(path, origin, &LoadProgress::silent())
+}
+
+/// [`load_geometry_at`], telling `progress` how many of the file's bytes are parsed.
+fn read_geometry(
+    path: &Path,
+    origin: Origin,
+    progress: &LoadProgress<'_>,
+) -> Result<ObjData, LoadError> {
     let t0 = Instant::now();
     let text = text::read_lossy(path)?;
+    progress.expect(text.len() as u64);
     let t_read = t0.elapsed();
-    let mut obj = parse::parse(&text).map_err(|e| e.at(path))?;
+    let mut obj = parse::parse(&text, progress).map_err(|e| e.at(path))?;
     let t_parse = t0.elapsed();
 
     let libs = libs::read(path, &obj.mtllibs);

@@ -11,7 +11,11 @@
 
 use super::located::{Located, article, comment_hint, name_after_space, show};
 use super::numbers::{self, Element};
+use crate::load::LoadProgress;
 use glam::{DVec3, Vec2, Vec3};
+
+/// How many bytes are read between two advances of the load's progress.
+const PROGRESS_CHUNK: usize = 1 << 20;
 
 /// Index of an element a corner does not name.
 pub(super) const NONE: usize = usize::MAX;
@@ -200,11 +204,18 @@ impl Obj {
     }
 }
 
-pub(super) fn parse(text: &str) -> Result<Obj, Located> {
+pub(super) fn parse(text: &str, progress: &LoadProgress<'_>) -> Result<Obj, Located> {
     let mut p = Parser::default();
+    // Bytes read since `progress` was last advanced.
+    let mut read = 0;
     for (i, line) in text.lines().enumerate() {
         if let Err(e) = p.statement(i + 1, line) {
             return Err(p.first_bad_before(e));
+        }
+        read += line.len() + 1;
+        if read >= PROGRESS_CHUNK {
+            progress.advance(read as u64);
+            read = 0;
         }
     }
     p.finish()
@@ -532,6 +543,10 @@ impl Parser {
 #[cfg(test)]
 mod tests {
     use super::*;
+
+    fn parse(text: &str) -> Result<Obj, Located> {
+        super::parse(text, &LoadProgress::silent())
+    }
 
     #[test]
     fn records_faces_materials_and_libraries() {

@@ -179,7 +179,7 @@ mod tests {
     use super::*;
 
     fn checked(src: &str, materials: &[(usize, &str)]) -> Result<Obj, Located> {
-        let mut obj = parse(src).unwrap();
+        let mut obj = parse(src, &crate::load::LoadProgress::silent()).unwrap();
         check(&mut obj, materials).map(|()| obj)
     }
 
