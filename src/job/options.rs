@@ -310,7 +310,8 @@ pub struct RenderOptions {
     pub packet_width: Option<u32>,
     /// Cast the shadow rays of each depth of a tile together, light by light, as
     /// Embree packets of this many rays (4, 8 or 16: `rtcOccluded4/8/16`); 0 casts them
-    /// one by one [default: 8]. The answers are the same either way.
+    /// one by one [default: 8 when the scene holds only triangles and spheres, else 0].
+    /// The answers are the same either way.
     #[cfg_attr(feature = "cli", arg(long, value_name = "N", help_heading = "Backend"))]
     #[serde(skip_serializing_if = "Option::is_none")]
     pub shadow_packet_width: Option<u32>,

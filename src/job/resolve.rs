@@ -8,7 +8,7 @@
 
 use super::options::{AaMode, FormFactors, Gi, RadiosityOptions, RenderOptions, Solver};
 use super::values::Band;
-use crate::accel::{Backend, BackendOptions, DEFAULT_PACKET_WIDTH, DEFAULT_SHADOW_PACKET_WIDTH};
+use crate::accel::{Backend, BackendOptions, DEFAULT_PACKET_WIDTH};
 use crate::output::Encoding;
 use crate::output::heatmap::Quantity;
 use crate::radiosity::{FormFactorMethod, RadiositySettings, SolverKind};
@@ -309,9 +309,7 @@ impl RenderOptions {
             embree_quality: self.embree_quality.unwrap_or_default(),
             embree_robust: self.embree_fast != Some(true),
             packet_width: self.packet_width.unwrap_or(DEFAULT_PACKET_WIDTH),
-            shadow_packet_width: self
-                .shadow_packet_width
-                .unwrap_or(DEFAULT_SHADOW_PACKET_WIDTH),
+            shadow_packet_width: self.shadow_packet_width,
         }
     }
 

@@ -26,7 +26,7 @@ mod tests;
 
 pub use error::EmbreeError;
 
-use crate::accel::{Accel, AccelStats, Backend, BackendOptions, Hit};
+use crate::accel::{Accel, AccelStats, Backend, BackendOptions, Hit, shadow_packet_width_for};
 use crate::math::Ray;
 use crate::scene::Scene;
 use device::Device;
@@ -84,13 +84,20 @@ impl EmbreeAccel {
         let (quality, robust) = (options.embree_quality, options.embree_robust);
         let before = device.allocated_bytes();
         let committed = CommittedScene::build(&device, scene, quality, robust)?;
+        let shadow_packet_width = options
+            .shadow_packet_width
+            .unwrap_or_else(|| shadow_packet_width_for(&committed.kinds));
         let api = if cfg!(embree4) { "embree4" } else { "embree3" };
         let detail = format!(
-            "{}, {api} API (headers {}), {} traversal, {} build quality",
+            "{}, {api} API (headers {}), {} traversal, {} build quality, shadow rays {}",
             device.describe(),
             env!("EMRAY_EMBREE_HEADER_VERSION"),
             if robust { "robust" } else { "fast" },
             quality.name(),
+            match shadow_packet_width {
+                4 | 8 | 16 => format!("in packets of {shadow_packet_width}"),
+                _ => "one by one".to_string(),
+            },
         );
         Ok(EmbreeAccel {
             // Embree's own allocations for this scene (hierarchy, triangle buffers), read
@@ -103,7 +110,7 @@ impl EmbreeAccel {
             prims: scene.prim_count_with_instances(),
             detail,
             packet_width: options.packet_width,
-            shadow_packet_width: options.shadow_packet_width,
+            shadow_packet_width,
         })
     }
 
