@@ -6,7 +6,6 @@
 use super::{BINS, Count};
 use crate::math::Aabb;
 use glam::Vec3;
-use smallvec::SmallVec;
 
 /// The bounds of a range's primitives and of their centroids.
 #[derive(Clone, Copy, Debug)]
@@ -127,10 +126,13 @@ impl Bins {
     pub fn best_split(&self, binning: &Binning) -> (f32, usize, usize) {
         let mut best = (f32::INFINITY, 0usize, 0usize);
         for axis in (0..3).filter(|&a| binning.binned[a]) {
-            let occupied: SmallVec<[usize; BINS]> = (0..BINS)
-                .filter(|&b| !self.counts[axis][b].is_empty())
-                .collect();
-            self.best_plane(axis, &occupied, &mut best);
+            let mut occupied = [0usize; BINS];
+            let mut len = 0;
+            for b in (0..BINS).filter(|&b| !self.counts[axis][b].is_empty()) {
+                occupied[len] = b;
+                len += 1;
+            }
+            self.best_plane(axis, &occupied[..len], &mut best);
         }
         best
     }

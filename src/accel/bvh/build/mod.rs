@@ -47,9 +47,9 @@ const TRAVERSAL_COST: f32 = 0.25;
 #[derive(Clone, Copy, Debug, Default)]
 struct Count {
     /// Triangles, tested four at a time.
-    tris: usize,
+    tris: u32,
     /// Other primitives, tested one at a time.
-    others: usize,
+    others: u32,
 }
 
 impl Count {
@@ -406,6 +406,26 @@ mod tests {
         assert!(one.0.len() > 1000, "{} nodes", one.0.len());
         for threads in [2, 4] {
             same(&on(threads), &one, &format!("{threads} threads"));
+        }
+    }
+
+    #[test]
+    fn spd_scenes_same_tree() {
+        let scenes = [
+            "balls?size=3",
+            "tetra?size=5",
+            "gears?size=1",
+            "rings?size=3",
+            "mount?size=4",
+            "teapot?size=4",
+            "sombrero?size=1",
+        ];
+        for spec in scenes {
+            let scene = crate::job::load_scene(format!("spd:{spec}")).expect("an SPD scene");
+            let prims = crate::accel::bvh::gather(&scene.geometry, 0);
+            let (_, bounds, triangle) = crate::accel::bvh::tree_prims(&prims, &[]);
+            let want = reference::build(&bounds, &triangle);
+            same(&build_with(&bounds, &triangle, FINE), &want, spec);
         }
     }
 }
