@@ -15,26 +15,23 @@ pub(super) struct Summary {
 }
 
 impl Summary {
-    /// The summary of primitives `order`.
-    pub fn of(order: &[u32], bounds: &[Aabb], centroids: &[Vec3]) -> Summary {
-        let mut bb = Aabb::EMPTY;
-        let mut cb = Aabb::EMPTY;
+    pub const EMPTY: Summary = Summary {
+        bounds: Aabb::EMPTY,
+        cbounds: Aabb::EMPTY,
+    };
+
+    /// Add primitives `order`.
+    pub fn add(&mut self, order: &[u32], bounds: &[Aabb], centroids: &[Vec3]) {
         for &i in order {
-            bb = bb.union(&bounds[i as usize]);
-            cb = cb.grow(centroids[i as usize]);
-        }
-        Summary {
-            bounds: bb,
-            cbounds: cb,
+            self.bounds = self.bounds.union(&bounds[i as usize]);
+            self.cbounds = self.cbounds.grow(centroids[i as usize]);
         }
     }
 
-    /// The summary of two parts of a range.
-    pub fn merge(self, o: Summary) -> Summary {
-        Summary {
-            bounds: self.bounds.union(&o.bounds),
-            cbounds: self.cbounds.union(&o.cbounds),
-        }
+    /// Add the summary of another part of the range.
+    pub fn merge(&mut self, o: &Summary) {
+        self.bounds = self.bounds.union(&o.bounds);
+        self.cbounds = self.cbounds.union(&o.cbounds);
     }
 }
 
@@ -67,25 +64,27 @@ impl Binning {
         (((c[axis] - self.min[axis]) * self.k[axis]) as usize).min(BINS - 1)
     }
 
-    /// The bins of primitives `order` along every binned axis.
-    pub fn bin_all(
+    /// Add primitives `order` to `bins` along every binned axis.
+    pub fn add(
         &self,
+        bins: &mut Bins,
         order: &[u32],
         bounds: &[Aabb],
         triangle: &[bool],
         centroids: &[Vec3],
-    ) -> Bins {
-        let mut bins = Bins::EMPTY;
+    ) {
         for &i in order {
             let (c, b) = (centroids[i as usize], &bounds[i as usize]);
             let count = Count::of(triangle[i as usize]);
-            for axis in (0..3).filter(|&a| self.binned[a]) {
+            for axis in 0..3 {
+                if !self.binned[axis] {
+                    continue;
+                }
                 let k = self.bin(c, axis);
                 bins.counts[axis][k] = bins.counts[axis][k].add(count);
                 bins.boxes[axis][k] = bins.boxes[axis][k].union(b);
             }
         }
-        bins
     }
 }
 
@@ -97,20 +96,19 @@ pub(super) struct Bins {
 }
 
 impl Bins {
-    const EMPTY: Bins = Bins {
+    pub const EMPTY: Bins = Bins {
         counts: [[Count { tris: 0, others: 0 }; BINS]; 3],
         boxes: [[Aabb::EMPTY; BINS]; 3],
     };
 
-    /// The bins of two parts of a range.
-    pub fn merge(mut self, o: Bins) -> Bins {
+    /// Add the bins of another part of the range.
+    pub fn merge(&mut self, o: &Bins) {
         for axis in 0..3 {
             for k in 0..BINS {
                 self.counts[axis][k] = self.counts[axis][k].add(o.counts[axis][k]);
                 self.boxes[axis][k] = self.boxes[axis][k].union(&o.boxes[axis][k]);
             }
         }
-        self
     }
 
     /// The split with the lowest cost among the `BINS - 1` planes between bins of
@@ -128,9 +126,11 @@ impl Bins {
         for axis in (0..3).filter(|&a| binning.binned[a]) {
             let mut occupied = [0usize; BINS];
             let mut len = 0;
-            for b in (0..BINS).filter(|&b| !self.counts[axis][b].is_empty()) {
-                occupied[len] = b;
-                len += 1;
+            for b in 0..BINS {
+                if !self.counts[axis][b].is_empty() {
+                    occupied[len] = b;
+                    len += 1;
+                }
             }
             self.best_plane(axis, &occupied[..len], &mut best);
         }

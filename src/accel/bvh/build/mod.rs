@@ -24,7 +24,7 @@ mod tree;
 
 use super::{MAX_DEPTH, Node};
 use crate::math::Aabb;
-use bins::{Binning, Summary};
+use bins::{Binning, Bins, Summary};
 use rayon::prelude::*;
 use tree::{Slot, Tree};
 
@@ -159,7 +159,8 @@ impl Builder<'_> {
     fn summary(&self, order: &[u32]) -> Summary {
         self.chunked(
             order,
-            |part| Summary::of(part, self.bounds, &self.centroids),
+            || Summary::EMPTY,
+            |s, part| s.add(part, self.bounds, &self.centroids),
             Summary::merge,
         )
     }
@@ -171,8 +172,9 @@ impl Builder<'_> {
         let binning = Binning::new(&s.cbounds);
         let bins = self.chunked(
             order,
-            |part| binning.bin_all(part, self.bounds, self.triangle, &self.centroids),
-            bins::Bins::merge,
+            || Bins::EMPTY,
+            |bins, part| binning.add(bins, part, self.bounds, self.triangle, &self.centroids),
+            Bins::merge,
         );
         let (cost, axis, split_bin) = bins.best_split(&binning);
         let area = s.bounds.surface_area().max(f32::MIN_POSITIVE);
@@ -192,22 +194,31 @@ impl Builder<'_> {
             .tests()
     }
 
-    /// `f` over `order`, in chunks of [`Grain::chunk`] on the pool's threads merged in
-    /// order when `order` is long, else at once.
+    /// `add` of `order` to `init()`: in chunks of [`Grain::chunk`] on the pool's
+    /// threads, merged in order, when `order` is long, else at once.
     fn chunked<T: Send>(
         &self,
         order: &[u32],
-        f: impl Fn(&[u32]) -> T + Sync + Send,
-        merge: impl Fn(T, T) -> T,
+        init: impl Fn() -> T + Sync + Send,
+        add: impl Fn(&mut T, &[u32]) + Sync + Send,
+        merge: impl Fn(&mut T, &T),
     ) -> T {
+        let mut acc = init();
         if order.len() < self.grain.par_range {
-            return f(order);
+            add(&mut acc, order);
+            return acc;
         }
-        let parts: Vec<T> = order.par_chunks(self.grain.chunk).map(f).collect();
-        parts
-            .into_iter()
-            .reduce(merge)
-            .expect("a long range has chunks")
+        let parts: Vec<T> = (order.par_chunks(self.grain.chunk))
+            .map(|part| {
+                let mut t = init();
+                add(&mut t, part);
+                t
+            })
+            .collect();
+        for part in &parts {
+            merge(&mut acc, part);
+        }
+        acc
     }
 
     /// A leaf when it fits, else a median split along the longest axis (for ranges whose
