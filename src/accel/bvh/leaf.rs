@@ -3,9 +3,16 @@
 //! [`Triangle4`] (their vertices copied, tested four at a time), then its other
 //! primitives (analytic shapes by value, instances by index).
 
+use super::build::MAX_LEAF;
 use crate::geometry::{Shape, Triangle, Triangle4};
 use crate::math::Aabb;
+use rayon::prelude::*;
+use smallvec::SmallVec;
 use std::ops::Range;
+
+/// Leaves stored by one task (their primitives are copied once more when the tasks'
+/// parts are joined).
+const LEAVES_PER_TASK: usize = 4096;
 
 /// A primitive of a level as the builder sees it, before it is stored in a leaf.
 #[derive(Clone, Debug)]
@@ -61,24 +68,49 @@ pub(super) struct LeafData {
 impl LeafData {
     /// Store the leaves `ranges` of `order` (each a `(first, count)` run of it, in leaf
     /// order), `order` indexing `prims`. A leaf keeps its primitives' order: triangles
-    /// first, four to a pack, then the others.
+    /// first, four to a pack, then the others. Runs of leaves are stored on the
+    /// caller's rayon pool and joined in order.
     pub fn new(ranges: &[(u32, u32)], order: &[usize], prims: &[Prim]) -> LeafData {
+        let parts: Vec<LeafData> = ranges
+            .par_chunks(LEAVES_PER_TASK)
+            .map(|run| {
+                let mut part = LeafData::default();
+                for &(first, count) in run {
+                    let items = order[first as usize..(first + count) as usize]
+                        .iter()
+                        .map(|&i| &prims[i]);
+                    part.push_leaf(items);
+                }
+                part
+            })
+            .collect();
         let mut data = LeafData {
             leaves: Vec::with_capacity(ranges.len()),
-            ..LeafData::default()
+            packs: Vec::with_capacity(parts.iter().map(|p| p.packs.len()).sum()),
+            pack_ids: Vec::with_capacity(parts.iter().map(|p| p.pack_ids.len()).sum()),
+            others: Vec::with_capacity(parts.iter().map(|p| p.others.len()).sum()),
         };
-        for &(first, count) in ranges {
-            let items = order[first as usize..(first + count) as usize]
-                .iter()
-                .map(|&i| &prims[i]);
-            data.push_leaf(items);
+        for part in parts {
+            data.append(part);
         }
         data
     }
 
+    /// Append the leaves of `part`.
+    fn append(&mut self, part: LeafData) {
+        let (packs, others) = (self.packs.len() as u32, self.others.len() as u32);
+        self.leaves.extend(part.leaves.iter().map(|l| Leaf {
+            packs: (l.packs.0 + packs, l.packs.1 + packs),
+            others: (l.others.0 + others, l.others.1 + others),
+        }));
+        self.packs.extend(part.packs);
+        self.pack_ids.extend(part.pack_ids);
+        self.others.extend(part.others);
+    }
+
     fn push_leaf<'a>(&mut self, items: impl Iterator<Item = &'a Prim>) {
         let (pack_start, other_start) = (self.packs.len(), self.others.len());
-        let mut tris: Vec<(Triangle, u32)> = Vec::new();
+        let mut tris: SmallVec<[(Triangle, u32); MAX_LEAF]> = SmallVec::new();
         for item in items {
             match item {
                 Prim::Triangle(t, i) => tris.push((*t, *i)),
@@ -87,7 +119,7 @@ impl LeafData {
             }
         }
         for chunk in tris.chunks(4) {
-            let t: Vec<Triangle> = chunk.iter().map(|c| c.0).collect();
+            let t: SmallVec<[Triangle; 4]> = chunk.iter().map(|c| c.0).collect();
             self.packs.push(Triangle4::new(&t));
             self.pack_ids
                 .push(std::array::from_fn(|i| chunk[i.min(chunk.len() - 1)].1));

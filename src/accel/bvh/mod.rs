@@ -20,6 +20,7 @@ use crate::geometry::{Analytic, Intersect, Kind, ShapeHit, WatertightRay, Watert
 use crate::math::{Aabb, Ray, Xform, next_float_up};
 use crate::scene::{Geometry, KindVisitor, Prims, Scene};
 use leaf::{Leaf, LeafData, Other, Prim};
+use rayon::prelude::*;
 use std::sync::Arc;
 use traverse::Visit;
 use wide::Node4;
@@ -47,10 +48,37 @@ struct Gather<'a> {
 impl KindVisitor for Gather<'_> {
     type Output = ();
     fn visit<P: Analytic>(&mut self, list: &Prims<P>) {
-        for (i, prim, _) in list.iter() {
-            self.prims.push(Prim::Shape(prim.clone().into(), i));
-        }
+        let shapes = (list.items.par_iter().enumerate())
+            .map(|(i, prim)| Prim::Shape(prim.clone().into(), i as u32));
+        self.prims.par_extend(shapes);
     }
+}
+
+/// The primitives of a level: its triangles, its analytic shapes kind by kind, then
+/// `instances` instances.
+fn gather(geometry: &Geometry, instances: usize) -> Vec<Prim> {
+    let mut prims = Vec::with_capacity(geometry.prim_count() + instances);
+    let triangles = (geometry.triangles.items.par_iter().enumerate())
+        .map(|(i, t)| Prim::Triangle(*t, i as u32));
+    prims.par_extend(triangles);
+    geometry.visit_all(&mut Gather { prims: &mut prims });
+    prims.extend((0..instances as u32).map(Prim::Instance));
+    prims
+}
+
+/// What the builder reads of `prims` (with `instance_bounds` for instances): the
+/// indices of those that go in the tree, their bounds, and whether each is a triangle.
+/// Unbounded primitives stay out of the tree (see `Unbounded`), and so do empty ones
+/// (an instance of an object without bounded primitives).
+fn tree_prims(prims: &[Prim], instance_bounds: &[Aabb]) -> (Vec<usize>, Vec<Aabb>, Vec<bool>) {
+    let (bounded, bounds): (Vec<usize>, Vec<Aabb>) = (prims.par_iter().enumerate())
+        .map(|(i, p)| (i, p.bounds(instance_bounds)))
+        .filter(|(_, b)| b.is_finite())
+        .unzip();
+    let triangle = (bounded.par_iter())
+        .map(|&i| matches!(prims[i], Prim::Triangle(..)))
+        .collect();
+    (bounded, bounds, triangle)
 }
 
 /// An instance: the object's own hierarchy under a transform.
@@ -91,7 +119,7 @@ impl Bvh {
     pub fn build(scene: &Scene) -> Bvh {
         let objects: Vec<Arc<Bvh>> = scene
             .objects
-            .iter()
+            .par_iter()
             .map(|g| Arc::new(Bvh::build_level(g, Vec::new())))
             .collect();
         let instances = scene
@@ -116,29 +144,13 @@ impl Bvh {
     /// The hierarchy over the bounded primitives of `geometry` and `instances` (an
     /// instance whose object's tree is empty is left out).
     fn build_level(geometry: &Geometry, instances: Vec<PlacedObject>) -> Bvh {
-        let mut prims = Vec::with_capacity(geometry.prim_count() + instances.len());
-        for (i, t) in geometry.triangles.items.iter().enumerate() {
-            prims.push(Prim::Triangle(*t, i as u32));
-        }
-        geometry.visit_all(&mut Gather { prims: &mut prims });
-        prims.extend((0..instances.len() as u32).map(Prim::Instance));
+        let prims = gather(geometry, instances.len());
         let instance_bounds: Vec<Aabb> = instances.iter().map(|i| i.bounds).collect();
-        // Unbounded primitives stay out of the tree (see `Unbounded`), and so do empty
-        // ones (an instance of an object without bounded primitives).
-        let (bounded, bounds): (Vec<usize>, Vec<Aabb>) = prims
-            .iter()
-            .map(|p| p.bounds(&instance_bounds))
-            .enumerate()
-            .filter(|(_, b)| b.is_finite())
-            .unzip();
-        let triangle: Vec<bool> = bounded
-            .iter()
-            .map(|&i| matches!(prims[i], Prim::Triangle(..)))
-            .collect();
+        let (bounded, bounds, triangle) = tree_prims(&prims, &instance_bounds);
         let (binary, order) = build::build(&bounds, &triangle);
         let tree_bounds = binary.first().map_or(Aabb::EMPTY, |n| n.bounds);
         let (nodes, ranges) = wide::collapse(&binary);
-        let order: Vec<usize> = order.iter().map(|&k| bounded[k as usize]).collect();
+        let order: Vec<usize> = order.par_iter().map(|&k| bounded[k as usize]).collect();
         Bvh {
             nodes,
             tree_bounds,

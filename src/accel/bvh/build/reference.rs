@@ -1,62 +1,9 @@
-//! Top-down binned SAH construction (Wald 2007): centroids binned along each axis, the
-//! split with the lowest surface-area cost taken, a leaf made when no split beats
-//! intersecting everything.
-//!
-//! The costs count what a leaf visit does: triangles are tested four at a time (see
-//! `leaf`), so `t` triangles cost `⌈t/4⌉` tests, and every other primitive one test.
+//! The sequential builder the parallel one replaced, kept as the reference it must
+//! reproduce node for node and primitive for primitive.
 
-use super::{MAX_DEPTH, Node};
+use super::{BINS, Count, MAX_LEAF, SAH_DEPTH, TRAVERSAL_COST};
+use crate::accel::bvh::{MAX_DEPTH, Node};
 use crate::math::Aabb;
-
-/// Bins per axis.
-pub const BINS: usize = 16;
-/// Largest leaf the builder makes while a split still helps.
-pub const MAX_LEAF: usize = 8;
-/// Below this depth, median splits take over from SAH so that pathological
-/// distributions (SAH peeling one primitive at a time) still give a shallow tree:
-/// 40 + log2(n / MAX_LEAF) < [`MAX_DEPTH`] for any n < 2^24.
-const SAH_DEPTH: usize = 40;
-/// Cost of a binary node step relative to one primitive test (a sphere, a cone, a
-/// pack of four triangles): a 4-wide node test, which stands for about two binary
-/// levels, costs about half as many instructions as one primitive test, so a binary
-/// step about a quarter (measured with callgrind on the SPD scenes, 2026-11-26:
-/// 0.15 to 0.35 give the same counts within 1%, 1.0 cost 3–7% more).
-const TRAVERSAL_COST: f32 = 0.25;
-
-/// Primitives of a range, by how a leaf tests them: the unit of the SAH costs.
-#[derive(Clone, Copy, Debug, Default)]
-struct Count {
-    /// Triangles, tested four at a time.
-    tris: usize,
-    /// Other primitives, tested one at a time.
-    others: usize,
-}
-
-impl Count {
-    fn of(triangle: bool) -> Count {
-        if triangle {
-            Count { tris: 1, others: 0 }
-        } else {
-            Count { tris: 0, others: 1 }
-        }
-    }
-
-    fn add(self, o: Count) -> Count {
-        Count {
-            tris: self.tris + o.tris,
-            others: self.others + o.others,
-        }
-    }
-
-    fn is_empty(self) -> bool {
-        self.tris + self.others == 0
-    }
-
-    /// Primitive tests a leaf of these costs.
-    fn tests(self) -> f32 {
-        (self.tris.div_ceil(4) + self.others) as f32
-    }
-}
 
 struct Builder<'a> {
     bounds: &'a [Aabb],
