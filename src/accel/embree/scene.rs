@@ -402,6 +402,14 @@ fn embree_tnear(ray: &Ray) -> Option<f32> {
     (ray.is_traceable() && ray.tmax >= tnear).then_some(tnear)
 }
 
+/// The valid mask of a packet of N rays (-1: the ray is cast, 0: it is not). Embree
+/// loads it as one vector, so it must be aligned as the packet is (16, 32 or 64 bytes
+/// for 4, 8 or 16 rays); 64 serves them all.
+#[repr(C, align(64))]
+struct ValidMask<const N: usize>([i32; N]);
+
+const _: () = assert!(std::mem::align_of::<ValidMask<4>>() == 64);
+
 /// `packetN(scene, rays, hits)`: up to N rays through one `rtcIntersectN` call, with the
 /// same conventions as the single-ray query (see [`embree_tnear`]; a ray it refuses is
 /// left out of the packet and misses).
@@ -409,12 +417,12 @@ macro_rules! packet_query {
     ($name:ident, $n:literal, $ty:ident, $query:ident) => {
         fn $name(scene: sys::RTCScene, rays: &[Ray], hits: &mut [Option<Hit>]) {
             let mut p = sys::$ty::default();
-            let mut valid = [0i32; $n];
+            let mut valid = ValidMask([0i32; $n]);
             for (i, ray) in rays.iter().enumerate().take($n) {
                 let Some(tnear) = embree_tnear(ray) else {
                     continue;
                 };
-                valid[i] = -1;
+                valid.0[i] = -1;
                 let r = &mut p.ray;
                 (r.org_x[i], r.org_y[i], r.org_z[i]) = (ray.org.x, ray.org.y, ray.org.z);
                 (r.dir_x[i], r.dir_y[i], r.dir_z[i]) = (ray.dir.x, ray.dir.y, ray.dir.z);
@@ -435,7 +443,7 @@ macro_rules! packet_query {
             rethrow_caught();
             for (i, out) in hits.iter_mut().enumerate().take($n) {
                 let h = &p.hit;
-                *out = (valid[i] != 0 && h.geomID[i] != sys::INVALID_GEOMETRY_ID).then(|| Hit {
+                *out = (valid.0[i] != 0 && h.geomID[i] != sys::INVALID_GEOMETRY_ID).then(|| Hit {
                     t: p.ray.tfar[i],
                     geom_id: h.geomID[i],
                     prim_id: h.primID[i],
@@ -463,12 +471,12 @@ macro_rules! shadow_query {
     ($name:ident, $n:literal, $ty:ident, $query:ident) => {
         fn $name(scene: sys::RTCScene, rays: &[Ray], occluded: &mut [bool]) {
             let mut r = sys::$ty::default();
-            let mut valid = [0i32; $n];
+            let mut valid = ValidMask([0i32; $n]);
             for (i, ray) in rays.iter().enumerate().take($n) {
                 let Some(tnear) = embree_tnear(ray) else {
                     continue;
                 };
-                valid[i] = -1;
+                valid.0[i] = -1;
                 (r.org_x[i], r.org_y[i], r.org_z[i]) = (ray.org.x, ray.org.y, ray.org.z);
                 (r.dir_x[i], r.dir_y[i], r.dir_z[i]) = (ray.dir.x, ray.dir.y, ray.dir.z);
                 (r.tnear[i], r.tfar[i], r.time[i]) = (tnear, ray.tmax, 0.0);
@@ -477,7 +485,7 @@ macro_rules! shadow_query {
             query::$query(&valid, scene, &mut r);
             rethrow_caught();
             for (i, out) in occluded.iter_mut().enumerate().take($n) {
-                *out = valid[i] != 0 && r.tfar[i] == f32::NEG_INFINITY;
+                *out = valid.0[i] != 0 && r.tfar[i] == f32::NEG_INFINITY;
             }
         }
     };
@@ -565,14 +573,19 @@ mod query {
     macro_rules! packet {
         ($name:ident, $n:literal, $ty:ident, $f:ident) => {
             #[inline(always)]
-            pub(super) fn $name(valid: &[i32; $n], scene: sys::RTCScene, rayhit: &mut sys::$ty) {
+            pub(super) fn $name(
+                valid: &super::ValidMask<$n>,
+                scene: sys::RTCScene,
+                rayhit: &mut sys::$ty,
+            ) {
                 let mut ctx = context();
                 ctx.flags = sys::RTCIntersectContextFlags::RTC_INTERSECT_CONTEXT_FLAG_COHERENT;
                 // SAFETY: `scene` is live and committed; `ctx` is initialised as in
-                // `intersect`; `valid` has N entries; `rayhit` is an aligned packet (its
-                // type carries the header's alignment) whose active rays have mask,
+                // `intersect`; `valid` has N entries and is aligned to 64 bytes (Embree
+                // loads it as one vector); `rayhit` is an aligned packet (its type
+                // carries the header's alignment) whose active rays have mask,
                 // tnear <= tfar and invalid ids set.
-                unsafe { sys::$f(valid.as_ptr(), scene, &mut ctx, rayhit) }
+                unsafe { sys::$f(valid.0.as_ptr(), scene, &mut ctx, rayhit) }
             }
         };
     }
@@ -584,14 +597,19 @@ mod query {
     macro_rules! shadow_packet {
         ($name:ident, $n:literal, $ty:ident, $f:ident) => {
             #[inline(always)]
-            pub(super) fn $name(valid: &[i32; $n], scene: sys::RTCScene, ray: &mut sys::$ty) {
+            pub(super) fn $name(
+                valid: &super::ValidMask<$n>,
+                scene: sys::RTCScene,
+                ray: &mut sys::$ty,
+            ) {
                 let mut ctx = context();
                 ctx.flags = sys::RTCIntersectContextFlags::RTC_INTERSECT_CONTEXT_FLAG_COHERENT;
                 // SAFETY: `scene` is live and committed; `ctx` is initialised as in
-                // `intersect`; `valid` has N entries; `ray` is an aligned packet (its
-                // type carries the header's alignment) whose active rays have mask and
-                // tnear <= tfar set.
-                unsafe { sys::$f(valid.as_ptr(), scene, &mut ctx, ray) }
+                // `intersect`; `valid` has N entries and is aligned to 64 bytes (Embree
+                // loads it as one vector); `ray` is an aligned packet (its type carries
+                // the header's alignment) whose active rays have mask and tnear <= tfar
+                // set.
+                unsafe { sys::$f(valid.0.as_ptr(), scene, &mut ctx, ray) }
             }
         };
     }
@@ -668,14 +686,18 @@ mod query {
     macro_rules! packet {
         ($name:ident, $n:literal, $ty:ident, $f:ident) => {
             #[inline(always)]
-            pub(super) fn $name(valid: &[i32; $n], scene: sys::RTCScene, rayhit: &mut sys::$ty) {
+            pub(super) fn $name(
+                valid: &super::ValidMask<$n>,
+                scene: sys::RTCScene,
+                rayhit: &mut sys::$ty,
+            ) {
                 let mut ctx = context();
                 let mut args =
                     intersect_args(&mut ctx, sys::RTCRayQueryFlags::RTC_RAY_QUERY_FLAG_COHERENT);
-                // SAFETY: as in `intersect`; `valid` has N entries; `rayhit` is an
-                // aligned packet whose active rays have mask, tnear <= tfar and invalid
-                // ids set.
-                unsafe { sys::$f(valid.as_ptr(), scene, rayhit, &mut args) }
+                // SAFETY: as in `intersect`; `valid` has N entries and is aligned to 64
+                // bytes (Embree loads it as one vector); `rayhit` is an aligned packet
+                // whose active rays have mask, tnear <= tfar and invalid ids set.
+                unsafe { sys::$f(valid.0.as_ptr(), scene, rayhit, &mut args) }
             }
         };
     }
@@ -687,7 +709,11 @@ mod query {
     macro_rules! shadow_packet {
         ($name:ident, $n:literal, $ty:ident, $f:ident) => {
             #[inline(always)]
-            pub(super) fn $name(valid: &[i32; $n], scene: sys::RTCScene, ray: &mut sys::$ty) {
+            pub(super) fn $name(
+                valid: &super::ValidMask<$n>,
+                scene: sys::RTCScene,
+                ray: &mut sys::$ty,
+            ) {
                 let mut ctx = context();
                 let mut args = sys::RTCOccludedArguments {
                     flags: sys::RTCRayQueryFlags::RTC_RAY_QUERY_FLAG_COHERENT,
@@ -697,9 +723,10 @@ mod query {
                     occluded: None,
                     ..Default::default()
                 };
-                // SAFETY: as in `occluded`; `valid` has N entries; `ray` is an aligned
-                // packet whose active rays have mask and tnear <= tfar set.
-                unsafe { sys::$f(valid.as_ptr(), scene, ray, &mut args) }
+                // SAFETY: as in `occluded`; `valid` has N entries and is aligned to 64
+                // bytes (Embree loads it as one vector); `ray` is an aligned packet whose
+                // active rays have mask and tnear <= tfar set.
+                unsafe { sys::$f(valid.0.as_ptr(), scene, ray, &mut args) }
             }
         };
     }
