@@ -515,6 +515,19 @@ fn a_scene_without_objects_is_warned_about() {
     );
 }
 
+/// `command` run through `bash` on `script`'s terminal (util-linux) in `dir`; `None`,
+/// with a note, where `script` is missing.
+fn on_a_terminal(command: &str, dir: &std::path::Path) -> Option<std::process::Output> {
+    let run = Command::new("script")
+        .args(["-qec", command, "/dev/null"])
+        .current_dir(dir)
+        .output();
+    if run.is_err() {
+        eprintln!("skipped: no `script` to give the render a terminal");
+    }
+    run.ok()
+}
+
 /// On a terminal the progress bar names each phase before the tiles count: a long
 /// load or build is never a silent wait. The terminal is `script`'s (util-linux); the
 /// test is skipped where it is missing.
@@ -526,12 +539,7 @@ fn the_progress_bar_names_the_phases_on_a_terminal() {
         "'{}' render a.nff -o out.png --res 64x48",
         env!("CARGO_BIN_EXE_emray")
     );
-    let run = Command::new("script")
-        .args(["-qec", &command, "/dev/null"])
-        .current_dir(dir.path())
-        .output();
-    let Ok(o) = run else {
-        eprintln!("skipped: no `script` to give the render a terminal");
+    let Some(o) = on_a_terminal(&command, dir.path()) else {
         return;
     };
     assert!(o.status.success(), "{}", stderr(&o));
@@ -550,12 +558,7 @@ fn the_progress_bar_shows_the_share_loaded() {
         "'{}' render 'spd:balls?size=5' -o out.png --res 8x8",
         env!("CARGO_BIN_EXE_emray")
     );
-    let run = Command::new("script")
-        .args(["-qec", &command, "/dev/null"])
-        .current_dir(dir.path())
-        .output();
-    let Ok(o) = run else {
-        eprintln!("skipped: no `script` to give the render a terminal");
+    let Some(o) = on_a_terminal(&command, dir.path()) else {
         return;
     };
     assert!(o.status.success(), "{}", stderr(&o));

@@ -410,6 +410,18 @@ struct ValidMask<const N: usize>([i32; N]);
 
 const _: () = assert!(std::mem::align_of::<ValidMask<4>>() == 64);
 
+/// Lane `$i` of ray packet `$r` (an `RTCRayN`) set to `$ray` from `$tnear`: mask all ones,
+/// no flags, time 0, as [`rtc_ray`] sets a single ray.
+macro_rules! set_lane {
+    ($r:expr, $i:expr, $ray:expr, $tnear:expr) => {{
+        let (r, i, ray) = ($r, $i, $ray);
+        (r.org_x[i], r.org_y[i], r.org_z[i]) = (ray.org.x, ray.org.y, ray.org.z);
+        (r.dir_x[i], r.dir_y[i], r.dir_z[i]) = (ray.dir.x, ray.dir.y, ray.dir.z);
+        (r.tnear[i], r.tfar[i], r.time[i]) = ($tnear, ray.tmax, 0.0);
+        (r.mask[i], r.id[i], r.flags[i]) = (u32::MAX, 0, 0);
+    }};
+}
+
 /// `packetN(scene, rays, hits)`: up to N rays through one `rtcIntersectN` call, with the
 /// same conventions as the single-ray query (see [`embree_tnear`]; a ray it refuses is
 /// left out of the packet and misses).
@@ -423,11 +435,7 @@ macro_rules! packet_query {
                     continue;
                 };
                 valid.0[i] = -1;
-                let r = &mut p.ray;
-                (r.org_x[i], r.org_y[i], r.org_z[i]) = (ray.org.x, ray.org.y, ray.org.z);
-                (r.dir_x[i], r.dir_y[i], r.dir_z[i]) = (ray.dir.x, ray.dir.y, ray.dir.z);
-                (r.tnear[i], r.tfar[i], r.time[i]) = (tnear, ray.tmax, 0.0);
-                (r.mask[i], r.id[i], r.flags[i]) = (u32::MAX, 0, 0);
+                set_lane!(&mut p.ray, i, ray, tnear);
                 let h = &mut p.hit;
                 h.geomID[i] = sys::INVALID_GEOMETRY_ID;
                 h.primID[i] = sys::INVALID_GEOMETRY_ID;
@@ -477,10 +485,7 @@ macro_rules! shadow_query {
                     continue;
                 };
                 valid.0[i] = -1;
-                (r.org_x[i], r.org_y[i], r.org_z[i]) = (ray.org.x, ray.org.y, ray.org.z);
-                (r.dir_x[i], r.dir_y[i], r.dir_z[i]) = (ray.dir.x, ray.dir.y, ray.dir.z);
-                (r.tnear[i], r.tfar[i], r.time[i]) = (tnear, ray.tmax, 0.0);
-                (r.mask[i], r.id[i], r.flags[i]) = (u32::MAX, 0, 0);
+                set_lane!(&mut r, i, ray, tnear);
             }
             query::$query(&valid, scene, &mut r);
             rethrow_caught();
@@ -569,53 +574,33 @@ mod query {
         unsafe { sys::rtcOccluded1(scene, &mut ctx, ray) }
     }
 
-    /// `intersectN(valid, scene, packet)`: `rtcIntersectN` with a coherent context.
+    /// `intersectN`/`occludedN(valid, scene, packet)`: `rtcIntersectN` or `rtcOccludedN`
+    /// (same arguments in Embree 3) with a coherent context.
     macro_rules! packet {
         ($name:ident, $n:literal, $ty:ident, $f:ident) => {
             #[inline(always)]
             pub(super) fn $name(
                 valid: &super::ValidMask<$n>,
                 scene: sys::RTCScene,
-                rayhit: &mut sys::$ty,
+                packet: &mut sys::$ty,
             ) {
                 let mut ctx = context();
                 ctx.flags = sys::RTCIntersectContextFlags::RTC_INTERSECT_CONTEXT_FLAG_COHERENT;
                 // SAFETY: `scene` is live and committed; `ctx` is initialised as in
                 // `intersect`; `valid` has N entries and is aligned to 64 bytes (Embree
-                // loads it as one vector); `rayhit` is an aligned packet (its type
-                // carries the header's alignment) whose active rays have mask,
-                // tnear <= tfar and invalid ids set.
-                unsafe { sys::$f(valid.0.as_ptr(), scene, &mut ctx, rayhit) }
+                // loads it as one vector); `packet` is an aligned packet (its type
+                // carries the header's alignment) whose active rays have mask and
+                // tnear <= tfar set (and, for a hit packet, invalid ids).
+                unsafe { sys::$f(valid.0.as_ptr(), scene, &mut ctx, packet) }
             }
         };
     }
     packet!(intersect4, 4, RTCRayHit4, rtcIntersect4);
     packet!(intersect8, 8, RTCRayHit8, rtcIntersect8);
     packet!(intersect16, 16, RTCRayHit16, rtcIntersect16);
-
-    /// `occludedN(valid, scene, packet)`: `rtcOccludedN` with a coherent context.
-    macro_rules! shadow_packet {
-        ($name:ident, $n:literal, $ty:ident, $f:ident) => {
-            #[inline(always)]
-            pub(super) fn $name(
-                valid: &super::ValidMask<$n>,
-                scene: sys::RTCScene,
-                ray: &mut sys::$ty,
-            ) {
-                let mut ctx = context();
-                ctx.flags = sys::RTCIntersectContextFlags::RTC_INTERSECT_CONTEXT_FLAG_COHERENT;
-                // SAFETY: `scene` is live and committed; `ctx` is initialised as in
-                // `intersect`; `valid` has N entries and is aligned to 64 bytes (Embree
-                // loads it as one vector); `ray` is an aligned packet (its type carries
-                // the header's alignment) whose active rays have mask and tnear <= tfar
-                // set.
-                unsafe { sys::$f(valid.0.as_ptr(), scene, &mut ctx, ray) }
-            }
-        };
-    }
-    shadow_packet!(occluded4, 4, RTCRay4, rtcOccluded4);
-    shadow_packet!(occluded8, 8, RTCRay8, rtcOccluded8);
-    shadow_packet!(occluded16, 16, RTCRay16, rtcOccluded16);
+    packet!(occluded4, 4, RTCRay4, rtcOccluded4);
+    packet!(occluded8, 8, RTCRay8, rtcOccluded8);
+    packet!(occluded16, 16, RTCRay16, rtcOccluded16);
 }
 
 /// `rtcIntersect1`/`rtcOccluded1`, whose arguments differ between Embree 3 and 4.
