@@ -426,7 +426,12 @@ fn collect(
                 }
             }
             Err(mpsc::RecvTimeoutError::Timeout) => {}
-            Err(mpsc::RecvTimeoutError::Disconnected) => return,
+            // Every worker stopped: a worker that saw the signal before this loop did
+            // stops without a word, so the batch was interrupted if the signal came.
+            Err(mpsc::RecvTimeoutError::Disconnected) => {
+                report.interrupted = shared.cancel.is_cancelled();
+                return;
+            }
         }
     }
 }

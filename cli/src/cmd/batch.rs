@@ -133,8 +133,13 @@ fn report_path(b: &Args) -> Result<Option<PathBuf>, Error> {
 /// What went wrong in a batch that ran: failed jobs, a report that could not be
 /// written.
 fn failure(report: &BatchReport, report_error: Option<&str>) -> Option<anyhow::Error> {
-    let jobs =
-        (report.failed > 0).then(|| format!("{} of {} jobs failed", report.failed, report.total));
+    let jobs = if report.failed > 0 {
+        Some(format!("{} of {} jobs failed", report.failed, report.total))
+    } else {
+        // Not interrupted, yet not every job ran: its workers could not start.
+        (report.unfinished > 0 && !report.interrupted)
+            .then(|| format!("{} of {} jobs did not run", report.unfinished, report.total))
+    };
     match (jobs, report_error) {
         (Some(jobs), Some(r)) => Some(anyhow::anyhow!("{jobs}; {r}")),
         (jobs, r) => jobs.as_deref().or(r).map(|e| anyhow::anyhow!("{e}")),
@@ -154,4 +159,33 @@ fn jobs(b: &Args) -> Result<Vec<Job>, Error> {
     batch::expand_scene_args(&b.scenes)
         .and_then(|s| batch::jobs_from_scenes(&s, template, &b.options))
         .map_err(|e| Error::Usage(e.into()))
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+
+    fn report(ok: usize, failed: usize, unfinished: usize, interrupted: bool) -> BatchReport {
+        BatchReport {
+            shard: None,
+            total: ok + failed + unfinished,
+            ok,
+            failed,
+            skipped: 0,
+            unfinished,
+            interrupted,
+            wall_ms: 0.0,
+            jobs: Vec::new(),
+        }
+    }
+
+    #[test]
+    fn a_batch_fails_when_a_job_failed_or_did_not_run_unasked() {
+        assert!(failure(&report(3, 0, 0, false), None).is_none());
+        assert!(failure(&report(1, 0, 2, true), None).is_none());
+        let e = failure(&report(1, 0, 2, false), None).unwrap();
+        assert_eq!(e.to_string(), "2 of 3 jobs did not run");
+        let e = failure(&report(1, 1, 1, false), Some("report not written")).unwrap();
+        assert_eq!(e.to_string(), "1 of 3 jobs failed; report not written");
+    }
 }
