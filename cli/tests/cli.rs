@@ -549,13 +549,22 @@ fn the_progress_bar_names_the_phases_on_a_terminal() {
     assert!(dir.path().join("out.png").exists());
 }
 
-/// A load shows how far it has come: a generated database of 66 000 spheres tells its
-/// first share when 16 384 are made, long before the end.
+/// A load shows how far it has come, in a render's bar and a batch job's: a generated
+/// database of 66 000 spheres tells its first share when 16 384 are made, long before
+/// the end.
 #[test]
 fn the_progress_bar_shows_the_share_loaded() {
+    for command in ["render", "batch"] {
+        shares_loaded_on_the_bar(command);
+    }
+}
+
+/// `emray COMMAND` of a generated database on a terminal shows a share below 100 %,
+/// then larger ones up to 100 %.
+fn shares_loaded_on_the_bar(command: &str) {
     let dir = tempfile::tempdir().unwrap();
     let command = format!(
-        "'{}' render 'spd:balls?size=5' -o out.png --res 8x8",
+        "'{}' {command} 'spd:balls?size=5' -o out.png --res 8x8",
         env!("CARGO_BIN_EXE_emray")
     );
     let Some(o) = on_a_terminal(&command, dir.path()) else {
@@ -564,7 +573,7 @@ fn the_progress_bar_shows_the_share_loaded() {
     assert!(o.status.success(), "{}", stderr(&o));
     let screen = String::from_utf8_lossy(&o.stdout);
     let shares: Vec<u32> = screen
-        .split("spd:balls?size=5: loading ")
+        .split(": loading ")
         .skip(1)
         .filter_map(|s| s.split('%').next()?.parse().ok())
         .collect();

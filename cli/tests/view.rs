@@ -127,6 +127,7 @@ fn the_image_and_the_explanation_are_the_commands_own() {
     );
     assert!(r["total"].as_u64().unwrap() > 1, "{r}");
     assert_eq!(r["done"], r["total"]);
+    assert_eq!(r["loaded"], 100, "the load told its end: {r}");
     for phase in ["load", "build", "render"] {
         assert!(r["timings"][phase].as_f64().unwrap() >= 0.0, "{r}");
     }

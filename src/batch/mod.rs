@@ -12,7 +12,9 @@ pub mod manifest;
 pub mod merge;
 mod runner;
 
-pub use runner::{BatchOptions, BatchReport, Cancel, JobRecord, JobStatus, Observer, run};
+pub use runner::{
+    BatchOptions, BatchReport, Cancel, JobPhase, JobRecord, JobStatus, Observer, run,
+};
 
 use crate::job::template::TemplateError;
 use crate::job::{Band, Job, JobError, RenderOptions, SceneSource};

@@ -139,6 +139,11 @@ pub trait Observer {
         let _ = (index, job);
     }
 
+    /// Job `index` is in `phase` (told from the start of its load to its first tile).
+    fn phase(&mut self, index: usize, phase: JobPhase) {
+        let _ = (index, phase);
+    }
+
     /// Job `index` has rendered `done` of its `total` tiles.
     fn progress(&mut self, index: usize, done: usize, total: usize) {
         let _ = (index, done, total);
@@ -168,6 +173,36 @@ pub trait Observer {
 /// Tells nothing.
 impl Observer for () {}
 
+/// What a job is doing before its first tile.
+#[derive(Clone, Copy, Debug, PartialEq, Eq)]
+pub enum JobPhase {
+    /// Reading or generating its scene; `done` of `total` units loaded (bytes of an
+    /// NFF or OBJ file, primitives of a generated database) once the load tells.
+    Loading {
+        /// Units done.
+        done: u64,
+        /// Units in all (0 until the load tells).
+        total: u64,
+    },
+    /// Building its backend.
+    Building,
+    /// Rendering (solving the radiosity first, in two-pass mode).
+    Rendering,
+}
+
+impl JobPhase {
+    /// The phase a job event starts or advances, if any.
+    fn of(event: &Event<'_>) -> Option<JobPhase> {
+        match *event {
+            Event::Loading => Some(JobPhase::Loading { done: 0, total: 0 }),
+            Event::Loaded { done, total } => Some(JobPhase::Loading { done, total }),
+            Event::Building => Some(JobPhase::Building),
+            Event::Rendering => Some(JobPhase::Rendering),
+            _ => None,
+        }
+    }
+}
+
 /// What the workers of one batch share.
 struct Shared {
     jobs: Vec<Job>,
@@ -186,17 +221,20 @@ struct Shared {
 
 enum Msg {
     Started(usize),
+    Phase(usize, JobPhase),
     Progress(usize, usize, usize),
     Writing(usize),
     Finished(Box<JobRecord>),
 }
 
-/// Load and render one job, telling `progress` of its tiles; the error is the
+/// Load and render one job, telling `tell` of its phases and tiles; the error is the
 /// report's `error`.
-fn render_job(job: &Job, progress: &(dyn Fn(usize, usize) + Sync)) -> Result<Rendered, String> {
+fn render_job(job: &Job, tell: &(dyn Fn(Msg) + Sync), i: usize) -> Result<Rendered, String> {
     let observer = |e: Event<'_>| {
         if let Event::Tiles { done, total } = e {
-            progress(done, total)
+            tell(Msg::Progress(i, done, total));
+        } else if let Some(phase) = JobPhase::of(&e) {
+            tell(Msg::Phase(i, phase));
         }
     };
     crate::job::render(job, &observer).map_err(|e| e.to_string())
@@ -270,11 +308,11 @@ fn run_job(
         return Some(record);
     }
     let txp = tx.clone();
-    let progress = move |d: usize, t: usize| {
-        let _ = txp.send(Msg::Progress(i, d, t));
+    let tell = move |m: Msg| {
+        let _ = txp.send(m);
     };
     let result = std::panic::catch_unwind(std::panic::AssertUnwindSafe(|| {
-        pool.install(|| render_job(job, &progress))
+        pool.install(|| render_job(job, &tell, i))
     }));
     // The image is written and the job reported with the gate held shared, and not at
     // all once the batch is cancelled (see `Shared::write_gate`).
@@ -405,6 +443,7 @@ fn collect(
                 report.jobs[i].status = JobStatus::Interrupted;
                 observer.started(i, &shared.jobs[i]);
             }
+            Ok(Msg::Phase(i, phase)) => observer.phase(i, phase),
             Ok(Msg::Progress(i, d, t)) => observer.progress(i, d, t),
             Ok(Msg::Writing(i)) => observer.writing(i, &shared.jobs[i]),
             Ok(Msg::Finished(r)) => {
@@ -433,5 +472,76 @@ fn collect(
                 return;
             }
         }
+    }
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+    use crate::job::{RenderOptions, Res, SceneSource};
+
+    /// Everything a batch tells, in order.
+    #[derive(Default)]
+    struct Told(Vec<String>);
+
+    impl Observer for Told {
+        fn started(&mut self, index: usize, _: &Job) {
+            self.0.push(format!("started {index}"));
+        }
+        fn phase(&mut self, index: usize, phase: JobPhase) {
+            self.0.push(format!("{index} {phase:?}"));
+        }
+        fn progress(&mut self, index: usize, done: usize, total: usize) {
+            self.0.push(format!("{index} tiles {done}/{total}"));
+        }
+        fn finished(&mut self, r: &JobRecord, _: usize, _: usize, _: Option<f64>) {
+            self.0.push(format!("finished {} {:?}", r.index, r.status));
+        }
+    }
+
+    #[test]
+    fn a_job_tells_its_phases_before_its_tiles() {
+        let dir = tempfile::tempdir().unwrap();
+        let options = RenderOptions {
+            res: Some(Res {
+                width: 16,
+                height: 16,
+            }),
+            ..RenderOptions::default()
+        };
+        let scene = SceneSource::File("spd:balls?size=1".into());
+        let job = Job::render(scene, options, Some(dir.path().join("b.png")));
+        let mut told = Told::default();
+        let opts = BatchOptions {
+            threads: Some(1),
+            jobs: 1,
+            skip_existing: false,
+            report: None,
+            shard: None,
+        };
+        let report = run(vec![job], &opts, &Cancel::default(), &mut told);
+        assert_eq!(report.ok, 1, "{:?}", told.0);
+        let at = |what: &str| told.0.iter().position(|t| t.starts_with(what));
+        let loading = at("0 Loading { done: 0, total: 0 }").expect("loading told");
+        let loaded = told.0.iter().position(|t| {
+            t.starts_with("0 Loading { done: ")
+                && t.contains("total: ")
+                && !t.contains("total: 0 }")
+        });
+        let building = at("0 Building").expect("building told");
+        let rendering = at("0 Rendering").expect("rendering told");
+        let first_tile = at("0 tiles").expect("tiles told");
+        assert!(at("started 0") < Some(loading));
+        assert!(
+            loaded.is_some_and(|l| loading < l && l < building),
+            "{:?}",
+            told.0
+        );
+        assert!(
+            building < rendering && rendering < first_tile,
+            "{:?}",
+            told.0
+        );
+        assert_eq!(told.0.last().map(String::as_str), Some("finished 0 Ok"));
     }
 }

@@ -6,7 +6,7 @@
 
 use super::error::error_line;
 use super::eta;
-use emray::batch::{JobRecord, JobStatus, Observer};
+use emray::batch::{JobPhase, JobRecord, JobStatus, Observer};
 use emray::job::Job;
 use emray::output::OutputError;
 use indicatif::{MultiProgress, ProgressBar, ProgressStyle};
@@ -232,6 +232,18 @@ impl Observer for BatchDisplay {
         if let Some((m, _)) = &self.bars {
             let b = m.add(spinner_bar(&job.name, "  "));
             self.job_bars.insert(index, Tiles::new(b, &job.name));
+        }
+    }
+
+    fn phase(&mut self, index: usize, phase: JobPhase) {
+        let Some(t) = self.job_bars.get(&index) else {
+            return;
+        };
+        match phase {
+            JobPhase::Loading { done, total } if total > 0 => t.loaded(done, total),
+            JobPhase::Loading { .. } => t.phase("loading"),
+            JobPhase::Building => t.phase("building"),
+            JobPhase::Rendering => t.phase("rendering"),
         }
     }
 

@@ -115,6 +115,8 @@ struct Progress {
     size: Option<(u32, u32)>,
     done: usize,
     total: usize,
+    /// The share of the scene loaded, in percent, once the load has told it.
+    loaded: Option<u64>,
     tiles: Vec<Tile>,
     /// When loading, building, rendering began and rendering ended.
     marks: [Option<Instant>; 4],
@@ -582,6 +584,7 @@ impl Session {
                 "height": p.size.map(|s| s.1),
                 "done": p.done,
                 "total": p.total,
+                "loaded": p.loaded,
                 "timings": p.timings(),
                 "error": p.error,
                 "tiles": tiles,
@@ -651,6 +654,9 @@ impl Observer for Watcher<'_> {
             Event::Building => mark(1, Phase::Building),
             Event::Rendering => mark(2, Phase::Rendering),
             Event::Rendered => mark(3, Phase::Writing),
+            Event::Loaded { done, total } if total > 0 => {
+                p.loaded = Some(done.min(total) * 100 / total);
+            }
             Event::Resolved { width, height } => p.size = Some((width, height)),
             Event::Tiles { done, total } => {
                 p.done = p.done.max(done);

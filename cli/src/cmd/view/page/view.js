@@ -127,7 +127,8 @@ function update(st) {
   if (r.width) resize(r.width, r.height);
   for (const t of r.tiles) drawTile(t);
   since = r.next;
-  $('phase').textContent = r.phase + (r.pass ? ` on ${r.pass}` : '') + (r.total ? ` ${r.done}/${r.total} tiles` : '');
+  const loaded = r.phase === 'loading' && r.loaded !== null ? ` ${r.loaded}%` : '';
+  $('phase').textContent = r.phase + loaded + (r.pass ? ` on ${r.pass}` : '') + (r.total ? ` ${r.done}/${r.total} tiles` : '');
   $('progress').value = r.total ? r.done / r.total : (r.phase === 'done' ? 1 : 0);
   const t = r.timings;
   $('timings').textContent = `load ${fmt(t.load)} · build ${fmt(t.build)} · render ${fmt(t.render)}`;
