@@ -58,6 +58,12 @@ fn renders_a_scene_to_png_with_stats() {
     assert_eq!(json["prims"]["spheres"], 1);
     assert_eq!(json["rays"]["eye"], 40 * 30);
     assert_eq!(json["backend"], "bvh");
+    if cfg!(target_os = "linux") {
+        // At least the image's buffers: more than a megabyte, less than the machine.
+        let peak = json["peak_resident_bytes"].as_u64().unwrap();
+        assert!((1 << 20..1 << 40).contains(&peak), "{json}");
+        assert!(out.contains("; peak resident "), "{out}");
+    }
 }
 
 #[test]

@@ -295,7 +295,7 @@ pub fn run_child(spec: &RunSpec) -> Result<RunResult, BenchError> {
         build_ms: m.build_ms,
         ms: m.ms,
         rays: Rays::from(m.counts),
-        peak_kib: peak_rss_kib(),
+        peak_kib: crate::job::peak_resident_bytes().map(|b| b / 1024),
         accel,
         cpu_ms: m.cpu_ms,
         steal_ms: m.steal_ms,
@@ -350,15 +350,6 @@ fn measure_raw(scene: &Scene, options: &RenderOptions) -> Result<Measure, BenchE
     let mut m = crate::accel::build(scene, &resolved.backend, work)?;
     m.prims = scene.prim_count_with_instances();
     Ok(m)
-}
-
-/// This process's peak resident set size in KiB, from `/proc/self/status` (Linux).
-pub fn peak_rss_kib() -> Option<u64> {
-    let status = std::fs::read_to_string("/proc/self/status").ok()?;
-    status
-        .lines()
-        .find_map(|l| l.strip_prefix("VmHWM:"))
-        .and_then(|v| v.trim().trim_end_matches("kB").trim().parse().ok())
 }
 
 /// Run `spec` in a child process `exe bench --child JSON` and parse its answer.

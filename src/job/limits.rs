@@ -1,9 +1,25 @@
 //! Memory limits: a render is refused, with the numbers, before its large buffers and
-//! the acceleration structure are allocated, when its estimate exceeds the limit.
+//! the acceleration structure are allocated, when its estimate exceeds the limit; and
+//! the memory the process did use at its peak, for the reports.
 
 use crate::render::{Region, RenderSettings};
 use crate::scene::Scene;
 use std::path::{Path, PathBuf};
+
+/// This process's peak resident memory so far in bytes (`VmHWM` of
+/// `/proc/self/status`), where the system tells it (Linux).
+pub fn peak_resident_bytes() -> Option<u64> {
+    let status = std::fs::read_to_string("/proc/self/status").ok()?;
+    let kib: u64 = status
+        .lines()
+        .find_map(|l| l.strip_prefix("VmHWM:"))?
+        .trim()
+        .trim_end_matches("kB")
+        .trim()
+        .parse()
+        .ok()?;
+    Some(kib * 1024)
+}
 
 /// Bytes per primitive allowed for the acceleration structure (either backend's nodes
 /// and references, with room to spare).

@@ -24,7 +24,7 @@ pub mod template;
 pub mod values;
 mod work;
 
-pub use limits::MemoryLimitError;
+pub use limits::{MemoryLimitError, peak_resident_bytes};
 pub use options::{AaMode, FormFactors, Gi, RadiosityOptions, RenderOptions, Solver};
 pub use pipeline::{
     Event, Job, JobError, Observer, Outputs, Rendered, Task, check_distinct, plan, render, run,

@@ -66,6 +66,10 @@ pub struct Report {
     pub accel_bytes: usize,
     /// Primitives in the backend's structure ([`AccelStats::prims`]).
     pub accel_prims: usize,
+    /// The process's peak resident memory in bytes when the render ended (`VmHWM`:
+    /// the load, the build and the render's buffers at their largest; in a batch, the
+    /// largest of its jobs so far); `None` where the system does not tell it.
+    pub peak_resident_bytes: Option<u64>,
     /// The primitive kinds the backend holds and dispatches to
     /// ([`AccelStats::kinds`]), e.g. `triangles, spheres`.
     pub kinds: String,
@@ -161,15 +165,24 @@ impl Report {
             kinds: crate::accel::kinds_summary(&accel.kinds),
             accel_bytes: accel.bytes,
             accel_prims: accel.prims,
+            peak_resident_bytes: super::peak_resident_bytes(),
         }
     }
 
-    /// The backend's memory for `--stats`: bytes, and bytes per primitive.
+    /// The memory line of `--stats`: the backend's bytes and the process's peak
+    /// resident bytes, each with its bytes per primitive.
     fn memory(&self) -> String {
-        match (self.accel_bytes, self.accel_prims) {
-            (0, _) => "unknown".to_string(),
-            (b, 0) => format!("{b} bytes"),
-            (b, n) => format!("{b} bytes, {:.1} per primitive", b as f64 / n as f64),
+        let per_prim = |b: u64| match self.accel_prims {
+            0 => format!("{b} bytes"),
+            n => format!("{b} bytes, {:.1} per primitive", b as f64 / n as f64),
+        };
+        let backend = match self.accel_bytes {
+            0 => "unknown".to_string(),
+            b => per_prim(b as u64),
+        };
+        match self.peak_resident_bytes {
+            Some(peak) => format!("backend {backend}; peak resident {}", per_prim(peak)),
+            None => format!("backend {backend}"),
         }
     }
 
