@@ -152,6 +152,9 @@ pub struct BackendOptions {
     /// Embree's `RTC_SCENE_FLAG_ROBUST` on every scene it commits (on by default: no
     /// pinholes between triangles sharing an edge; the BVH is watertight anyway).
     pub embree_robust: bool,
+    /// Embree's `RTC_SCENE_FLAG_COMPACT` on every scene it commits; `None` chooses by
+    /// the scene's size ([`embree_compact_for`]).
+    pub embree_compact: Option<bool>,
     /// Coherent rays (a tile's eye rays with one sample per pixel) are cast in packets
     /// of this many (4, 8 or 16: Embree's `rtcIntersect4/8/16`); 0 casts them one by
     /// one. Analytic shapes give the same hits either way; Embree's packet triangle
@@ -187,6 +190,20 @@ pub fn shadow_packet_width_for(kinds: &[(Kind, usize)]) -> u32 {
     }
 }
 
+/// Primitives from which Embree builds compact structures by default.
+pub const EMBREE_COMPACT_FROM: usize = 1 << 22;
+
+/// Whether Embree builds a scene of `prims` primitives compact when not told: from
+/// [`EMBREE_COMPACT_FROM`] on. Measured on balls at 5.4 M spheres (2 threads, six
+/// interleaved runs): the peak resident memory is 817 MB instead of 891 MB and the
+/// build steadier (2.5–2.7 s, against 2.5–3.7 s); at 0.6 M spheres the build gains
+/// 2–6 %. A compact structure costs the render 0–16 % (jacks +16 %, gears +12 %, rings
+/// and tetra nothing; 512² `--spd`), which only a scene whose build outweighs its
+/// render repays.
+pub fn embree_compact_for(prims: usize) -> bool {
+    prims >= EMBREE_COMPACT_FROM
+}
+
 impl BackendOptions {
     /// `backend` with the default options: medium build quality, robust (watertight)
     /// traversal, packets of [`DEFAULT_PACKET_WIDTH`].
@@ -195,6 +212,7 @@ impl BackendOptions {
             backend,
             embree_quality: EmbreeQuality::default(),
             embree_robust: true,
+            embree_compact: None,
             packet_width: DEFAULT_PACKET_WIDTH,
             shadow_packet_width: None,
         }

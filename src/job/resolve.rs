@@ -308,6 +308,7 @@ impl RenderOptions {
             backend: self.backend.unwrap_or_else(Backend::default_available),
             embree_quality: self.embree_quality.unwrap_or_default(),
             embree_robust: self.embree_fast != Some(true),
+            embree_compact: self.embree_compact,
             packet_width: self.packet_width.unwrap_or(DEFAULT_PACKET_WIDTH),
             shadow_packet_width: self.shadow_packet_width,
         }

@@ -26,7 +26,9 @@ mod tests;
 
 pub use error::EmbreeError;
 
-use crate::accel::{Accel, AccelStats, Backend, BackendOptions, Hit, shadow_packet_width_for};
+use crate::accel::{
+    Accel, AccelStats, Backend, BackendOptions, Hit, embree_compact_for, shadow_packet_width_for,
+};
 use crate::math::Ray;
 use crate::scene::Scene;
 use device::Device;
@@ -82,18 +84,23 @@ impl EmbreeAccel {
     pub fn build_with(scene: &Scene, options: &BackendOptions) -> Result<EmbreeAccel, EmbreeError> {
         let device = shared_device(rayon::current_num_threads())?;
         let (quality, robust) = (options.embree_quality, options.embree_robust);
+        let prims = scene.prim_count_with_instances();
+        let compact = options
+            .embree_compact
+            .unwrap_or_else(|| embree_compact_for(prims));
         let before = device.allocated_bytes();
-        let committed = CommittedScene::build(&device, scene, quality, robust)?;
+        let committed = CommittedScene::build(&device, scene, quality, robust, compact)?;
         let shadow_packet_width = options
             .shadow_packet_width
             .unwrap_or_else(|| shadow_packet_width_for(&committed.kinds));
         let api = if cfg!(embree4) { "embree4" } else { "embree3" };
         let detail = format!(
-            "{}, {api} API (headers {}), {} traversal, {} build quality, shadow rays {}",
+            "{}, {api} API (headers {}), {} traversal, {} build quality{}, shadow rays {}",
             device.describe(),
             env!("EMRAY_EMBREE_HEADER_VERSION"),
             if robust { "robust" } else { "fast" },
             quality.name(),
+            if compact { ", compact" } else { "" },
             match shadow_packet_width {
                 4 | 8 | 16 => format!("in packets of {shadow_packet_width}"),
                 _ => "one by one".to_string(),
@@ -107,7 +114,7 @@ impl EmbreeAccel {
             bytes: device.allocated_bytes().saturating_sub(before) + committed.rust_bytes(),
             scene: committed,
             device,
-            prims: scene.prim_count_with_instances(),
+            prims,
             detail,
             packet_width: options.packet_width,
             shadow_packet_width,

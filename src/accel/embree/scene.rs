@@ -115,9 +115,23 @@ unsafe impl Send for CommittedScene {}
 // `OnceLock`, and only during the commit.
 unsafe impl Sync for CommittedScene {}
 
+/// The flags of every scene emray commits. Robust traversal takes no arithmetic
+/// shortcuts that can miss rays through shared edges and vertices; a compact scene
+/// takes less memory and builds faster, and traverses somewhat slower.
+fn scene_flags(robust: bool, compact: bool) -> sys::RTCSceneFlags {
+    let mut flags = sys::RTCSceneFlags::RTC_SCENE_FLAG_NONE;
+    if robust {
+        flags |= sys::RTCSceneFlags::RTC_SCENE_FLAG_ROBUST;
+    }
+    if compact {
+        flags |= sys::RTCSceneFlags::RTC_SCENE_FLAG_COMPACT;
+    }
+    flags
+}
+
 impl Level {
-    /// A new, empty scene, with robust traversal if `robust`.
-    fn new(device: &Device, robust: bool) -> Result<Level, EmbreeError> {
+    /// A new, empty scene with `flags`.
+    fn new(device: &Device, flags: sys::RTCSceneFlags) -> Result<Level, EmbreeError> {
         // SAFETY: `device` is live.
         let raw = unsafe { sys::rtcNewScene(device.raw()) };
         if raw.is_null() {
@@ -131,14 +145,7 @@ impl Level {
             raw,
             user: UserData::default(),
         };
-        // Robust traversal: no arithmetic shortcuts that can miss rays through shared
-        // edges and vertices.
-        let flags = if robust {
-            sys::RTCSceneFlags::RTC_SCENE_FLAG_ROBUST
-        } else {
-            sys::RTCSceneFlags::RTC_SCENE_FLAG_NONE
-        };
-        // SAFETY: `raw` is a live, uncommitted scene; both flag values are valid.
+        // SAFETY: `raw` is a live, uncommitted scene; `flags` are Embree's scene flags.
         unsafe { sys::rtcSetSceneFlags(raw, flags) };
         device.check("rtcSetSceneFlags")?;
         Ok(level)
@@ -224,12 +231,14 @@ impl CommittedScene {
     }
 
     /// Build and commit the scene of `scene`'s primitives at build quality `quality`,
-    /// every level with `RTC_SCENE_FLAG_ROBUST` if `robust`.
+    /// every level with `RTC_SCENE_FLAG_ROBUST` if `robust` and `RTC_SCENE_FLAG_COMPACT`
+    /// if `compact`.
     pub(super) fn build(
         device: &Device,
         scene: &crate::scene::Scene,
         quality: crate::accel::EmbreeQuality,
         robust: bool,
+        compact: bool,
     ) -> Result<CommittedScene, EmbreeError> {
         use crate::accel::EmbreeQuality as Q;
         let quality = match quality {
@@ -237,15 +246,16 @@ impl CommittedScene {
             Q::Medium => sys::RTCBuildQuality::RTC_BUILD_QUALITY_MEDIUM,
             Q::High => sys::RTCBuildQuality::RTC_BUILD_QUALITY_HIGH,
         };
+        let flags = scene_flags(robust, compact);
         let mut kinds = Vec::new();
         let mut objects = Vec::with_capacity(scene.objects.len());
         for object in &scene.objects {
-            let mut level = Level::new(device, robust)?;
+            let mut level = Level::new(device, flags)?;
             level.attach_geometry(device, object, &mut kinds)?;
             level.commit(device, quality)?;
             objects.push(level);
         }
-        let mut top = Level::new(device, robust)?;
+        let mut top = Level::new(device, flags)?;
         top.attach_geometry(device, &scene.geometry, &mut kinds)?;
         for (i, inst) in (0u32..).zip(&scene.instances) {
             let object = inst.object as usize;

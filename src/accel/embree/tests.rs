@@ -609,6 +609,31 @@ fn packets_find_what_single_rays_find() {
     }
 }
 
+/// A compact scene (`RTC_SCENE_FLAG_COMPACT`) answers every query as the default one:
+/// the same primitive at the same distance, the same shadow answers; its description
+/// says so.
+#[test]
+fn a_compact_scene_answers_as_the_default_one() {
+    let s = triangles_spheres_cones();
+    let rays = packet_rays();
+    let with = |compact| {
+        let options = BackendOptions {
+            embree_compact: Some(compact),
+            ..BackendOptions::new(Backend::Embree)
+        };
+        EmbreeAccel::build_with(&s, &options).unwrap()
+    };
+    let (plain, compact) = (with(false), with(true));
+    assert!(compact.stats().detail.contains(", compact"));
+    assert!(!plain.stats().detail.contains("compact"));
+    for r in &rays {
+        assert_eq!(plain.intersect(r), compact.intersect(r), "{r:?}");
+        assert_eq!(plain.occluded(r), compact.occluded(r), "{r:?}");
+    }
+    assert!(!crate::accel::embree_compact_for(1 << 20));
+    assert!(crate::accel::embree_compact_for(1 << 22));
+}
+
 /// Shadow rays in packets of 4, 8 and 16 are answered as one by one, with and without
 /// an unbounded primitive (then cast one by one), rays with empty or NaN intervals
 /// included.
