@@ -124,7 +124,7 @@ fn of_geometry(geometry: &Geometry) -> Vec<(Kind, u32, Shape)> {
 /// Collects the unbounded primitives of the lists it visits.
 struct Collect(Vec<(Kind, u32, Shape)>);
 
-impl KindVisitor for Collect {
+impl KindVisitor<'_> for Collect {
     type Output = ();
     fn visit<P: Analytic>(&mut self, list: &Prims<P>) {
         for (i, prim, _) in list.iter() {

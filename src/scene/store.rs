@@ -74,12 +74,13 @@ impl<T> Prims<T> {
 
 /// Code run on one kind's list at its static type: [`Geometry::visit`] calls it for one
 /// kind, [`Geometry::visit_all`] for every analytic kind in geometry-id order. The
-/// kind is `P::KIND`.
-pub trait KindVisitor {
+/// kind is `P::KIND`; the lists are borrowed for `'g` (a visitor that keeps them, as
+/// Embree's user geometries do, names it).
+pub trait KindVisitor<'g> {
     /// What one visit returns.
     type Output;
     /// Work on the list of kind `P::KIND`.
-    fn visit<P: Analytic>(&mut self, prims: &Prims<P>) -> Self::Output;
+    fn visit<P: Analytic>(&mut self, prims: &'g Prims<P>) -> Self::Output;
 }
 
 /// One analytic primitive of a store, as [`Geometry::shapes`] lists them.
@@ -176,7 +177,11 @@ macro_rules! define_store {
 
             /// Run `visitor` on the list of `kind` (`None` for triangles).
             #[inline]
-            pub fn visit<V: KindVisitor>(&self, kind: Kind, visitor: &mut V) -> Option<V::Output> {
+            pub fn visit<'g, V: KindVisitor<'g>>(
+                &'g self,
+                kind: Kind,
+                visitor: &mut V,
+            ) -> Option<V::Output> {
                 match kind {
                     Kind::Triangle => None,
                     $(Kind::$v => Some(visitor.visit(&self.$field)),)*
@@ -185,14 +190,14 @@ macro_rules! define_store {
 
             /// Run `visitor` on the list of every analytic kind, in geometry-id order
             /// (empty lists included).
-            pub fn visit_all<V: KindVisitor<Output = ()>>(&self, visitor: &mut V) {
+            pub fn visit_all<'g, V: KindVisitor<'g, Output = ()>>(&'g self, visitor: &mut V) {
                 $(visitor.visit(&self.$field);)*
             }
 
             /// As [`Geometry::visit_all`], stopping at the first error.
-            pub fn try_visit_all<V, E>(&self, visitor: &mut V) -> Result<(), E>
+            pub fn try_visit_all<'g, V, E>(&'g self, visitor: &mut V) -> Result<(), E>
             where
-                V: KindVisitor<Output = Result<(), E>>,
+                V: KindVisitor<'g, Output = Result<(), E>>,
             {
                 $(visitor.visit(&self.$field)?;)*
                 Ok(())
@@ -430,7 +435,7 @@ impl Geometry {
 /// Primitive `.0` of a list as a [`Shape`].
 struct ShapeAt(usize);
 
-impl KindVisitor for ShapeAt {
+impl KindVisitor<'_> for ShapeAt {
     type Output = Option<Shape>;
     fn visit<P: Analytic>(&mut self, prims: &Prims<P>) -> Option<Shape> {
         prims.items.get(self.0).map(|p| p.clone().into())
@@ -440,7 +445,7 @@ impl KindVisitor for ShapeAt {
 /// Primitive `.0` of a list as a [`ShapeEntry`].
 struct EntryAt(usize);
 
-impl KindVisitor for EntryAt {
+impl KindVisitor<'_> for EntryAt {
     type Output = ShapeEntry;
     fn visit<P: Analytic>(&mut self, prims: &Prims<P>) -> ShapeEntry {
         ShapeEntry {
@@ -455,7 +460,7 @@ impl KindVisitor for EntryAt {
 /// The bounds of primitive `.0` of a list.
 struct BoundsAt(usize);
 
-impl KindVisitor for BoundsAt {
+impl KindVisitor<'_> for BoundsAt {
     type Output = Aabb;
     fn visit<P: Analytic>(&mut self, prims: &Prims<P>) -> Aabb {
         prims.items[self.0].bounds()
@@ -465,7 +470,7 @@ impl KindVisitor for BoundsAt {
 /// The union of the bounds of every primitive visited, starting from `.0`.
 struct AllBounds(Aabb);
 
-impl KindVisitor for AllBounds {
+impl KindVisitor<'_> for AllBounds {
     type Output = ();
     fn visit<P: Analytic>(&mut self, prims: &Prims<P>) {
         for p in &prims.items {
@@ -481,7 +486,7 @@ struct ParamAt {
     ng: Vec3,
 }
 
-impl KindVisitor for ParamAt {
+impl KindVisitor<'_> for ParamAt {
     type Output = Param;
     #[inline]
     fn visit<P: Analytic>(&mut self, prims: &Prims<P>) -> Param {
@@ -496,7 +501,7 @@ struct SurfaceAt<'a> {
     ray: &'a Ray,
 }
 
-impl KindVisitor for SurfaceAt<'_> {
+impl KindVisitor<'_> for SurfaceAt<'_> {
     type Output = Surface;
     #[inline]
     fn visit<P: Analytic>(&mut self, prims: &Prims<P>) -> Surface {

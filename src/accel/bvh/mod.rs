@@ -45,7 +45,7 @@ struct Gather<'a> {
     prims: &'a mut Vec<Prim>,
 }
 
-impl KindVisitor for Gather<'_> {
+impl KindVisitor<'_> for Gather<'_> {
     type Output = ();
     fn visit<P: Analytic>(&mut self, list: &Prims<P>) {
         let shapes = (list.items.par_iter().enumerate())

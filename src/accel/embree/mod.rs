@@ -35,16 +35,16 @@ use device::Device;
 use scene::CommittedScene;
 use std::sync::{Arc, Mutex};
 
-/// A committed Embree scene over a [`Scene`]'s primitives.
+/// A committed Embree scene over a [`Scene`]'s primitives, which it borrows: its
+/// user-geometry callbacks read the scene's analytic primitives where they are.
 ///
 /// Immutable once built, and `Send + Sync`: queries run from any number of threads.
-/// Dropping it releases the scene (then frees the primitive data its user-geometry
-/// callbacks read), then its hold on the device, which the process shares
-/// (`shared_device`).
+/// Dropping it releases the scene (then frees the user data its callbacks read), then
+/// its hold on the device, which the process shares (`shared_device`).
 #[derive(Debug)]
-pub struct EmbreeAccel {
+pub struct EmbreeAccel<'s> {
     // Fields drop in declaration order: the scene before the device.
-    scene: CommittedScene,
+    scene: CommittedScene<'s>,
     device: Arc<Device>,
     prims: usize,
     bytes: usize,
@@ -70,9 +70,9 @@ fn shared_device(threads: usize) -> Result<Arc<Device>, EmbreeError> {
     Ok(device)
 }
 
-impl EmbreeAccel {
+impl<'s> EmbreeAccel<'s> {
     /// Build with emray's defaults: medium build quality, robust traversal.
-    pub fn build(scene: &Scene) -> Result<EmbreeAccel, EmbreeError> {
+    pub fn build(scene: &'s Scene) -> Result<EmbreeAccel<'s>, EmbreeError> {
         EmbreeAccel::build_with(scene, &BackendOptions::new(Backend::Embree))
     }
 
@@ -81,7 +81,10 @@ impl EmbreeAccel {
     /// (`RTC_SCENE_FLAG_ROBUST` on every scene: the top level and each instanced
     /// object's) avoids the arithmetic shortcuts that can let a ray slip between two
     /// triangles sharing an edge, at some cost in speed.
-    pub fn build_with(scene: &Scene, options: &BackendOptions) -> Result<EmbreeAccel, EmbreeError> {
+    pub fn build_with(
+        scene: &'s Scene,
+        options: &BackendOptions,
+    ) -> Result<EmbreeAccel<'s>, EmbreeError> {
         let device = shared_device(rayon::current_num_threads())?;
         let (quality, robust) = (options.embree_quality, options.embree_robust);
         let prims = scene.prim_count_with_instances();
@@ -109,8 +112,8 @@ impl EmbreeAccel {
         Ok(EmbreeAccel {
             // Embree's own allocations for this scene (hierarchy, triangle buffers), read
             // after the commit has freed the build's temporaries (on a device building
-            // one scene at a time), and the primitive data emray keeps for the
-            // callbacks.
+            // one scene at a time), and what emray keeps for the callbacks besides the
+            // scene's primitives, which they read where they are.
             bytes: device.allocated_bytes().saturating_sub(before) + committed.rust_bytes(),
             scene: committed,
             device,
@@ -147,7 +150,7 @@ impl EmbreeAccel {
 
 /// Hits are reported in `(max(tmin, 0), tmax)`: Embree requires rays to start at or
 /// after their origin.
-impl Accel for EmbreeAccel {
+impl Accel for EmbreeAccel<'_> {
     #[inline]
     fn intersect(&self, ray: &Ray) -> Option<Hit> {
         self.scene.intersect(ray)

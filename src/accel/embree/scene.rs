@@ -46,7 +46,7 @@ impl Geometry {
     fn commit_and_attach(
         self,
         device: &Device,
-        scene: &Level,
+        scene: &Level<'_>,
         id: u32,
         what: &str,
     ) -> Result<(), EmbreeError> {
@@ -64,15 +64,15 @@ impl Geometry {
 const INSTANCE_BASE: u32 = 64;
 
 /// One Embree scene, the top level or an instanced object, owning the user data its
-/// callbacks read.
+/// callbacks read (which borrows the scene's primitives for `'s`).
 #[derive(Debug)]
-struct Level {
+struct Level<'s> {
     raw: sys::RTCScene,
     /// Dropped after `Drop::drop` has released `raw`, so no callback can outlive it.
-    user: UserData,
+    user: UserData<'s>,
 }
 
-impl Drop for Level {
+impl Drop for Level<'_> {
     fn drop(&mut self) {
         // SAFETY: `self.raw` is a live scene; no query can be running (queries borrow
         // the `CommittedScene`). Releasing it releases the geometries it holds (instance
@@ -86,19 +86,19 @@ impl Drop for Level {
 /// (boxed: Embree holds their addresses). Kept alive for the callbacks; read from Rust
 /// only for a panic caught in a bounds callback.
 #[derive(Debug, Default)]
-struct UserData {
-    kinds: Vec<Box<dyn UserGeometry>>,
+struct UserData<'s> {
+    kinds: Vec<Box<dyn UserGeometry + 's>>,
 }
 
 /// A committed Embree scene: the top level (with one instance geometry per instance),
 /// the objects' scenes, and the unbounded primitives. Immutable after
 /// [`CommittedScene::build`]; queried from any number of threads.
 #[derive(Debug)]
-pub(super) struct CommittedScene {
+pub(super) struct CommittedScene<'s> {
     // Fields drop in declaration order: the top level first, so the instance
     // geometries let go of the objects' scenes before those are released.
-    top: Level,
-    objects: Vec<Level>,
+    top: Level<'s>,
+    objects: Vec<Level<'s>>,
     /// What Embree cannot hold (infinite bounds), intersected in Rust before each query.
     unbounded: Unbounded,
     /// The kinds attached, with counts (see [`crate::accel::AccelStats::kinds`]).
@@ -107,13 +107,13 @@ pub(super) struct CommittedScene {
 
 // SAFETY: the handles refer to Embree's reference-counted scene objects; they are only
 // mutated inside `build`, before they are shared.
-unsafe impl Send for CommittedScene {}
+unsafe impl Send for CommittedScene<'_> {}
 // SAFETY: after `rtcCommitScene` the scenes are never modified, and Embree documents
 // `rtcIntersect1`/`rtcOccluded1` on a committed scene as safe to call from many threads
 // at once. The primitives the callbacks read are immutable and `Sync` (`Analytic`
 // requires it); the only state they write is the bounds callbacks' panic slot, a
 // `OnceLock`, and only during the commit.
-unsafe impl Sync for CommittedScene {}
+unsafe impl Sync for CommittedScene<'_> {}
 
 /// The flags of every scene emray commits. Robust traversal takes no arithmetic
 /// shortcuts that can miss rays through shared edges and vertices; a compact scene
@@ -129,9 +129,9 @@ fn scene_flags(robust: bool, compact: bool) -> sys::RTCSceneFlags {
     flags
 }
 
-impl Level {
+impl<'s> Level<'s> {
     /// A new, empty scene with `flags`.
-    fn new(device: &Device, flags: sys::RTCSceneFlags) -> Result<Level, EmbreeError> {
+    fn new(device: &Device, flags: sys::RTCSceneFlags) -> Result<Level<'s>, EmbreeError> {
         // SAFETY: `device` is live.
         let raw = unsafe { sys::rtcNewScene(device.raw()) };
         if raw.is_null() {
@@ -157,7 +157,7 @@ impl Level {
     fn attach_geometry(
         &mut self,
         device: &Device,
-        geometry: &SceneGeometry,
+        geometry: &'s SceneGeometry,
         kinds: &mut Vec<(Kind, usize)>,
     ) -> Result<(), EmbreeError> {
         if !geometry.triangles.is_empty() {
@@ -192,39 +192,45 @@ impl Level {
 }
 
 /// Attaches one user geometry per kind visited (the bounded primitives of the list),
-/// keeping its user data in `user`.
-struct AttachUser<'a> {
+/// keeping its user data, which borrows the list, in `user`.
+struct AttachUser<'a, 's> {
     device: &'a Device,
-    level: &'a Level,
+    level: &'a Level<'s>,
     kinds: &'a mut Vec<(Kind, usize)>,
-    user: Vec<Box<dyn UserGeometry>>,
+    user: Vec<Box<dyn UserGeometry + 's>>,
 }
 
-impl KindVisitor for AttachUser<'_> {
+impl<'s> KindVisitor<'s> for AttachUser<'_, 's> {
     type Output = Result<(), EmbreeError>;
 
-    fn visit<P: Analytic>(&mut self, list: &Prims<P>) -> Result<(), EmbreeError> {
+    fn visit<P: Analytic>(&mut self, list: &'s Prims<P>) -> Result<(), EmbreeError> {
         add_kind(self.kinds, P::KIND, list.len());
-        let mut items = Vec::new();
-        let mut ids = Vec::new();
-        for (i, prim, _) in list.iter() {
-            if !is_unbounded(&prim.bounds()) {
-                items.push(prim.clone());
-                ids.push(i);
-            }
-        }
-        if let Some(data) = attach_user(self.device, self.level, P::KIND, items, ids)? {
+        let items = &list.items[..];
+        if let Some(data) = attach_user(self.device, self.level, items, bounded_ids(items))? {
             self.user.push(data);
         }
         Ok(())
     }
 }
 
-impl CommittedScene {
+/// The indices of the bounded primitives of `items` when some are unbounded (Embree
+/// cannot hold those); `None` when all are bounded.
+fn bounded_ids<P: Analytic>(items: &[P]) -> Option<Box<[u32]>> {
+    if !items.iter().any(|p| is_unbounded(&p.bounds())) {
+        return None;
+    }
+    let bounded = (0u32..)
+        .zip(items)
+        .filter(|(_, p)| !is_unbounded(&p.bounds()));
+    Some(bounded.map(|(i, _)| i).collect())
+}
+
+impl<'s> CommittedScene<'s> {
     /// Bytes of what the scene keeps on emray's side for Embree: the user geometries'
-    /// primitive lists and the unbounded primitives.
+    /// indices of bounded primitives (when a list has unbounded ones) and the
+    /// unbounded primitives. The primitives themselves are the scene's.
     pub(super) fn rust_bytes(&self) -> usize {
-        let user = |level: &Level| level.user.kinds.iter().map(|k| k.bytes()).sum::<usize>();
+        let user = |level: &Level<'_>| level.user.kinds.iter().map(|k| k.bytes()).sum::<usize>();
         user(&self.top)
             + self.objects.iter().map(user).sum::<usize>()
             + self.unbounded.memory_bytes()
@@ -235,11 +241,11 @@ impl CommittedScene {
     /// if `compact`.
     pub(super) fn build(
         device: &Device,
-        scene: &crate::scene::Scene,
+        scene: &'s crate::scene::Scene,
         quality: crate::accel::EmbreeQuality,
         robust: bool,
         compact: bool,
-    ) -> Result<CommittedScene, EmbreeError> {
+    ) -> Result<CommittedScene<'s>, EmbreeError> {
         use crate::accel::EmbreeQuality as Q;
         let quality = match quality {
             Q::Low => sys::RTCBuildQuality::RTC_BUILD_QUALITY_LOW,
@@ -359,7 +365,7 @@ impl CommittedScene {
     }
 }
 
-impl CommittedScene {
+impl CommittedScene<'_> {
     /// The nearest hits of `rays` (`hits[i]` for `rays[i]`), cast as packets of `width`
     /// (4, 8 or 16) rays flagged coherent; any other width, or a scene with unbounded
     /// primitives (tested outside Embree, one ray at a time), casts single rays.
@@ -732,7 +738,11 @@ mod query {
 
 /// One native triangle mesh holding all triangles, three vertices each, so that
 /// `primID` is the index in `scene.triangles`.
-fn attach_triangles(device: &Device, scene: &Level, tris: &[Triangle]) -> Result<(), EmbreeError> {
+fn attach_triangles(
+    device: &Device,
+    scene: &Level<'_>,
+    tris: &[Triangle],
+) -> Result<(), EmbreeError> {
     let count = tris.len();
     let too_many = || {
         EmbreeError::emray(
@@ -804,31 +814,27 @@ fn attach_triangles(device: &Device, scene: &Level, tris: &[Triangle]) -> Result
     geometry.commit_and_attach(device, scene, Kind::Triangle as u32, "triangles")
 }
 
-/// One user geometry holding all `prims` of `kind` (none when there are none). Returns
-/// the boxed user data Embree's callbacks read, which must outlive `scene`'s handle.
-fn attach_user<T: Analytic>(
+/// One user geometry holding the primitives `ids` of the scene's list `items` of kind
+/// `T::KIND` (all of them for `None`; no geometry when that is none). Returns the boxed
+/// user data Embree's callbacks read, which must outlive `scene`'s handle.
+fn attach_user<'s, T: Analytic>(
     device: &Device,
-    scene: &Level,
-    kind: Kind,
-    prims: Vec<T>,
-    ids: Vec<u32>,
-) -> Result<Option<Box<UserPrims<T>>>, EmbreeError> {
-    if prims.is_empty() {
+    scene: &Level<'s>,
+    items: &'s [T],
+    ids: Option<Box<[u32]>>,
+) -> Result<Option<Box<UserPrims<'s, T>>>, EmbreeError> {
+    let kind = T::KIND;
+    let len = ids.as_ref().map_or(items.len(), |ids| ids.len());
+    if len == 0 {
         return Ok(None);
     }
-    let count = u32::try_from(prims.len()).map_err(|_| {
+    let count = u32::try_from(len).map_err(|_| {
         EmbreeError::emray(
             format!("building the {} geometry", kind.name()),
-            format!(
-                "{} primitives exceed Embree's 32-bit primitive ids",
-                prims.len()
-            ),
+            format!("{len} primitives exceed Embree's 32-bit primitive ids"),
         )
     })?;
-    let data = Box::new(UserPrims::new(
-        prims.into_boxed_slice(),
-        ids.into_boxed_slice(),
-    ));
+    let data = Box::new(UserPrims::new(items, ids));
     let geometry = Geometry::new(
         device,
         sys::RTCGeometryType::RTC_GEOMETRY_TYPE_USER,
@@ -857,8 +863,8 @@ fn attach_user<T: Analytic>(
 /// An instance geometry placing `object` in `scene` under `xform`, as geometry `id`.
 fn attach_instance(
     device: &Device,
-    scene: &Level,
-    object: &Level,
+    scene: &Level<'_>,
+    object: &Level<'_>,
     xform: &Xform,
     id: u32,
 ) -> Result<(), EmbreeError> {

@@ -26,7 +26,7 @@ fn add_triangle(s: &mut Scene, p0: Vec3, p1: Vec3, p2: Vec3) {
     s.geometry.triangle_normals.push(u32::MAX);
 }
 
-fn build(s: &Scene) -> EmbreeAccel {
+fn build(s: &Scene) -> EmbreeAccel<'_> {
     EmbreeAccel::build(s).expect("Embree build")
 }
 
@@ -765,4 +765,57 @@ fn a_panic_in_a_callback_comes_back_after_the_query_instead_of_aborting() {
         "the Embree bounds callback of the spheres panicked: injected panic"
     );
     assert!(build(&s).intersect(&r).is_some());
+}
+
+/// A kind whose list mixes bounded and unbounded primitives: Embree holds the bounded
+/// ones under their own indices in the scene's list (the unbounded one between them
+/// is tested outside Embree), and every hit names the primitive the BVH names.
+#[test]
+fn bounded_and_unbounded_of_one_kind_keep_their_prim_ids() {
+    use crate::geometry::{Quadric, Shape};
+    let ball = |c: Vec3, r: f64| {
+        let (x, y, z) = (f64::from(c.x), f64::from(c.y), f64::from(c.z));
+        let j = x * x + y * y + z * z - r * r;
+        let coeffs = [
+            1.0,
+            1.0,
+            1.0,
+            0.0,
+            0.0,
+            0.0,
+            -2.0 * x,
+            -2.0 * y,
+            -2.0 * z,
+            j,
+        ];
+        Shape::Quadric(Quadric::new(coeffs, None).expect("ball").into())
+    };
+    // The cylinder x² + y² = 36 around the view, unbounded along z.
+    let cylinder = [1.0, 1.0, 0.0, 0.0, 0.0, 0.0, 0.0, 0.0, 0.0, -36.0];
+    let mut s = scene();
+    s.geometry.add_shape(ball(Vec3::new(0.5, 0.0, 6.0), 1.0), 0);
+    s.geometry.add_shape(
+        Shape::Quadric(Quadric::new(cylinder, None).unwrap().into()),
+        0,
+    );
+    s.geometry
+        .add_shape(ball(Vec3::new(-1.0, 1.0, 5.0), 0.5), 0);
+    let embree = build(&s);
+    let bvh = crate::accel::bvh::Bvh::build(&s);
+    let mut seen = [0; 3];
+    for org in [Vec3::ZERO, Vec3::new(0.3, -0.2, 1.0)] {
+        for r in fan(org, Vec3::new(0.0, 0.0, 6.0), 1.5, 15) {
+            let (a, b) = (embree.intersect(&r), bvh.intersect(&r));
+            assert_eq!(
+                a.map(|h| (h.kind(), h.prim_id)),
+                b.map(|h| (h.kind(), h.prim_id))
+            );
+            assert_eq!(embree.occluded(&r), bvh.occluded(&r), "{r:?}");
+            if let Some(h) = a {
+                seen[h.prim_id as usize] += 1;
+            }
+        }
+    }
+    assert!(seen.iter().all(|&n| n > 0), "every quadric hit: {seen:?}");
+    assert!(embree.stats().bytes > 0);
 }

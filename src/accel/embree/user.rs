@@ -41,14 +41,18 @@ use super::sys;
 use crate::geometry::Analytic;
 use crate::math::{Aabb, Ray, Vec3, next_float_up};
 
-/// The user data of one user geometry: its primitives, indexed by Embree's `primID`.
-/// Lives in a `Box` owned by the `EmbreeAccel`, so the pointer Embree holds stays valid
-/// until the scene has been released.
+/// The user data of one user geometry: the scene's list of its kind, borrowed (never
+/// copied), and the primitive each of Embree's `primID`s is. Lives in a `Box` owned by
+/// the `EmbreeAccel`, so the pointer Embree holds stays valid until the scene has been
+/// released; the accel borrows the scene for `'s`, so the list outlives it.
 #[derive(Debug)]
-pub(super) struct UserPrims<T> {
-    pub(super) items: Box<[T]>,
-    /// The primitive id reported for each item (its index in the scene's list).
-    pub(super) ids: Box<[u32]>,
+pub(super) struct UserPrims<'s, T> {
+    /// The scene's primitives of this kind.
+    items: &'s [T],
+    /// The index in `items` of each of Embree's primitives, when the geometry holds
+    /// only some of them (not the unbounded ones); `None`: Embree's primitive `k` is
+    /// item `k`.
+    ids: Option<Box<[u32]>>,
     /// The first panic caught in the bounds callback (set from Embree's build threads).
     bounds_panic: OnceLock<String>,
     /// Test hook: the bounds callback panics.
@@ -56,9 +60,10 @@ pub(super) struct UserPrims<T> {
     panic_in_bounds: bool,
 }
 
-impl<T> UserPrims<T> {
-    /// The user data of `items`, reported as primitives `ids`.
-    pub(super) fn new(items: Box<[T]>, ids: Box<[u32]>) -> Self {
+impl<'s, T> UserPrims<'s, T> {
+    /// The user data of the scene's list `items`, of which Embree holds those `ids`
+    /// (all of them, in order, for `None`).
+    pub(super) fn new(items: &'s [T], ids: Option<Box<[u32]>>) -> Self {
         UserPrims {
             items,
             ids,
@@ -66,6 +71,17 @@ impl<T> UserPrims<T> {
             #[cfg(test)]
             panic_in_bounds: inject::take(Callback::Bounds),
         }
+    }
+
+    /// Embree's primitive `prim_id`: the primitive, and its index in the scene's list
+    /// (the `primID` a hit reports); `None` for an id out of range.
+    #[inline(always)]
+    fn prim(&self, prim_id: u32) -> Option<(&'s T, u32)> {
+        let index = match &self.ids {
+            None => prim_id,
+            Some(ids) => *ids.get(prim_id as usize)?,
+        };
+        Some((self.items.get(index as usize)?, index))
     }
 
     /// The pointer registered with `rtcSetGeometryUserData`.
@@ -79,14 +95,16 @@ pub(super) trait UserGeometry: Send + Sync + std::fmt::Debug {
     /// The message of a panic caught in the bounds callback during the last commit
     /// (naming the callback and the kind), if there was one.
     fn bounds_panic(&self) -> Option<String>;
-    /// Bytes of the primitives and ids the callbacks read (emray's memory, which
-    /// Embree's memory monitor does not see).
+    /// Bytes of the index the callbacks read besides the scene's primitives (emray's
+    /// memory, which Embree's memory monitor does not see).
     fn bytes(&self) -> usize;
 }
 
-impl<T: Analytic> UserGeometry for UserPrims<T> {
+impl<T: Analytic> UserGeometry for UserPrims<'_, T> {
     fn bytes(&self) -> usize {
-        self.items.len() * std::mem::size_of::<T>() + self.ids.len() * std::mem::size_of::<u32>()
+        self.ids
+            .as_ref()
+            .map_or(0, |ids| std::mem::size_of_val(&**ids))
     }
 
     fn bounds_panic(&self) -> Option<String> {
@@ -368,9 +386,9 @@ unsafe fn report_miss(valid: *mut i32, i: usize) {
 /// `user_ptr` is the `UserPrims<T>` registered for this geometry, which the
 /// `EmbreeAccel` keeps alive (and unmoved, in its `Box`) until the scene is released.
 #[inline(always)]
-unsafe fn prims<'a, T>(user_ptr: *mut c_void) -> Option<&'a UserPrims<T>> {
+unsafe fn prims<'a, T>(user_ptr: *mut c_void) -> Option<&'a UserPrims<'a, T>> {
     // SAFETY: by the caller's contract; only a shared reference is formed.
-    unsafe { user_ptr.cast::<UserPrims<T>>().as_ref() }
+    unsafe { user_ptr.cast::<UserPrims<'a, T>>().as_ref() }
 }
 
 /// `RTCBoundsFunction`: the shape's own bounds (empty, which Embree skips, for an
@@ -383,7 +401,7 @@ pub(super) unsafe extern "C" fn bounds<T: Analytic>(args: *const sys::RTCBoundsF
     // SAFETY: this callback is only registered on geometries whose user data is a
     // `UserPrims<T>` (see `scene::attach_user`).
     let user = unsafe { prims::<T>(args.geometryUserPtr) };
-    let prim = user.and_then(|p| p.items.get(args.primID as usize));
+    let prim = user.and_then(|p| p.prim(args.primID)).map(|(prim, _)| prim);
     let b = match catch_unwind(AssertUnwindSafe(|| {
         #[cfg(test)]
         if user.is_some_and(|u| u.panic_in_bounds) {
@@ -455,8 +473,7 @@ pub(super) unsafe extern "C" fn intersect<T: Analytic>(
     let n = args.N as usize;
     // SAFETY: registered only with `UserPrims<T>` user data (see `bounds`).
     let user = unsafe { prims::<T>(args.geometryUserPtr) };
-    let index = args.primID as usize;
-    let Some((prim, &prim_id)) = user.and_then(|p| p.items.get(index).zip(p.ids.get(index))) else {
+    let Some((prim, prim_id)) = user.and_then(|p| p.prim(args.primID)) else {
         // SAFETY: `valid` has `N` entries.
         unsafe { report_all_missed(args.valid, n) };
         return;
@@ -538,7 +555,7 @@ pub(super) unsafe extern "C" fn occluded<T: Analytic>(
     let n = args.N as usize;
     // SAFETY: registered only with `UserPrims<T>` user data (see `bounds`).
     let user = unsafe { prims::<T>(args.geometryUserPtr) };
-    let Some(prim) = user.and_then(|p| p.items.get(args.primID as usize)) else {
+    let Some((prim, _)) = user.and_then(|p| p.prim(args.primID)) else {
         // SAFETY: `valid` has `N` entries.
         unsafe { report_all_missed(args.valid, n) };
         return;
