@@ -106,8 +106,12 @@ impl<'a, A: Accel> Tracer<'a, A> {
     /// schedule).
     fn samples(&self, i: u32, j: u32) -> impl Iterator<Item = (f32, f32)> {
         let n = self.spp;
-        let seed = hash(i.wrapping_mul(0x9e37_79b9) ^ hash(j));
-        let (ox, oy) = (unit(hash(seed)), unit(hash(seed ^ 0x5bd1_e995)));
+        let (ox, oy) = if n == 1 {
+            (0.0, 0.0)
+        } else {
+            let seed = hash(i.wrapping_mul(0x9e37_79b9) ^ hash(j));
+            (unit(hash(seed)), unit(hash(seed ^ 0x5bd1_e995)))
+        };
         (0..n).map(move |s| {
             if n == 1 {
                 return (i as f32 + 0.5, j as f32 + 0.5);
@@ -141,13 +145,20 @@ impl<'a, A: Accel> Tracer<'a, A> {
         } else {
             positions.clone()
         };
-        let eyes: Vec<Eye> = order
-            .iter()
-            .flat_map(|&(i, j)| {
-                self.samples(i, j)
-                    .map(move |(x, y)| eye(raygen, x, y, slot(i, j)))
-            })
-            .collect();
+        let eyes: Vec<Eye> = if self.spp == 1 {
+            // The pixel centres, without the samples' iterator.
+            let centre = |i: u32| i as f32 + 0.5;
+            let eye_at = |&(i, j): &(u32, u32)| eye(raygen, centre(i), centre(j), slot(i, j));
+            order.iter().map(eye_at).collect()
+        } else {
+            order
+                .iter()
+                .flat_map(|&(i, j)| {
+                    self.samples(i, j)
+                        .map(move |(x, y)| eye(raygen, x, y, slot(i, j)))
+                })
+                .collect()
+        };
         let mut values = Vec::new();
         self.trace_batch(&eyes, &positions, self.spp == 1, rec, &mut values);
         // The eyes of each position: `spp` in a row in sample order, or with one
