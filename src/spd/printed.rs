@@ -65,7 +65,7 @@ fn six_digits(x: f64) -> Option<(u64, i32)> {
     if !a.is_finite() {
         return None;
     }
-    let mut k = 5 - a.log10().floor() as i32;
+    let mut k = 5 - decimal_exponent_floor(a);
     let mut scaled = scale(a, k)?;
     if scaled < 1e5 {
         k += 1;
@@ -74,12 +74,29 @@ fn six_digits(x: f64) -> Option<(u64, i32)> {
         k -= 1;
         scaled = scale(a, k)?;
     }
-    let frac = scaled - scaled.floor();
-    let unsure = (frac - 0.5).abs() < MARGIN || !(1e5 + MARGIN..1e6 - MARGIN).contains(&scaled);
-    if unsure {
+    if !(1e5 + MARGIN..1e6 - MARGIN).contains(&scaled) {
         return None;
     }
-    Some((scaled.round() as u64, k))
+    // In that range truncation is the floor, and, ties excluded, rounding is the floor
+    // plus one above the half (no call to the library's `floor` and `round`).
+    let floor = scaled as u64;
+    let frac = scaled - floor as f64;
+    if (frac - 0.5).abs() < MARGIN {
+        return None;
+    }
+    Some((floor + u64::from(frac > 0.5), k))
+}
+
+/// `floor(log10(a))` for a positive finite `a`, or one less: from the binary exponent
+/// (`floor(e · log10 2)`, exact in integers for every exponent of an `f64`), since
+/// `2^e ≤ a < 2^(e+1)`; [`six_digits`] corrects the one. Subnormals ask `log10`.
+fn decimal_exponent_floor(a: f64) -> i32 {
+    let biased = ((a.to_bits() >> 52) & 0x7ff) as i32;
+    if biased == 0 {
+        return a.log10().floor() as i32;
+    }
+    // 78913 / 2^18 is log10 2 to within 3e-7 relative: the floor is exact for |e| < 1650.
+    ((biased - 1023) * 78_913) >> 18
 }
 
 /// `a · 10^k`, one rounding away from exact (`None` when `10^|k|` is not exact).
@@ -136,6 +153,23 @@ mod tests {
             123456789.0,
         ] {
             same_as_text(x);
+        }
+    }
+
+    #[test]
+    fn the_decimal_exponent_is_the_floor_of_log10_or_one_less() {
+        let mut x = f64::MIN_POSITIVE;
+        while x.is_finite() {
+            for a in [x, x * 1.5, x * 1.999_999, f64::from_bits((x * 2.0).to_bits() - 1)] {
+                let exact = a.log10().floor() as i32;
+                let e = decimal_exponent_floor(a);
+                assert!(e == exact || e + 1 == exact, "{a:e}: {e} against {exact}");
+            }
+            x *= 2.0;
+        }
+        for p in 1..=22 {
+            let a = 10f64.powi(p);
+            assert!((p - 1..=p).contains(&decimal_exponent_floor(a)), "1e{p}");
         }
     }
 
