@@ -20,6 +20,7 @@ use crate::math::{DVec3, Vec3};
 use crate::scene::{Camera, Light, Scene, range};
 use crate::spd::{Database, NffSink, g_f32, g_f64};
 use glam::DVec3 as D;
+use rayon::prelude::*;
 use std::path::Path;
 use std::sync::Arc;
 
@@ -216,15 +217,18 @@ impl NffSink for SceneBuilder<'_, '_> {
     }
 
     fn sphere(&mut self, center: D, radius: f64) {
-        self.made(1);
-        let line = self.entity(1);
-        let (center, r) = (self.point(center), self.num(radius));
-        self.check(r != 0.0);
-        let sphere = Sphere::new(center, r);
-        let ok = self.world_bounds_ok("the sphere", &sphere.bounds());
-        self.check(ok);
-        if !self.failed {
-            self.part.add_analytic(sphere, Kind::Sphere, line);
+        let sphere = sphere_of(self.origin, center, radius);
+        self.add_sphere(sphere);
+    }
+
+    fn spheres(&mut self, spheres: &[(D, f64)]) {
+        let origin = self.origin;
+        let made: Vec<Option<Sphere>> = spheres
+            .par_iter()
+            .map(|&(center, radius)| sphere_of(origin, center, radius))
+            .collect();
+        for sphere in made {
+            self.add_sphere(sphere);
         }
     }
 
@@ -255,7 +259,36 @@ impl NffSink for SceneBuilder<'_, '_> {
     }
 }
 
+/// The sphere the loader reads from `s` with `center` and `radius` printed, in the
+/// frame of the first viewpoint's eye `origin`; `None` where the loader would refuse
+/// or warn (no viewpoint yet, a number out of range, a zero radius).
+fn sphere_of(origin: Option<DVec3>, center: D, radius: f64) -> Option<Sphere> {
+    let world = D::new(g_f64(center.x), g_f64(center.y), g_f64(center.z));
+    let finite = world.is_finite() && world.as_vec3().is_finite();
+    let r = g_f32(radius);
+    if !(finite && range::check_point("", world.as_vec3()).is_ok() && r.is_finite() && r != 0.0) {
+        return None;
+    }
+    let origin = origin?;
+    let sphere = Sphere::new((world - origin).as_vec3(), r);
+    let bounds = world_bounds(origin, &sphere.bounds());
+    range::check_bounds("the sphere", &bounds)
+        .is_ok()
+        .then_some(sphere)
+}
+
 impl SceneBuilder<'_, '_> {
+    /// Add `sphere`, one line's entity, or fail the build for `None`.
+    fn add_sphere(&mut self, sphere: Option<Sphere>) {
+        self.made(1);
+        let line = self.entity(1);
+        match sphere {
+            Some(sphere) if !self.failed => self.part.add_analytic(sphere, Kind::Sphere, line),
+            Some(_) => {}
+            None => self.failed = true,
+        }
+    }
+
     /// `p` (no normals) or `pp`: one line for the count, one per vertex.
     fn polygon_with(&mut self, verts: &[D], normals: Option<&[D]>) {
         self.made(verts.len().saturating_sub(2));

@@ -137,7 +137,12 @@ impl Sources {
     }
 
     fn file_index(&mut self, file: &Arc<str>) -> u32 {
-        match self.files.iter().rposition(|f| f == file) {
+        // The same `Arc` nearly always (one loader, one file): its pointer first.
+        match self
+            .files
+            .iter()
+            .rposition(|f| Arc::ptr_eq(f, file) || f == file)
+        {
             Some(k) => k as u32,
             None => {
                 self.files.push(file.clone());

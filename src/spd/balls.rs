@@ -24,6 +24,9 @@ use std::f64::consts::PI;
 /// The SPD program's default size factor (`balls.c`: `size_factor = 4`, 7381 spheres).
 pub const DEFAULT_SIZE: u32 = 4;
 
+/// Spheres handed to the sink at once.
+const SPHERE_BATCH: usize = 1 << 16;
+
 /// Ratio of a child's radius to its parent's.
 const CHILD_RATIO: f64 = 1.0 / 3.0;
 
@@ -190,8 +193,10 @@ pub fn generate(size: u32, w: &mut impl NffSink) {
         0.0,
         1.0,
     );
-    for b in flake(size) {
-        w.sphere(b.center, b.radius);
+    // In batches, which a scene builder makes in parallel.
+    for batch in flake(size).chunks(SPHERE_BATCH) {
+        let spheres: Vec<(DVec3, f64)> = batch.iter().map(|b| (b.center, b.radius)).collect();
+        w.spheres(&spheres);
     }
 }
 

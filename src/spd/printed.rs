@@ -160,7 +160,12 @@ mod tests {
     fn the_decimal_exponent_is_the_floor_of_log10_or_one_less() {
         let mut x = f64::MIN_POSITIVE;
         while x.is_finite() {
-            for a in [x, x * 1.5, x * 1.999_999, f64::from_bits((x * 2.0).to_bits() - 1)] {
+            for a in [
+                x,
+                x * 1.5,
+                x * 1.999_999,
+                f64::from_bits((x * 2.0).to_bits() - 1),
+            ] {
                 let exact = a.log10().floor() as i32;
                 let e = decimal_exponent_floor(a);
                 assert!(e == exact || e + 1 == exact, "{a:e}: {e} against {exact}");

@@ -26,6 +26,12 @@ pub trait NffSink {
     fn fill(&mut self, rgb: DVec3, kd: f64, ks: f64, shine: f64, t: f64, ior: f64);
     /// `s x y z r`.
     fn sphere(&mut self, center: DVec3, radius: f64);
+    /// One `s` per `(centre, radius)`, in order (a sink may make them in parallel).
+    fn spheres(&mut self, spheres: &[(DVec3, f64)]) {
+        for &(center, radius) in spheres {
+            self.sphere(center, radius);
+        }
+    }
     /// `c`: base, base radius, apex, apex radius.
     fn cone(&mut self, base: DVec3, base_radius: f64, apex: DVec3, apex_radius: f64);
     /// `p n` and its vertices.
