@@ -1,15 +1,23 @@
-//! The OBJ statement parser: one pass over the text gives the elements (`v`, `vt`,
-//! `vn`), the faces and lines with their index triples, and the statements that apply
-//! to faces (`usemtl`, `mtllib`, `s`, `g`, `o`), after checking every statement.
+//! The OBJ statement parser: one pass over a stretch of the text (the whole file, or
+//! a part of it that starts at a line start) gives its elements (`v`, `vt`, `vn`), the
+//! faces and lines with their index triples, and the statements that apply to faces
+//! (`usemtl`, `mtllib`, `s`, `g`, `o`), after checking every statement.
 //!
-//! The first problem stops the parse with its `line:col`. Numbers are looked at after
-//! the structure: a structural problem is reported unless a number on an earlier line
-//! is bad (see [`super::numbers`]). Indices are resolved as written: a negative index
-//! counts back from the last element defined before the face, a positive one may name
-//! an element defined later in the file (checked at the end of the file here, and at
-//! the end of the face's run by [`super::runs`]).
+//! A stretch is parsed knowing where it starts ([`Start`]): the lines before it, and
+//! the elements defined before it, which [`count`] finds by looking at the keywords
+//! of the earlier stretches alone. So line numbers and element indices are the file's
+//! from the start, and a negative index counts back from the last element defined
+//! before the face, whichever stretch defined it.
+//!
+//! The first problem stops the stretch with its `line:col`. Numbers are looked at
+//! after the structure: a structural problem is reported unless a number on an earlier
+//! line is bad (see [`super::numbers`]; [`super::join`] decides, as the bad number may
+//! be in an earlier stretch). A positive index may name an element defined later in
+//! the file: such forward references are noted, and checked against the whole file by
+//! [`super::join`] and against the end of the face's run by [`super::runs`].
 
-use super::located::{Located, article, comment_hint, name_after_space, show};
+use super::colours::{ColourNote, Colours};
+use super::located::{Located, article, col_of, comment_hint, name_after_space, show};
 use super::numbers::{self, Element};
 use crate::load::LoadProgress;
 use glam::{DVec3, Vec2, Vec3};
@@ -111,14 +119,14 @@ pub(super) struct Obj {
     /// Elements defined by the whole file.
     pub counts: Counts,
     /// The first `v` whose colour (x y z r g b) is present where the first `v`'s is
-    /// not, or the other way round.
+    /// not, or the other way round (found when the stretches are joined).
     pub colour_mismatch: Option<Located>,
     /// The first bad number of the file (see [`super::numbers`]).
     pub first_bad_number: Option<Located>,
 }
 
 /// Element kinds that faces index: vertices, texture coordinates, normals.
-const KINDS: [(&str, &str); 3] = [
+pub(super) const KINDS: [(&str, &str); 3] = [
     ("vertex", "vertices"),
     ("texture coordinate", "texture coordinates"),
     ("normal", "normals"),
@@ -127,22 +135,42 @@ const KINDS: [(&str, &str); 3] = [
 /// A positive index beyond the elements defined so far: valid only if the file defines
 /// enough elements later.
 #[derive(Debug)]
-struct ForwardRef {
-    index: usize,
-    at: Located,
+pub(super) struct ForwardRef {
+    pub index: usize,
+    pub at: Located,
+}
+
+/// Where a stretch starts: after `line` lines of the file, which define `counts`
+/// elements (their vertex colours are not counted: see [`count`]).
+#[derive(Clone, Copy, Debug, Default, PartialEq, Eq)]
+pub(super) struct Start {
+    pub line: usize,
+    pub counts: Counts,
+}
+
+/// What a stretch gives. In [`Part::obj`], line numbers and element indices are the
+/// file's; the indices of corners, faces and `usemtl` statements, and the vertex
+/// colours counted, are the stretch's own.
+#[derive(Debug, Default)]
+pub(super) struct Part {
+    /// The statements read ([`Obj::colour_mismatch`] is left for the join).
+    pub obj: Obj,
+    /// Per kind: forward references, each larger than the one before in the stretch
+    /// (the first in the file that turns out out of range is always among them).
+    pub forward: [Vec<ForwardRef>; 3],
+    /// Which vertices have colours.
+    pub colours: Colours,
+    /// A number that does not parse (or a weight of 0) was met.
+    pub fatal_number: bool,
+    /// The problem that stopped the stretch (a bad number on an earlier line may come
+    /// first: see [`super::join`]).
+    pub error: Option<Located>,
 }
 
 /// The parser's state between lines.
 #[derive(Default)]
 struct Parser {
-    obj: Obj,
-    /// Per kind: forward references, each larger than the one before (the first that
-    /// turns out out of range is always among them).
-    forward: [Vec<ForwardRef>; 3],
-    /// Whether the first `v` has a colour, and its line.
-    first_has_colour: Option<(bool, usize)>,
-    /// A number that does not parse (or a weight of 0) was met.
-    fatal_number: bool,
+    part: Part,
 }
 
 /// The words of a statement after its keyword: how many, and the first seven.
@@ -204,32 +232,46 @@ impl Obj {
     }
 }
 
-pub(super) fn parse(text: &str, progress: &LoadProgress<'_>) -> Result<Obj, Located> {
+/// Parse a stretch of OBJ text (lines split as [`str::lines`] does) that starts at
+/// `start`, telling `progress` of its bytes as they are read.
+pub(super) fn parse(text: &str, start: Start, progress: &LoadProgress<'_>) -> Part {
     let mut p = Parser::default();
-    // Bytes read since `progress` was last advanced.
-    let mut read = 0;
+    p.part.obj.counts = start.counts;
+    // Bytes read since `progress` was last advanced, and before.
+    let (mut read, mut told) = (0, 0);
     for (i, line) in text.lines().enumerate() {
-        if let Err(e) = p.statement(i + 1, line) {
-            return Err(p.first_bad_before(e));
+        if let Err(e) = p.statement(start.line + i + 1, line) {
+            p.part.error = Some(e);
+            return p.part;
         }
         read += line.len() + 1;
         if read >= PROGRESS_CHUNK {
             progress.advance(read as u64);
-            read = 0;
+            (told, read) = (told + read, 0);
         }
     }
-    p.finish()
+    progress.advance(text.len().saturating_sub(told) as u64);
+    p.part
+}
+
+/// The lines of a stretch and the elements they define, as far as their keywords
+/// tell: exact up to the stretch's first problem, after which nothing counts.
+pub(super) fn count(text: &str) -> Start {
+    let mut n = Start::default();
+    for line in text.lines() {
+        n.line += 1;
+        // The keyword, as `Parser::statement` reads it.
+        match line.split_whitespace().next() {
+            Some("v") => n.counts.v += 1,
+            Some("vt") => n.counts.vt += 1,
+            Some("vn") => n.counts.vn += 1,
+            _ => {}
+        }
+    }
+    n
 }
 
 impl Parser {
-    /// `e`, or a bad number on an earlier line.
-    fn first_bad_before(&mut self, e: Located) -> Located {
-        match self.obj.first_bad_number.take() {
-            Some(b) if b.line < e.line => b,
-            _ => e,
-        }
-    }
-
     fn statement(&mut self, ln: usize, line: &str) -> Result<(), Located> {
         let mut words = line.split_whitespace();
         let Some(kw) = words.next() else {
@@ -241,7 +283,7 @@ impl Parser {
             "vn" => self.element(Element::Normal, ln, line, &Words::new(words))?,
             "f" | "l" => self.face(ln, line, kw == "l", words)?,
             "usemtl" => self.usemtl(ln, line)?,
-            "mtllib" => self.obj.mtllibs.push(MtlLib {
+            "mtllib" => self.part.obj.mtllibs.push(MtlLib {
                 name: name_after_space(line).to_string(),
                 line: ln,
             }),
@@ -251,7 +293,10 @@ impl Parser {
                     None | Some("off") | Some("0") => 0,
                     Some(w) => w.parse::<u32>().unwrap_or(u32::MAX).max(1),
                 };
-                self.obj.smoothing.push((self.obj.faces.len(), group));
+                self.part
+                    .obj
+                    .smoothing
+                    .push((self.part.obj.faces.len(), group));
             }
             "g" | "o" => self.cut(ln, None),
             _ => {}
@@ -261,10 +306,10 @@ impl Parser {
 
     /// A statement that may end a run of faces.
     fn cut(&mut self, ln: usize, usemtl: Option<usize>) {
-        self.obj.cuts.push(Cut {
-            first_face: self.obj.faces.len(),
+        self.part.obj.cuts.push(Cut {
+            first_face: self.part.obj.faces.len(),
             line: ln,
-            counts: self.obj.counts,
+            counts: self.part.obj.counts,
             usemtl,
         });
     }
@@ -284,37 +329,17 @@ impl Parser {
                 format!("a vertex is 'x y z', 'x y z w' or 'x y z r g b', found {n} numbers{hint}");
             return Err(err(tok, message));
         }
-        self.note_colour(n == 6, ln, || err(Some(kw), String::new()));
-        let read = self.numbers(Element::Vertex, ln, line, w);
-        self.obj.positions.push(Vec3::from(read.values));
-        self.obj.world.push(DVec3::from(read.exact));
-        self.obj.counts.v += 1;
-        self.obj.counts.colours += read.colours;
-        Ok(())
-    }
-
-    /// Note whether this vertex has a colour, and the first that differs from the
-    /// first vertex in this.
-    fn note_colour(&mut self, has_colour: bool, ln: usize, at: impl Fn() -> Located) {
-        let Some((first, first_ln)) = self.first_has_colour else {
-            self.first_has_colour = Some((has_colour, ln));
-            return;
-        };
-        if first == has_colour || self.obj.colour_mismatch.is_some() {
-            return;
-        }
-        let (this, that) = if has_colour {
-            ("has a colour", "has none")
-        } else {
-            ("has no colour", "has one")
-        };
-        self.obj.colour_mismatch = Some(Located {
-            message: format!(
-                "this vertex {this} but the first one (line {first_ln}) {that}: vertex colours \
-                 must be on every vertex or on none"
-            ),
-            ..at()
+        self.part.colours.note(ColourNote {
+            has_colour: n == 6,
+            line: ln,
+            col: col_of(line, kw),
         });
+        let read = self.numbers(Element::Vertex, ln, line, w);
+        self.part.obj.positions.push(Vec3::from(read.values));
+        self.part.obj.world.push(DVec3::from(read.exact));
+        self.part.obj.counts.v += 1;
+        self.part.obj.counts.colours += read.colours;
+        Ok(())
     }
 
     /// `vt u v [w]` or `vn x y z`.
@@ -334,11 +359,11 @@ impl Parser {
         }
         let [a, b, c] = self.numbers(kind, ln, line, w).values;
         if kind == Element::Texture {
-            self.obj.texcoords.push(Vec2::new(a, b));
-            self.obj.counts.vt += 1;
+            self.part.obj.texcoords.push(Vec2::new(a, b));
+            self.part.obj.counts.vt += 1;
         } else {
-            self.obj.normals.push(Vec3::new(a, b, c));
-            self.obj.counts.vn += 1;
+            self.part.obj.normals.push(Vec3::new(a, b, c));
+            self.part.obj.counts.vn += 1;
         }
         Ok(())
     }
@@ -346,9 +371,9 @@ impl Parser {
     /// Read the numbers of an element statement, keeping the file's first problem.
     fn numbers(&mut self, kind: Element, ln: usize, line: &str, w: &Words) -> numbers::Numbers {
         let mut read = numbers::read(kind, ln, line, w.kept(), w.n);
-        self.fatal_number |= read.fatal;
-        if self.obj.first_bad_number.is_none() {
-            self.obj.first_bad_number = read.bad.take();
+        self.part.fatal_number |= read.fatal;
+        if self.part.obj.first_bad_number.is_none() {
+            self.part.obj.first_bad_number = read.bad.take();
         }
         read
     }
@@ -364,9 +389,9 @@ impl Parser {
                 "expected a material name after 'usemtl' (separated by a space)".into(),
             ));
         }
-        let k = self.obj.usemtl.len();
-        self.obj.usemtl.push(UseMtl {
-            first_face: self.obj.faces.len(),
+        let k = self.part.obj.usemtl.len();
+        self.part.obj.usemtl.push(UseMtl {
+            first_face: self.part.obj.faces.len(),
             name: name.to_string(),
             line: ln,
         });
@@ -382,18 +407,18 @@ impl Parser {
         is_line: bool,
         words: std::str::SplitWhitespace,
     ) -> Result<(), Located> {
-        let first = self.obj.corners.len();
+        let first = self.part.obj.corners.len();
         let mut all_normals = true;
         let mut all_texcoords = true;
         for tok in words {
             let (corner, normal, texcoord) = self.corner(ln, line, tok)?;
-            self.obj.corners.push(corner);
+            self.part.obj.corners.push(corner);
             all_normals &= normal;
             all_texcoords &= texcoord;
         }
-        let arity = self.obj.corners.len() - first;
+        let arity = self.part.obj.corners.len() - first;
         if is_line {
-            self.obj.lines += 1;
+            self.part.obj.lines += 1;
         } else if arity == 0 {
             return Err(Located::at_token(
                 ln,
@@ -402,7 +427,7 @@ impl Parser {
                 "face without vertices".into(),
             ));
         }
-        self.obj.faces.push(Face {
+        self.part.obj.faces.push(Face {
             line: ln,
             first,
             arity,
@@ -468,9 +493,9 @@ impl Parser {
             )));
         };
         let count = match k {
-            0 => self.obj.counts.v,
-            1 => self.obj.counts.vt,
-            _ => self.obj.counts.vn,
+            0 => self.part.obj.counts.v,
+            1 => self.part.obj.counts.vt,
+            _ => self.part.obj.counts.vn,
         };
         if x == 0 {
             return Err(err(format!(
@@ -494,49 +519,12 @@ impl Parser {
     }
 
     fn forward_ref(&mut self, k: usize, index: usize, at: Located) {
-        let Some(refs) = self.forward.get_mut(k) else {
+        let Some(refs) = self.part.forward.get_mut(k) else {
             return;
         };
         if refs.last().is_none_or(|r| r.index < index) {
             refs.push(ForwardRef { index, at });
         }
-    }
-
-    /// Check the forward references against the whole file, and that every number
-    /// parses.
-    fn finish(mut self) -> Result<Obj, Located> {
-        let counts = self.obj.counts;
-        let totals = [counts.v, counts.vt, counts.vn];
-        // Forward references beyond the end: report the first in the file.
-        let mut worst: Option<Located> = None;
-        for ((refs, (one, many)), total) in self.forward.iter().zip(KINDS).zip(totals) {
-            let Some(r) = refs.iter().find(|r| r.index > total) else {
-                continue;
-            };
-            let at = Located {
-                message: format!(
-                    "{one} index {} is out of range: the file has {total} {}",
-                    r.index,
-                    if total == 1 { one } else { many }
-                ),
-                ..r.at.clone()
-            };
-            if worst
-                .as_ref()
-                .is_none_or(|w| (at.line, at.col) < (w.line, w.col))
-            {
-                worst = Some(at);
-            }
-        }
-        if let Some(w) = worst {
-            return Err(self.first_bad_before(w));
-        }
-        if self.fatal_number {
-            if let Some(bad) = self.obj.first_bad_number.take() {
-                return Err(bad);
-            }
-        }
-        Ok(self.obj)
     }
 }
 
@@ -545,7 +533,7 @@ mod tests {
     use super::*;
 
     fn parse(text: &str) -> Result<Obj, Located> {
-        super::parse(text, &LoadProgress::silent())
+        super::super::stretches::parse(text, usize::MAX, &LoadProgress::silent())
     }
 
     #[test]

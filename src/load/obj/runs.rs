@@ -175,11 +175,11 @@ fn elements_in_range(obj: &Obj, normal0_used: bool) -> bool {
 
 #[cfg(test)]
 mod tests {
-    use super::super::parse::parse;
+    use super::super::stretches::parse;
     use super::*;
 
     fn checked(src: &str, materials: &[(usize, &str)]) -> Result<Obj, Located> {
-        let mut obj = parse(src, &crate::load::LoadProgress::silent()).unwrap();
+        let mut obj = parse(src, usize::MAX, &crate::load::LoadProgress::silent()).unwrap();
         check(&mut obj, materials).map(|()| obj)
     }
 
