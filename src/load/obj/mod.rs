@@ -7,7 +7,11 @@
 //! # Geometry
 //!
 //! The text is parsed once, by emray's own parser, which checks every statement as it
-//! reads it; the faces are then triangulated and the materials mapped:
+//! reads it; the faces are then triangulated and the materials mapped. A file larger
+//! than 4 MB is cut into stretches of about 4 MB at line starts, parsed in parallel
+//! on the current thread pool and joined in file order (`stretches`, `join`): the
+//! model, the warnings and the error are those of reading the file from start to end,
+//! whatever the cut, as `tests/obj_stretches.rs` checks.
 //!
 //! - Faces (`f`) with 3 vertices become one triangle directly; larger ones, convex or
 //!   not, are cut by ear clipping ([`crate::geometry::polygon`]), never as a blind fan,

@@ -260,8 +260,7 @@ pub(super) fn count(text: &str) -> Start {
     let mut n = Start::default();
     for line in text.lines() {
         n.line += 1;
-        // The keyword, as `Parser::statement` reads it.
-        match line.split_whitespace().next() {
+        match keyword(line) {
             Some("v") => n.counts.v += 1,
             Some("vt") => n.counts.vt += 1,
             Some("vn") => n.counts.vn += 1,
@@ -271,12 +270,38 @@ pub(super) fn count(text: &str) -> Start {
     n
 }
 
+/// The keyword of a statement: its first word, as [`str::split_whitespace`] finds it
+/// (looked at byte by byte when it is ASCII, as it almost always is).
+fn keyword(line: &str) -> Option<&str> {
+    let b = line.as_bytes();
+    let n = b
+        .iter()
+        .position(|c| !c.is_ascii_graphic())
+        .unwrap_or(b.len());
+    // The word ends at ASCII whitespace (vertical tab included), or the line's end.
+    if n > 0
+        && b.get(n)
+            .is_none_or(|&c| c.is_ascii_whitespace() || c == 0x0B)
+    {
+        return line.get(..n);
+    }
+    line.split_whitespace().next()
+}
+
+/// The byte offset of `word`, a slice of `line`.
+fn offset(line: &str, word: &str) -> usize {
+    (word.as_ptr() as usize).saturating_sub(line.as_ptr() as usize)
+}
+
 impl Parser {
     fn statement(&mut self, ln: usize, line: &str) -> Result<(), Located> {
-        let mut words = line.split_whitespace();
-        let Some(kw) = words.next() else {
+        let Some(kw) = keyword(line) else {
             return Ok(());
         };
+        let mut words = line
+            .get(offset(line, kw) + kw.len()..)
+            .unwrap_or_default()
+            .split_whitespace();
         match kw {
             "v" => self.vertex(ln, line, kw, &Words::new(words))?,
             "vt" => self.element(Element::Texture, ln, line, &Words::new(words))?,
@@ -651,6 +676,26 @@ f -3/-1/-1 -2/1/1 -1//1
         // But then the first bad number is the error.
         let e = parse("v 0 0 0\nv inf 0 0\nv 0 1e39 0\nv 0 0 x\n").unwrap_err();
         assert_eq!(e.line, 2);
+    }
+
+    #[test]
+    fn keywords_are_the_first_words() {
+        for line in [
+            "v 1",
+            "vt\t1",
+            "f",
+            " vn 1",
+            "\u{a0}v 1",
+            "v\u{a0}1",
+            "v\u{b}1",
+            "v\u{1}x",
+            "é 1",
+            "",
+        ] {
+            assert_eq!(keyword(line), line.split_whitespace().next(), "{line:?}");
+        }
+        let line = " \u{a0}usemtl a";
+        assert_eq!(offset(line, keyword(line).unwrap()), 3);
     }
 
     #[test]
