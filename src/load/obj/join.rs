@@ -102,11 +102,11 @@ fn first_bad_before(obj: &mut Obj, e: Located) -> Located {
 fn append(obj: &mut Obj, mut next: Obj) {
     let (corners, faces, usemtl) = (obj.corners.len(), obj.faces.len(), obj.usemtl.len());
     let colours = obj.counts.colours;
-    obj.positions.append(&mut next.positions);
-    obj.world.append(&mut next.world);
-    obj.texcoords.append(&mut next.texcoords);
-    obj.normals.append(&mut next.normals);
-    obj.corners.append(&mut next.corners);
+    append_list(&mut obj.positions, next.positions);
+    append_list(&mut obj.world, next.world);
+    append_list(&mut obj.texcoords, next.texcoords);
+    append_list(&mut obj.normals, next.normals);
+    append_list(&mut obj.corners, next.corners);
     obj.faces.extend(next.faces.into_iter().map(|mut f| {
         f.first += corners;
         f
@@ -127,4 +127,14 @@ fn append(obj: &mut Obj, mut next: Obj) {
     obj.lines += next.lines;
     obj.counts = next.counts;
     obj.counts.colours += colours;
+}
+
+/// `list` followed by `next`: `next` itself when `list` is empty (the first stretch's
+/// lists are not copied).
+fn append_list<T>(list: &mut Vec<T>, mut next: Vec<T>) {
+    if list.is_empty() {
+        *list = next;
+    } else {
+        list.append(&mut next);
+    }
 }

@@ -9,7 +9,8 @@
 //! The text is parsed once, by emray's own parser, which checks every statement as it
 //! reads it; the faces are then triangulated and the materials mapped. A file larger
 //! than 4 MB is cut into stretches of about 4 MB at line starts, parsed in parallel
-//! on the current thread pool and joined in file order (`stretches`, `join`): the
+//! on the current thread pool (when it has more than one thread) and joined in file
+//! order (`stretches`, `join`): the
 //! model, the warnings and the error are those of reading the file from start to end,
 //! whatever the cut, as `tests/obj_stretches.rs` checks.
 //!
@@ -189,6 +190,17 @@ use std::time::{Duration, Instant};
 /// The size of the stretches a large file is cut into to be parsed in parallel.
 const STRETCH: usize = 4 << 20;
 
+/// The size of the stretches on the current thread pool: [`STRETCH`], or the whole
+/// file when there is one thread to parse them (stretches would only add work: their
+/// count, and the copy that joins them).
+fn stretch() -> usize {
+    if rayon::current_num_threads() > 1 {
+        STRETCH
+    } else {
+        usize::MAX
+    }
+}
+
 /// The material of faces without one: before any `usemtl`, or whose material is
 /// missing. Mid-grey (0.5), fully diffuse, ambient weight 1, no highlight.
 pub const DEFAULT_MATERIAL: Material = Material {
@@ -251,7 +263,7 @@ pub fn load(path: &Path) -> Result<Scene, LoadError> {
 /// # Errors
 /// As [`load`].
 pub fn load_with(path: &Path, progress: &LoadProgress<'_>) -> Result<Scene, LoadError> {
-    let data = read_geometry(path, Origin::Centre, STRETCH, progress)?;
+    let data = read_geometry(path, Origin::Centre, stretch(), progress)?;
     for w in &data.warnings {
         log::warn!("{w}");
     }
@@ -297,7 +309,7 @@ pub fn load_geometry(path: &Path) -> Result<ObjData, LoadError> {
 /// # Errors
 /// As [`load_geometry`].
 pub fn load_geometry_at(path: &Path, origin: Origin) -> Result<ObjData, LoadError> {
-    read_geometry(path, origin, STRETCH, &LoadProgress::silent())
+    read_geometry(path, origin, stretch(), &LoadProgress::silent())
 }
 
 /// [`load_geometry`], with the text cut into stretches of about `stretch` bytes that

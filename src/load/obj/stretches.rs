@@ -4,12 +4,14 @@
 //! statement is one line). A first parallel pass counts the lines of each stretch and
 //! the elements its keywords define ([`parse::count`]); summed in order, they tell each
 //! stretch where it starts. A second parallel pass parses the stretches
-//! ([`parse::parse`]), and [`Joined`] joins them in file order. A small file is one
-//! stretch, parsed without the count.
+//! ([`parse::parse`]), a batch at a time, and [`Joined`] joins them in file order,
+//! each batch while the next is parsed, so that the join, which copies the stretches'
+//! lists into the file's on one thread, does not leave the other threads idle. A
+//! small file is one stretch, parsed without the count.
 
 use super::join::Joined;
 use super::located::Located;
-use super::parse::{self, Obj, Start};
+use super::parse::{self, Obj, Part, Start};
 use crate::load::LoadProgress;
 use rayon::prelude::*;
 
@@ -25,16 +27,34 @@ pub(super) fn parse(
 ) -> Result<Obj, Located> {
     let pieces = cut(text, stretch);
     let starts = starts(&pieces);
-    let parts: Vec<parse::Part> = pieces
+    let batch = rayon::current_num_threads().max(1) * 4;
+    let mut joined = Joined::default();
+    let mut pending = Vec::new();
+    for (pieces, starts) in pieces.chunks(batch).zip(starts.chunks(batch)) {
+        let earlier = std::mem::take(&mut pending);
+        let (added, parsed) = rayon::join(
+            || add(&mut joined, earlier),
+            || parse_batch(pieces, starts, progress),
+        );
+        added?;
+        pending = parsed;
+    }
+    add(&mut joined, pending)?;
+    joined.finish()
+}
+
+/// Parse a batch of stretches in parallel, in order.
+fn parse_batch(pieces: &[&str], starts: &[Start], progress: &LoadProgress<'_>) -> Vec<Part> {
+    pieces
         .par_iter()
         .zip(starts)
-        .map(|(piece, start)| parse::parse(piece, start, progress))
-        .collect();
-    let mut joined = Joined::default();
-    for part in parts {
-        joined.add(part)?;
-    }
-    joined.finish()
+        .map(|(piece, &start)| parse::parse(piece, start, progress))
+        .collect()
+}
+
+/// Join parsed stretches in order.
+fn add(joined: &mut Joined, parts: Vec<Part>) -> Result<(), Located> {
+    parts.into_iter().try_for_each(|part| joined.add(part))
 }
 
 /// Where each stretch starts: the lines and elements of the stretches before it.
