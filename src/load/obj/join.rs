@@ -2,8 +2,9 @@
 //! file gives: the statements of one [`Obj`], or the file's first problem.
 //!
 //! A stretch's line numbers and element indices are already the file's (see
-//! [`super::parse`]); the join moves its corner, face and `usemtl` indices past the
-//! earlier stretches' and adds the vertex colours counted before it. The first
+//! [`super::parse`]); the join moves its face and `usemtl` indices past the earlier
+//! stretches', points its faces at its own list of corners (kept as it is: the
+//! largest list is not copied), and adds the vertex colours counted before it. The first
 //! stretch stopped by a problem ends the join: its problem is the error, unless the
 //! file has a bad number on an earlier line, in this stretch or an earlier one. With
 //! none, the forward references are checked against the elements of the whole file,
@@ -11,7 +12,7 @@
 
 use super::colours::Colours;
 use super::located::Located;
-use super::parse::{ForwardRef, KINDS, Obj, Part};
+use super::parse::{Corner, ForwardRef, KINDS, Obj, Part};
 
 /// The stretches joined so far.
 #[derive(Default)]
@@ -35,7 +36,7 @@ impl Joined {
         if let Some(e) = part.error {
             return Err(first_bad_before(obj, e));
         }
-        append(obj, part.obj);
+        append(obj, part.obj, part.corners);
         for (all, refs) in self.forward.iter_mut().zip(part.forward) {
             all.extend(refs);
         }
@@ -98,19 +99,25 @@ fn first_bad_before(obj: &mut Obj, e: Located) -> Located {
     }
 }
 
-/// Append the statements of the next stretch to those of the earlier ones.
-fn append(obj: &mut Obj, mut next: Obj) {
-    let (corners, faces, usemtl) = (obj.corners.len(), obj.faces.len(), obj.usemtl.len());
+/// Append the statements of the next stretch, with its `corners`, to those of the
+/// earlier ones.
+fn append(obj: &mut Obj, mut next: Obj, corners: Vec<Corner>) {
+    let (part, faces, usemtl) = (obj.corners.len(), obj.faces.len(), obj.usemtl.len());
     let colours = obj.counts.colours;
     append_list(&mut obj.positions, next.positions);
     append_list(&mut obj.world, next.world);
     append_list(&mut obj.texcoords, next.texcoords);
     append_list(&mut obj.normals, next.normals);
-    append_list(&mut obj.corners, next.corners);
-    obj.faces.extend(next.faces.into_iter().map(|mut f| {
-        f.first += corners;
-        f
-    }));
+    obj.corners.push(corners);
+    if part == 0 {
+        // The faces of the first stretch name its list already.
+        append_list(&mut obj.faces, next.faces);
+    } else {
+        obj.faces.extend(next.faces.into_iter().map(|mut f| {
+            f.part = part;
+            f
+        }));
+    }
     obj.usemtl.extend(next.usemtl.into_iter().map(|mut u| {
         u.first_face += faces;
         u

@@ -41,7 +41,9 @@ pub(super) struct Corner {
 #[derive(Clone, Debug, PartialEq)]
 pub(super) struct Face {
     pub line: usize,
-    /// Index of its first corner in [`Obj::corners`].
+    /// The list of [`Obj::corners`] its corners are in (its stretch's).
+    pub part: usize,
+    /// Index of its first corner in that list.
     pub first: usize,
     pub arity: usize,
     pub is_line: bool,
@@ -105,7 +107,9 @@ pub(super) struct Obj {
     pub world: Vec<DVec3>,
     pub texcoords: Vec<Vec2>,
     pub normals: Vec<Vec3>,
-    pub corners: Vec<Corner>,
+    /// The corners of the faces and lines, one list per stretch of the file (the
+    /// stretches' lists are not copied into one).
+    pub corners: Vec<Vec<Corner>>,
     /// Faces and lines in file order.
     pub faces: Vec<Face>,
     pub usemtl: Vec<UseMtl>,
@@ -153,8 +157,11 @@ pub(super) struct Start {
 /// colours counted, are the stretch's own.
 #[derive(Debug, Default)]
 pub(super) struct Part {
-    /// The statements read ([`Obj::colour_mismatch`] is left for the join).
+    /// The statements read ([`Obj::colour_mismatch`] is left for the join), but for
+    /// the corners.
     pub obj: Obj,
+    /// The corners of the faces and lines read (their [`Face::part`] is 0).
+    pub corners: Vec<Corner>,
     /// Per kind: forward references, each larger than the one before in the stretch
     /// (the first in the file that turns out out of range is always among them).
     pub forward: [Vec<ForwardRef>; 3],
@@ -209,6 +216,16 @@ impl<'a> Words<'a> {
 /// # Errors
 /// The first problem, at its line and column (see the module documentation).
 impl Obj {
+    /// The corners of `face` (none if it names corners that do not exist).
+    pub fn corners_of(&self, face: &Face) -> &[Corner] {
+        corners_of(&self.corners, face)
+    }
+
+    /// How many corners the faces and lines have.
+    pub fn corner_count(&self) -> usize {
+        self.corners.iter().map(Vec::len).sum()
+    }
+
     /// The centre of the box around the finite vertex positions (the origin 0 when
     /// there is none): where a model alone is re-centred.
     pub fn centre(&self) -> DVec3 {
@@ -230,6 +247,13 @@ impl Obj {
             *p = (*w - origin).as_vec3();
         }
     }
+}
+
+/// The corners of `face` in `lists` ([`Obj::corners`]).
+pub(super) fn corners_of<'a>(lists: &'a [Vec<Corner>], face: &Face) -> &'a [Corner] {
+    let list = lists.get(face.part).map(Vec::as_slice);
+    list.and_then(|c| c.get(face.first..face.first + face.arity))
+        .unwrap_or_default()
 }
 
 /// Parse a stretch of OBJ text (lines split as [`str::lines`] does) that starts at
@@ -432,16 +456,16 @@ impl Parser {
         is_line: bool,
         words: std::str::SplitWhitespace,
     ) -> Result<(), Located> {
-        let first = self.part.obj.corners.len();
+        let first = self.part.corners.len();
         let mut all_normals = true;
         let mut all_texcoords = true;
         for tok in words {
             let (corner, normal, texcoord) = self.corner(ln, line, tok)?;
-            self.part.obj.corners.push(corner);
+            self.part.corners.push(corner);
             all_normals &= normal;
             all_texcoords &= texcoord;
         }
-        let arity = self.part.obj.corners.len() - first;
+        let arity = self.part.corners.len() - first;
         if is_line {
             self.part.obj.lines += 1;
         } else if arity == 0 {
@@ -454,6 +478,7 @@ impl Parser {
         }
         self.part.obj.faces.push(Face {
             line: ln,
+            part: 0,
             first,
             arity,
             is_line,
@@ -610,7 +635,7 @@ f -3/-1/-1 -2/1/1 -1//1
         assert_eq!(u, [(1, "m1", 8), (4, "m 2", 13)]);
         assert!(obj.colour_mismatch.is_none());
         // Relative indices count back from the last element defined.
-        let last = &obj.corners[obj.faces[4].first..];
+        let last = obj.corners_of(&obj.faces[4]);
         let c = |v, vt, vn| Corner { v, vt, vn };
         assert_eq!(last, [c(0, 0, 0), c(1, 0, 0), c(2, NONE, 0)]);
         assert_eq!(obj.positions[1], Vec3::X);

@@ -63,8 +63,7 @@ pub(super) fn group_normals(obj: &Obj, groups: &[u32]) -> HashMap<GroupKey, Vec3
 /// The positions of `face`'s vertices into `out`; false if an index is out of range.
 pub(super) fn positions(obj: &Obj, face: &Face, out: &mut Vec<Vec3>) -> bool {
     out.clear();
-    let corners = obj.corners.get(face.first..face.first + face.arity);
-    for c in corners.unwrap_or_default() {
+    for c in obj.corners_of(face) {
         match obj.positions.get(c.v) {
             Some(&p) => out.push(p),
             None => return false,
