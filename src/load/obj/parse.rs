@@ -211,10 +211,6 @@ impl<'a> Words<'a> {
     }
 }
 
-/// Parse the OBJ text (lines split as [`str::lines`] does).
-///
-/// # Errors
-/// The first problem, at its line and column (see the module documentation).
 impl Obj {
     /// The corners of `face` (none if it names corners that do not exist).
     pub fn corners_of(&self, face: &Face) -> &[Corner] {
