@@ -75,7 +75,7 @@ impl<'a> Builder<'a> {
         slots: &[u32],
         materials: &mut Materials,
     ) -> Result<(), LoadError> {
-        let corners = obj.corners.len();
+        let corners = obj.corner_count();
         self.geometry.triangles.items.reserve(corners / 3);
         self.geometry.triangles.material.reserve(corners / 3);
         self.geometry.triangle_normals.reserve(corners / 3);
@@ -144,9 +144,8 @@ impl<'a> Builder<'a> {
     fn shading_normals(&mut self, obj: &Obj, face: &Face, context: &FaceContext) -> bool {
         self.nrm.clear();
         if face.all_normals && face.normals_defined {
-            let corners = obj.corners.get(face.first..face.first + face.arity);
-            let normals = corners
-                .unwrap_or_default()
+            let normals = obj
+                .corners_of(face)
                 .iter()
                 .filter_map(|c| obj.normals.get(c.vn).copied().and_then(unit));
             self.nrm.extend(normals);
@@ -175,9 +174,8 @@ impl<'a> Builder<'a> {
         if !(face.all_texcoords && face.texcoords_defined) {
             return;
         }
-        let corners = obj.corners.get(face.first..face.first + face.arity);
-        let uvs = corners
-            .unwrap_or_default()
+        let uvs = obj
+            .corners_of(face)
             .iter()
             .map(|c| obj.texcoords.get(c.vt).copied().unwrap_or_default());
         self.uvs.extend(uvs);

@@ -7,7 +7,12 @@
 //! # Geometry
 //!
 //! The text is parsed once, by emray's own parser, which checks every statement as it
-//! reads it; the faces are then triangulated and the materials mapped:
+//! reads it; the faces are then triangulated and the materials mapped. A file larger
+//! than 4 MB is cut into stretches of about 4 MB at line starts, parsed in parallel
+//! on the current thread pool (when it has more than one thread) and joined in file
+//! order (`stretches`, `join`): the
+//! model, the warnings and the error are those of reading the file from start to end,
+//! whatever the cut, as `tests/obj_stretches.rs` checks.
 //!
 //! - Faces (`f`) with 3 vertices become one triangle directly; larger ones, convex or
 //!   not, are cut by ear clipping ([`crate::geometry::polygon`]), never as a blind fan,
@@ -153,7 +158,9 @@
 //! an error.
 
 mod build;
+mod colours;
 mod framing;
+mod join;
 mod libs;
 mod located;
 mod material;
@@ -162,6 +169,7 @@ mod numbers;
 mod parse;
 mod runs;
 mod smoothing;
+mod stretches;
 mod texmap;
 mod textures;
 
@@ -178,6 +186,20 @@ use located::whole_file;
 use material::Materials;
 use std::path::Path;
 use std::time::{Duration, Instant};
+
+/// The size of the stretches a large file is cut into to be parsed in parallel.
+const STRETCH: usize = 4 << 20;
+
+/// The size of the stretches on the current thread pool: [`STRETCH`], or the whole
+/// file when there is one thread to parse them (stretches would only add work: their
+/// count, and the copy that joins them).
+fn stretch() -> usize {
+    if rayon::current_num_threads() > 1 {
+        STRETCH
+    } else {
+        usize::MAX
+    }
+}
 
 /// The material of faces without one: before any `usemtl`, or whose material is
 /// missing. Mid-grey (0.5), fully diffuse, ambient weight 1, no highlight.
@@ -241,7 +263,7 @@ pub fn load(path: &Path) -> Result<Scene, LoadError> {
 /// # Errors
 /// As [`load`].
 pub fn load_with(path: &Path, progress: &LoadProgress<'_>) -> Result<Scene, LoadError> {
-    let data = read_geometry(path, Origin::Centre, progress)?;
+    let data = read_geometry(path, Origin::Centre, stretch(), progress)?;
     for w in &data.warnings {
         log::warn!("{w}");
     }
@@ -287,20 +309,37 @@ pub fn load_geometry(path: &Path) -> Result<ObjData, LoadError> {
 /// # Errors
 /// As [`load_geometry`].
 pub fn load_geometry_at(path: &Path, origin: Origin) -> Result<ObjData, LoadError> {
-    read_geometry(path, origin, &LoadProgress::silent())
+    read_geometry(path, origin, stretch(), &LoadProgress::silent())
 }
 
-/// [`load_geometry_at`], telling `progress` how many of the file's bytes are parsed.
+/// [`load_geometry`], with the text cut into stretches of about `stretch` bytes that
+/// are parsed in parallel. The model, the warnings and the error are the same whatever
+/// the size; a small one makes many stretches of a small file (to test that).
+///
+/// # Errors
+/// As [`load_geometry`].
+pub fn load_geometry_in_stretches(path: &Path, stretch: usize) -> Result<ObjData, LoadError> {
+    read_geometry(
+        path,
+        Origin::At(DVec3::ZERO),
+        stretch,
+        &LoadProgress::silent(),
+    )
+}
+
+/// [`load_geometry_at`] in stretches of `stretch` bytes, telling `progress` how many
+/// of the file's bytes are parsed.
 fn read_geometry(
     path: &Path,
     origin: Origin,
+    stretch: usize,
     progress: &LoadProgress<'_>,
 ) -> Result<ObjData, LoadError> {
     let t0 = Instant::now();
     let text = text::read_lossy(path)?;
     progress.expect(text.len() as u64);
     let t_read = t0.elapsed();
-    let mut obj = parse::parse(&text, progress).map_err(|e| e.at(path))?;
+    let mut obj = stretches::parse(&text, stretch, progress).map_err(|e| e.at(path))?;
     let t_parse = t0.elapsed();
 
     let libs = libs::read(path, &obj.mtllibs);

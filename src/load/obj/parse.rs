@@ -1,15 +1,23 @@
-//! The OBJ statement parser: one pass over the text gives the elements (`v`, `vt`,
-//! `vn`), the faces and lines with their index triples, and the statements that apply
-//! to faces (`usemtl`, `mtllib`, `s`, `g`, `o`), after checking every statement.
+//! The OBJ statement parser: one pass over a stretch of the text (the whole file, or
+//! a part of it that starts at a line start) gives its elements (`v`, `vt`, `vn`), the
+//! faces and lines with their index triples, and the statements that apply to faces
+//! (`usemtl`, `mtllib`, `s`, `g`, `o`), after checking every statement.
 //!
-//! The first problem stops the parse with its `line:col`. Numbers are looked at after
-//! the structure: a structural problem is reported unless a number on an earlier line
-//! is bad (see [`super::numbers`]). Indices are resolved as written: a negative index
-//! counts back from the last element defined before the face, a positive one may name
-//! an element defined later in the file (checked at the end of the file here, and at
-//! the end of the face's run by [`super::runs`]).
+//! A stretch is parsed knowing where it starts ([`Start`]): the lines before it, and
+//! the elements defined before it, which [`count`] finds by looking at the keywords
+//! of the earlier stretches alone. So line numbers and element indices are the file's
+//! from the start, and a negative index counts back from the last element defined
+//! before the face, whichever stretch defined it.
+//!
+//! The first problem stops the stretch with its `line:col`. Numbers are looked at
+//! after the structure: a structural problem is reported unless a number on an earlier
+//! line is bad (see [`super::numbers`]; [`super::join`] decides, as the bad number may
+//! be in an earlier stretch). A positive index may name an element defined later in
+//! the file: such forward references are noted, and checked against the whole file by
+//! [`super::join`] and against the end of the face's run by [`super::runs`].
 
-use super::located::{Located, article, comment_hint, name_after_space, show};
+use super::colours::{ColourNote, Colours};
+use super::located::{Located, article, col_of, comment_hint, name_after_space, show};
 use super::numbers::{self, Element};
 use crate::load::LoadProgress;
 use glam::{DVec3, Vec2, Vec3};
@@ -33,7 +41,9 @@ pub(super) struct Corner {
 #[derive(Clone, Debug, PartialEq)]
 pub(super) struct Face {
     pub line: usize,
-    /// Index of its first corner in [`Obj::corners`].
+    /// The list of [`Obj::corners`] its corners are in (its stretch's).
+    pub part: usize,
+    /// Index of its first corner in that list.
     pub first: usize,
     pub arity: usize,
     pub is_line: bool,
@@ -97,7 +107,9 @@ pub(super) struct Obj {
     pub world: Vec<DVec3>,
     pub texcoords: Vec<Vec2>,
     pub normals: Vec<Vec3>,
-    pub corners: Vec<Corner>,
+    /// The corners of the faces and lines, one list per stretch of the file (the
+    /// stretches' lists are not copied into one).
+    pub corners: Vec<Vec<Corner>>,
     /// Faces and lines in file order.
     pub faces: Vec<Face>,
     pub usemtl: Vec<UseMtl>,
@@ -111,14 +123,14 @@ pub(super) struct Obj {
     /// Elements defined by the whole file.
     pub counts: Counts,
     /// The first `v` whose colour (x y z r g b) is present where the first `v`'s is
-    /// not, or the other way round.
+    /// not, or the other way round (found when the stretches are joined).
     pub colour_mismatch: Option<Located>,
     /// The first bad number of the file (see [`super::numbers`]).
     pub first_bad_number: Option<Located>,
 }
 
 /// Element kinds that faces index: vertices, texture coordinates, normals.
-const KINDS: [(&str, &str); 3] = [
+pub(super) const KINDS: [(&str, &str); 3] = [
     ("vertex", "vertices"),
     ("texture coordinate", "texture coordinates"),
     ("normal", "normals"),
@@ -127,22 +139,45 @@ const KINDS: [(&str, &str); 3] = [
 /// A positive index beyond the elements defined so far: valid only if the file defines
 /// enough elements later.
 #[derive(Debug)]
-struct ForwardRef {
-    index: usize,
-    at: Located,
+pub(super) struct ForwardRef {
+    pub index: usize,
+    pub at: Located,
+}
+
+/// Where a stretch starts: after `line` lines of the file, which define `counts`
+/// elements (their vertex colours are not counted: see [`count`]).
+#[derive(Clone, Copy, Debug, Default, PartialEq, Eq)]
+pub(super) struct Start {
+    pub line: usize,
+    pub counts: Counts,
+}
+
+/// What a stretch gives. In [`Part::obj`], line numbers and element indices are the
+/// file's; the indices of corners, faces and `usemtl` statements, and the vertex
+/// colours counted, are the stretch's own.
+#[derive(Debug, Default)]
+pub(super) struct Part {
+    /// The statements read ([`Obj::colour_mismatch`] is left for the join), but for
+    /// the corners.
+    pub obj: Obj,
+    /// The corners of the faces and lines read (their [`Face::part`] is 0).
+    pub corners: Vec<Corner>,
+    /// Per kind: forward references, each larger than the one before in the stretch
+    /// (the first in the file that turns out out of range is always among them).
+    pub forward: [Vec<ForwardRef>; 3],
+    /// Which vertices have colours.
+    pub colours: Colours,
+    /// A number that does not parse (or a weight of 0) was met.
+    pub fatal_number: bool,
+    /// The problem that stopped the stretch (a bad number on an earlier line may come
+    /// first: see [`super::join`]).
+    pub error: Option<Located>,
 }
 
 /// The parser's state between lines.
 #[derive(Default)]
 struct Parser {
-    obj: Obj,
-    /// Per kind: forward references, each larger than the one before (the first that
-    /// turns out out of range is always among them).
-    forward: [Vec<ForwardRef>; 3],
-    /// Whether the first `v` has a colour, and its line.
-    first_has_colour: Option<(bool, usize)>,
-    /// A number that does not parse (or a weight of 0) was met.
-    fatal_number: bool,
+    part: Part,
 }
 
 /// The words of a statement after its keyword: how many, and the first seven.
@@ -176,11 +211,17 @@ impl<'a> Words<'a> {
     }
 }
 
-/// Parse the OBJ text (lines split as [`str::lines`] does).
-///
-/// # Errors
-/// The first problem, at its line and column (see the module documentation).
 impl Obj {
+    /// The corners of `face` (none if it names corners that do not exist).
+    pub fn corners_of(&self, face: &Face) -> &[Corner] {
+        corners_of(&self.corners, face)
+    }
+
+    /// How many corners the faces and lines have.
+    pub fn corner_count(&self) -> usize {
+        self.corners.iter().map(Vec::len).sum()
+    }
+
     /// The centre of the box around the finite vertex positions (the origin 0 when
     /// there is none): where a model alone is re-centred.
     pub fn centre(&self) -> DVec3 {
@@ -204,44 +245,90 @@ impl Obj {
     }
 }
 
-pub(super) fn parse(text: &str, progress: &LoadProgress<'_>) -> Result<Obj, Located> {
+/// The corners of `face` in `lists` ([`Obj::corners`]).
+pub(super) fn corners_of<'a>(lists: &'a [Vec<Corner>], face: &Face) -> &'a [Corner] {
+    let list = lists.get(face.part).map(Vec::as_slice);
+    list.and_then(|c| c.get(face.first..face.first + face.arity))
+        .unwrap_or_default()
+}
+
+/// Parse a stretch of OBJ text (lines split as [`str::lines`] does) that starts at
+/// `start`, telling `progress` of its bytes as they are read.
+pub(super) fn parse(text: &str, start: Start, progress: &LoadProgress<'_>) -> Part {
     let mut p = Parser::default();
-    // Bytes read since `progress` was last advanced.
-    let mut read = 0;
+    p.part.obj.counts = start.counts;
+    // Bytes read since `progress` was last advanced, and before.
+    let (mut read, mut told) = (0, 0);
     for (i, line) in text.lines().enumerate() {
-        if let Err(e) = p.statement(i + 1, line) {
-            return Err(p.first_bad_before(e));
+        if let Err(e) = p.statement(start.line + i + 1, line) {
+            p.part.error = Some(e);
+            return p.part;
         }
         read += line.len() + 1;
         if read >= PROGRESS_CHUNK {
             progress.advance(read as u64);
-            read = 0;
+            (told, read) = (told + read, 0);
         }
     }
-    p.finish()
+    progress.advance(text.len().saturating_sub(told) as u64);
+    p.part
+}
+
+/// The lines of a stretch and the elements they define, as far as their keywords
+/// tell: exact up to the stretch's first problem, after which nothing counts.
+pub(super) fn count(text: &str) -> Start {
+    let mut n = Start::default();
+    for line in text.lines() {
+        n.line += 1;
+        match keyword(line) {
+            Some("v") => n.counts.v += 1,
+            Some("vt") => n.counts.vt += 1,
+            Some("vn") => n.counts.vn += 1,
+            _ => {}
+        }
+    }
+    n
+}
+
+/// The keyword of a statement: its first word, as [`str::split_whitespace`] finds it
+/// (looked at byte by byte when it is ASCII, as it almost always is).
+fn keyword(line: &str) -> Option<&str> {
+    let b = line.as_bytes();
+    let n = b
+        .iter()
+        .position(|c| !c.is_ascii_graphic())
+        .unwrap_or(b.len());
+    // The word ends at ASCII whitespace (vertical tab included), or the line's end.
+    if n > 0
+        && b.get(n)
+            .is_none_or(|&c| c.is_ascii_whitespace() || c == 0x0B)
+    {
+        return line.get(..n);
+    }
+    line.split_whitespace().next()
+}
+
+/// The byte offset of `word`, a slice of `line`.
+fn offset(line: &str, word: &str) -> usize {
+    (word.as_ptr() as usize).saturating_sub(line.as_ptr() as usize)
 }
 
 impl Parser {
-    /// `e`, or a bad number on an earlier line.
-    fn first_bad_before(&mut self, e: Located) -> Located {
-        match self.obj.first_bad_number.take() {
-            Some(b) if b.line < e.line => b,
-            _ => e,
-        }
-    }
-
     fn statement(&mut self, ln: usize, line: &str) -> Result<(), Located> {
-        let mut words = line.split_whitespace();
-        let Some(kw) = words.next() else {
+        let Some(kw) = keyword(line) else {
             return Ok(());
         };
+        let mut words = line
+            .get(offset(line, kw) + kw.len()..)
+            .unwrap_or_default()
+            .split_whitespace();
         match kw {
             "v" => self.vertex(ln, line, kw, &Words::new(words))?,
             "vt" => self.element(Element::Texture, ln, line, &Words::new(words))?,
             "vn" => self.element(Element::Normal, ln, line, &Words::new(words))?,
             "f" | "l" => self.face(ln, line, kw == "l", words)?,
             "usemtl" => self.usemtl(ln, line)?,
-            "mtllib" => self.obj.mtllibs.push(MtlLib {
+            "mtllib" => self.part.obj.mtllibs.push(MtlLib {
                 name: name_after_space(line).to_string(),
                 line: ln,
             }),
@@ -251,7 +338,10 @@ impl Parser {
                     None | Some("off") | Some("0") => 0,
                     Some(w) => w.parse::<u32>().unwrap_or(u32::MAX).max(1),
                 };
-                self.obj.smoothing.push((self.obj.faces.len(), group));
+                self.part
+                    .obj
+                    .smoothing
+                    .push((self.part.obj.faces.len(), group));
             }
             "g" | "o" => self.cut(ln, None),
             _ => {}
@@ -261,10 +351,10 @@ impl Parser {
 
     /// A statement that may end a run of faces.
     fn cut(&mut self, ln: usize, usemtl: Option<usize>) {
-        self.obj.cuts.push(Cut {
-            first_face: self.obj.faces.len(),
+        self.part.obj.cuts.push(Cut {
+            first_face: self.part.obj.faces.len(),
             line: ln,
-            counts: self.obj.counts,
+            counts: self.part.obj.counts,
             usemtl,
         });
     }
@@ -284,37 +374,17 @@ impl Parser {
                 format!("a vertex is 'x y z', 'x y z w' or 'x y z r g b', found {n} numbers{hint}");
             return Err(err(tok, message));
         }
-        self.note_colour(n == 6, ln, || err(Some(kw), String::new()));
-        let read = self.numbers(Element::Vertex, ln, line, w);
-        self.obj.positions.push(Vec3::from(read.values));
-        self.obj.world.push(DVec3::from(read.exact));
-        self.obj.counts.v += 1;
-        self.obj.counts.colours += read.colours;
-        Ok(())
-    }
-
-    /// Note whether this vertex has a colour, and the first that differs from the
-    /// first vertex in this.
-    fn note_colour(&mut self, has_colour: bool, ln: usize, at: impl Fn() -> Located) {
-        let Some((first, first_ln)) = self.first_has_colour else {
-            self.first_has_colour = Some((has_colour, ln));
-            return;
-        };
-        if first == has_colour || self.obj.colour_mismatch.is_some() {
-            return;
-        }
-        let (this, that) = if has_colour {
-            ("has a colour", "has none")
-        } else {
-            ("has no colour", "has one")
-        };
-        self.obj.colour_mismatch = Some(Located {
-            message: format!(
-                "this vertex {this} but the first one (line {first_ln}) {that}: vertex colours \
-                 must be on every vertex or on none"
-            ),
-            ..at()
+        self.part.colours.note(ColourNote {
+            has_colour: n == 6,
+            line: ln,
+            col: col_of(line, kw),
         });
+        let read = self.numbers(Element::Vertex, ln, line, w);
+        self.part.obj.positions.push(Vec3::from(read.values));
+        self.part.obj.world.push(DVec3::from(read.exact));
+        self.part.obj.counts.v += 1;
+        self.part.obj.counts.colours += read.colours;
+        Ok(())
     }
 
     /// `vt u v [w]` or `vn x y z`.
@@ -334,11 +404,11 @@ impl Parser {
         }
         let [a, b, c] = self.numbers(kind, ln, line, w).values;
         if kind == Element::Texture {
-            self.obj.texcoords.push(Vec2::new(a, b));
-            self.obj.counts.vt += 1;
+            self.part.obj.texcoords.push(Vec2::new(a, b));
+            self.part.obj.counts.vt += 1;
         } else {
-            self.obj.normals.push(Vec3::new(a, b, c));
-            self.obj.counts.vn += 1;
+            self.part.obj.normals.push(Vec3::new(a, b, c));
+            self.part.obj.counts.vn += 1;
         }
         Ok(())
     }
@@ -346,9 +416,9 @@ impl Parser {
     /// Read the numbers of an element statement, keeping the file's first problem.
     fn numbers(&mut self, kind: Element, ln: usize, line: &str, w: &Words) -> numbers::Numbers {
         let mut read = numbers::read(kind, ln, line, w.kept(), w.n);
-        self.fatal_number |= read.fatal;
-        if self.obj.first_bad_number.is_none() {
-            self.obj.first_bad_number = read.bad.take();
+        self.part.fatal_number |= read.fatal;
+        if self.part.obj.first_bad_number.is_none() {
+            self.part.obj.first_bad_number = read.bad.take();
         }
         read
     }
@@ -364,9 +434,9 @@ impl Parser {
                 "expected a material name after 'usemtl' (separated by a space)".into(),
             ));
         }
-        let k = self.obj.usemtl.len();
-        self.obj.usemtl.push(UseMtl {
-            first_face: self.obj.faces.len(),
+        let k = self.part.obj.usemtl.len();
+        self.part.obj.usemtl.push(UseMtl {
+            first_face: self.part.obj.faces.len(),
             name: name.to_string(),
             line: ln,
         });
@@ -382,18 +452,18 @@ impl Parser {
         is_line: bool,
         words: std::str::SplitWhitespace,
     ) -> Result<(), Located> {
-        let first = self.obj.corners.len();
+        let first = self.part.corners.len();
         let mut all_normals = true;
         let mut all_texcoords = true;
         for tok in words {
             let (corner, normal, texcoord) = self.corner(ln, line, tok)?;
-            self.obj.corners.push(corner);
+            self.part.corners.push(corner);
             all_normals &= normal;
             all_texcoords &= texcoord;
         }
-        let arity = self.obj.corners.len() - first;
+        let arity = self.part.corners.len() - first;
         if is_line {
-            self.obj.lines += 1;
+            self.part.obj.lines += 1;
         } else if arity == 0 {
             return Err(Located::at_token(
                 ln,
@@ -402,8 +472,9 @@ impl Parser {
                 "face without vertices".into(),
             ));
         }
-        self.obj.faces.push(Face {
+        self.part.obj.faces.push(Face {
             line: ln,
+            part: 0,
             first,
             arity,
             is_line,
@@ -468,9 +539,9 @@ impl Parser {
             )));
         };
         let count = match k {
-            0 => self.obj.counts.v,
-            1 => self.obj.counts.vt,
-            _ => self.obj.counts.vn,
+            0 => self.part.obj.counts.v,
+            1 => self.part.obj.counts.vt,
+            _ => self.part.obj.counts.vn,
         };
         if x == 0 {
             return Err(err(format!(
@@ -494,49 +565,12 @@ impl Parser {
     }
 
     fn forward_ref(&mut self, k: usize, index: usize, at: Located) {
-        let Some(refs) = self.forward.get_mut(k) else {
+        let Some(refs) = self.part.forward.get_mut(k) else {
             return;
         };
         if refs.last().is_none_or(|r| r.index < index) {
             refs.push(ForwardRef { index, at });
         }
-    }
-
-    /// Check the forward references against the whole file, and that every number
-    /// parses.
-    fn finish(mut self) -> Result<Obj, Located> {
-        let counts = self.obj.counts;
-        let totals = [counts.v, counts.vt, counts.vn];
-        // Forward references beyond the end: report the first in the file.
-        let mut worst: Option<Located> = None;
-        for ((refs, (one, many)), total) in self.forward.iter().zip(KINDS).zip(totals) {
-            let Some(r) = refs.iter().find(|r| r.index > total) else {
-                continue;
-            };
-            let at = Located {
-                message: format!(
-                    "{one} index {} is out of range: the file has {total} {}",
-                    r.index,
-                    if total == 1 { one } else { many }
-                ),
-                ..r.at.clone()
-            };
-            if worst
-                .as_ref()
-                .is_none_or(|w| (at.line, at.col) < (w.line, w.col))
-            {
-                worst = Some(at);
-            }
-        }
-        if let Some(w) = worst {
-            return Err(self.first_bad_before(w));
-        }
-        if self.fatal_number {
-            if let Some(bad) = self.obj.first_bad_number.take() {
-                return Err(bad);
-            }
-        }
-        Ok(self.obj)
     }
 }
 
@@ -545,7 +579,7 @@ mod tests {
     use super::*;
 
     fn parse(text: &str) -> Result<Obj, Located> {
-        super::parse(text, &LoadProgress::silent())
+        super::super::stretches::parse(text, usize::MAX, &LoadProgress::silent())
     }
 
     #[test]
@@ -597,7 +631,7 @@ f -3/-1/-1 -2/1/1 -1//1
         assert_eq!(u, [(1, "m1", 8), (4, "m 2", 13)]);
         assert!(obj.colour_mismatch.is_none());
         // Relative indices count back from the last element defined.
-        let last = &obj.corners[obj.faces[4].first..];
+        let last = obj.corners_of(&obj.faces[4]);
         let c = |v, vt, vn| Corner { v, vt, vn };
         assert_eq!(last, [c(0, 0, 0), c(1, 0, 0), c(2, NONE, 0)]);
         assert_eq!(obj.positions[1], Vec3::X);
@@ -663,6 +697,26 @@ f -3/-1/-1 -2/1/1 -1//1
         // But then the first bad number is the error.
         let e = parse("v 0 0 0\nv inf 0 0\nv 0 1e39 0\nv 0 0 x\n").unwrap_err();
         assert_eq!(e.line, 2);
+    }
+
+    #[test]
+    fn keywords_are_the_first_words() {
+        for line in [
+            "v 1",
+            "vt\t1",
+            "f",
+            " vn 1",
+            "\u{a0}v 1",
+            "v\u{a0}1",
+            "v\u{b}1",
+            "v\u{1}x",
+            "é 1",
+            "",
+        ] {
+            assert_eq!(keyword(line), line.split_whitespace().next(), "{line:?}");
+        }
+        let line = " \u{a0}usemtl a";
+        assert_eq!(offset(line, keyword(line).unwrap()), 3);
     }
 
     #[test]

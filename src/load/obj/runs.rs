@@ -15,7 +15,7 @@
 //! whose first vertex has no normal index uses the file's first normal.
 
 use super::located::Located;
-use super::parse::{Corner, Counts, Face, NONE, Obj};
+use super::parse::{Corner, Counts, Face, NONE, Obj, corners_of};
 use crate::scene::range;
 use std::collections::HashMap;
 use std::ops::Range;
@@ -115,11 +115,7 @@ fn end_run(
     let faces = obj.faces.get_mut(run).unwrap_or_default();
     let mut first_corner = true;
     for face in faces.iter_mut() {
-        let corners = obj
-            .corners
-            .get(face.first..face.first + face.arity)
-            .unwrap_or_default();
-        for c in corners {
+        for c in corners_of(&obj.corners, face) {
             check_corner(c, &counts)?;
             if first_corner && counts.vn > 0 && c.vn == NONE {
                 *normal0_used = true;
@@ -163,11 +159,7 @@ fn elements_in_range(obj: &Obj, normal0_used: bool) -> bool {
         return false;
     }
     obj.faces.iter().all(|f: &Face| {
-        let corners = obj
-            .corners
-            .get(f.first..f.first + f.arity)
-            .unwrap_or_default();
-        corners.iter().all(|c| {
+        obj.corners_of(f).iter().all(|c| {
             usable_position(c.v) && (!f.normals_defined || c.vn == NONE || usable_normal(c.vn))
         })
     })
@@ -175,11 +167,11 @@ fn elements_in_range(obj: &Obj, normal0_used: bool) -> bool {
 
 #[cfg(test)]
 mod tests {
-    use super::super::parse::parse;
+    use super::super::stretches::parse;
     use super::*;
 
     fn checked(src: &str, materials: &[(usize, &str)]) -> Result<Obj, Located> {
-        let mut obj = parse(src, &crate::load::LoadProgress::silent()).unwrap();
+        let mut obj = parse(src, usize::MAX, &crate::load::LoadProgress::silent()).unwrap();
         check(&mut obj, materials).map(|()| obj)
     }
 

@@ -63,8 +63,7 @@ pub(super) fn group_normals(obj: &Obj, groups: &[u32]) -> HashMap<GroupKey, Vec3
 /// The positions of `face`'s vertices into `out`; false if an index is out of range.
 pub(super) fn positions(obj: &Obj, face: &Face, out: &mut Vec<Vec3>) -> bool {
     out.clear();
-    let corners = obj.corners.get(face.first..face.first + face.arity);
-    for c in corners.unwrap_or_default() {
+    for c in obj.corners_of(face) {
         match obj.positions.get(c.v) {
             Some(&p) => out.push(p),
             None => return false,
@@ -86,13 +85,13 @@ pub(super) fn unit(n: Vec3) -> Option<Vec3> {
 
 #[cfg(test)]
 mod tests {
-    use super::super::parse::parse;
+    use super::super::stretches::parse;
     use super::*;
 
     #[test]
     fn groups_sum_area_weighted_normals_at_shared_positions() {
         let src = "v 0 0 0\nv 1 0 0\nv 0 1 0\nv 0 0 1\ns 1\nf 1 2 3\nf 1 4 2\ns off\nf 1 3 4\n";
-        let obj = parse(src, &crate::load::LoadProgress::silent()).unwrap();
+        let obj = parse(src, usize::MAX, &crate::load::LoadProgress::silent()).unwrap();
         let groups = face_groups(&obj);
         assert_eq!(groups, [1, 1, 0]);
         let sums = group_normals(&obj, &groups);
