@@ -62,6 +62,11 @@ const PARSE_ONLY: &[(&str, &str)] = &[
         "counts 48 million spheres, then is refused (exits 1, as documented)",
     ),
     (
+        "render balls7.nff",
+        "5.4 million spheres from the 228 MB file `emray gen balls -s 7` writes: seconds \
+         and gigabytes",
+    ),
+    (
         "scenes/ice-cube.toml -o",
         "depth 10, 19 million rays: about 6 s",
     ),
