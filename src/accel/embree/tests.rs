@@ -610,8 +610,10 @@ fn packets_find_what_single_rays_find() {
 }
 
 /// A compact scene (`RTC_SCENE_FLAG_COMPACT`) answers every query as the default one:
-/// the same primitive at the same distance, the same shadow answers; its description
-/// says so.
+/// the same hits bit for bit on the user geometry, the same triangle at the same
+/// distance (Embree 4's compact triangles round `u` and `v` otherwise; the renderer
+/// recomputes a triangle hit's exactly anyway), the same shadow answers; its
+/// description says so.
 #[test]
 fn a_compact_scene_answers_as_the_default_one() {
     let s = triangles_spheres_cones();
@@ -627,7 +629,17 @@ fn a_compact_scene_answers_as_the_default_one() {
     assert!(compact.stats().detail.contains(", compact"));
     assert!(!plain.stats().detail.contains("compact"));
     for r in &rays {
-        assert_eq!(plain.intersect(r), compact.intersect(r), "{r:?}");
+        match (plain.intersect(r), compact.intersect(r)) {
+            (Some(a), Some(b)) if a.kind() == Kind::Triangle => {
+                assert_eq!((a.geom_id, a.prim_id), (b.geom_id, b.prim_id), "{r:?}");
+                assert!((a.t - b.t).abs() <= 1e-5 * a.t, "{r:?}");
+                assert!(
+                    (a.u - b.u).abs() <= 1e-5 && (a.v - b.v).abs() <= 1e-5,
+                    "{r:?}"
+                );
+            }
+            (a, b) => assert_eq!(a, b, "{r:?}"),
+        }
         assert_eq!(plain.occluded(r), compact.occluded(r), "{r:?}");
     }
     assert!(!crate::accel::embree_compact_for(1 << 20));
