@@ -222,6 +222,17 @@ impl RadiosityOptions {
     }
 }
 
+/// The camera rays a render with `settings` casts at the least: a sample per pixel
+/// position of its region (one more row and column in SPD mode) times the samples per
+/// pixel.
+fn camera_rays(settings: &RenderSettings) -> u64 {
+    let r = settings
+        .region
+        .unwrap_or(Region::full(settings.width, settings.height));
+    let extra = u64::from(settings.spd);
+    (r.width() as u64 + extra) * (r.height() as u64 + extra) * u64::from(settings.spp.max(1))
+}
+
 impl RenderOptions {
     /// What no scene can make right: values out of range, options that cannot go
     /// together, heat maps that are not `WHAT FILE.png` pairs.
@@ -229,6 +240,7 @@ impl RenderOptions {
         in_range("spp", self.spp, 1, 65536, "1 to 65536")?;
         in_range("max_depth", self.max_depth, 1, 64, "1 to 64")?;
         in_range("aa_depth", self.aa_depth, 0, 8, "0 to 8")?;
+        in_range("embree_group", self.embree_group, 1, 64, "1 to 64")?;
         in_range("area_samples", self.area_samples, 1, 4096, "1 to 4096")?;
         one_of(
             "packet_width",
@@ -302,13 +314,16 @@ impl RenderOptions {
         Ok(out)
     }
 
-    /// The backend and how to build it.
+    /// The backend and how to build it, the render's camera rays not yet known (see
+    /// [`RenderOptions::resolve`]).
     pub fn backend_options(&self) -> BackendOptions {
         BackendOptions {
             backend: self.backend.unwrap_or_else(Backend::default_available),
             embree_quality: self.embree_quality.unwrap_or_default(),
             embree_robust: self.embree_fast != Some(true),
             embree_compact: self.embree_compact,
+            embree_group: self.embree_group,
+            camera_rays: 0,
             packet_width: self.packet_width.unwrap_or(DEFAULT_PACKET_WIDTH),
             shadow_packet_width: self.shadow_packet_width,
         }
@@ -322,9 +337,13 @@ impl RenderOptions {
             let spp = self.spp.unwrap_or(DEFAULT_REFERENCE_SPP);
             (spp as f64).sqrt().floor() as u32
         });
+        let settings = self.settings(scene)?;
         Ok(Resolved {
-            settings: self.settings(scene)?,
-            backend: self.backend_options(),
+            backend: BackendOptions {
+                camera_rays: camera_rays(&settings),
+                ..self.backend_options()
+            },
+            settings,
             radiosity: self.gi.map(|Gi::Radiosity| self.radiosity.settings()),
             encoding: self.encoding.unwrap_or_default(),
             layers: self.aov.map(|a| a.0).unwrap_or_default(),

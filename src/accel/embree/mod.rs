@@ -5,7 +5,9 @@
 //! - `scene`: the build (triangles natively, one user geometry per analytic kind) and
 //!   the committed scene the queries run on;
 //! - `user`: the user-geometry callbacks, which call the shared `geometry::`
-//!   intersectors and keep their panics from unwinding into Embree.
+//!   intersectors and keep their panics from unwinding into Embree;
+//! - `group`: the order that puts neighbouring primitives together when one Embree
+//!   primitive stands for several (large scenes).
 //!
 //! Geometry ids are the [`Kind`](crate::geometry::Kind) discriminants and primitive ids
 //! the index within the kind, exactly as the BVH reports them. Embree 3 and 4 differ in
@@ -17,6 +19,7 @@
 
 mod device;
 mod error;
+mod group;
 mod scene;
 mod sys;
 mod user;
@@ -27,7 +30,8 @@ mod tests;
 pub use error::EmbreeError;
 
 use crate::accel::{
-    Accel, AccelStats, Backend, BackendOptions, Hit, embree_compact_for, shadow_packet_width_for,
+    Accel, AccelStats, Backend, BackendOptions, Hit, embree_compact_for, embree_group_for,
+    shadow_packet_width_for,
 };
 use crate::math::Ray;
 use crate::scene::Scene;
@@ -91,19 +95,29 @@ impl<'s> EmbreeAccel<'s> {
         let compact = options
             .embree_compact
             .unwrap_or_else(|| embree_compact_for(prims));
+        let group = options
+            .embree_group
+            .unwrap_or_else(|| embree_group_for(prims, options.camera_rays))
+            .max(1);
         let before = device.allocated_bytes();
-        let committed = CommittedScene::build(&device, scene, quality, robust, compact)?;
+        let committed =
+            CommittedScene::build(&device, scene, quality, robust, compact, group as usize)?;
         let shadow_packet_width = options
             .shadow_packet_width
             .unwrap_or_else(|| shadow_packet_width_for(&committed.kinds));
         let api = if cfg!(embree4) { "embree4" } else { "embree3" };
         let detail = format!(
-            "{}, {api} API (headers {}), {} traversal, {} build quality{}, shadow rays {}",
+            "{}, {api} API (headers {}), {} traversal, {} build quality{}{}, shadow rays {}",
             device.describe(),
             env!("EMRAY_EMBREE_HEADER_VERSION"),
             if robust { "robust" } else { "fast" },
             quality.name(),
             if compact { ", compact" } else { "" },
+            if group > 1 {
+                format!(", analytic primitives in groups of {group}")
+            } else {
+                String::new()
+            },
             match shadow_packet_width {
                 4 | 8 | 16 => format!("in packets of {shadow_packet_width}"),
                 _ => "one by one".to_string(),

@@ -3,6 +3,7 @@
 
 use super::device::Device;
 use super::error::EmbreeError;
+use super::group::morton_order;
 use super::sys;
 use super::user::{self, UserGeometry, UserPrims, rethrow_caught};
 use crate::accel::unbounded::{Unbounded, is_unbounded};
@@ -152,12 +153,14 @@ impl<'s> Level<'s> {
     }
 
     /// Attach every bounded primitive of `geometry`, one geometry per kind present,
-    /// adding to `kinds` the count of each kind (the unbounded ones included: the
-    /// [`Unbounded`] list holds them).
+    /// `group` analytic primitives per Embree primitive (see `group`), adding to
+    /// `kinds` the count of each kind (the unbounded ones included: the [`Unbounded`]
+    /// list holds them).
     fn attach_geometry(
         &mut self,
         device: &Device,
         geometry: &'s SceneGeometry,
+        group: usize,
         kinds: &mut Vec<(Kind, usize)>,
     ) -> Result<(), EmbreeError> {
         if !geometry.triangles.is_empty() {
@@ -167,6 +170,7 @@ impl<'s> Level<'s> {
         let mut attach = AttachUser {
             device,
             level: self,
+            group,
             kinds,
             user: Vec::new(),
         };
@@ -196,6 +200,8 @@ impl<'s> Level<'s> {
 struct AttachUser<'a, 's> {
     device: &'a Device,
     level: &'a Level<'s>,
+    /// Primitives per Embree primitive.
+    group: usize,
     kinds: &'a mut Vec<(Kind, usize)>,
     user: Vec<Box<dyn UserGeometry + 's>>,
 }
@@ -206,7 +212,22 @@ impl<'s> KindVisitor<'s> for AttachUser<'_, 's> {
     fn visit<P: Analytic>(&mut self, list: &'s Prims<P>) -> Result<(), EmbreeError> {
         add_kind(self.kinds, P::KIND, list.len());
         let items = &list.items[..];
-        if let Some(data) = attach_user(self.device, self.level, items, bounded_ids(items))? {
+        let ids = bounded_ids(items);
+        let held = ids.as_ref().map_or(items.len(), |ids| ids.len());
+        let (ids, group) = if self.group > 1 && held > self.group {
+            let start = std::time::Instant::now();
+            let order = morton_order(items, ids);
+            log::info!(
+                "ordered {held} {} in groups of {} in {:.0?}",
+                P::KIND.name(),
+                self.group,
+                start.elapsed()
+            );
+            (Some(order), self.group)
+        } else {
+            (ids, 1)
+        };
+        if let Some(data) = attach_user(self.device, self.level, items, ids, group)? {
             self.user.push(data);
         }
         Ok(())
@@ -238,13 +259,14 @@ impl<'s> CommittedScene<'s> {
 
     /// Build and commit the scene of `scene`'s primitives at build quality `quality`,
     /// every level with `RTC_SCENE_FLAG_ROBUST` if `robust` and `RTC_SCENE_FLAG_COMPACT`
-    /// if `compact`.
+    /// if `compact`, `group` analytic primitives per Embree primitive.
     pub(super) fn build(
         device: &Device,
         scene: &'s crate::scene::Scene,
         quality: crate::accel::EmbreeQuality,
         robust: bool,
         compact: bool,
+        group: usize,
     ) -> Result<CommittedScene<'s>, EmbreeError> {
         use crate::accel::EmbreeQuality as Q;
         let quality = match quality {
@@ -257,12 +279,12 @@ impl<'s> CommittedScene<'s> {
         let mut objects = Vec::with_capacity(scene.objects.len());
         for object in &scene.objects {
             let mut level = Level::new(device, flags)?;
-            level.attach_geometry(device, object, &mut kinds)?;
+            level.attach_geometry(device, object, group, &mut kinds)?;
             level.commit(device, quality)?;
             objects.push(level);
         }
         let mut top = Level::new(device, flags)?;
-        top.attach_geometry(device, &scene.geometry, &mut kinds)?;
+        top.attach_geometry(device, &scene.geometry, group, &mut kinds)?;
         for (i, inst) in (0u32..).zip(&scene.instances) {
             let object = inst.object as usize;
             let id = INSTANCE_BASE.checked_add(i).ok_or_else(|| {
@@ -815,26 +837,29 @@ fn attach_triangles(
 }
 
 /// One user geometry holding the primitives `ids` of the scene's list `items` of kind
-/// `T::KIND` (all of them for `None`; no geometry when that is none). Returns the boxed
+/// `T::KIND` (all of them for `None`; no geometry when that is none), `group` of them
+/// per Embree primitive (consecutive ids; see `group`). Returns the boxed
 /// user data Embree's callbacks read, which must outlive `scene`'s handle.
 fn attach_user<'s, T: Analytic>(
     device: &Device,
     scene: &Level<'s>,
     items: &'s [T],
     ids: Option<Box<[u32]>>,
+    group: usize,
 ) -> Result<Option<Box<UserPrims<'s, T>>>, EmbreeError> {
     let kind = T::KIND;
     let len = ids.as_ref().map_or(items.len(), |ids| ids.len());
     if len == 0 {
         return Ok(None);
     }
-    let count = u32::try_from(len).map_err(|_| {
-        EmbreeError::emray(
+    if u32::try_from(len).is_err() {
+        return Err(EmbreeError::emray(
             format!("building the {} geometry", kind.name()),
             format!("{len} primitives exceed Embree's 32-bit primitive ids"),
-        )
-    })?;
-    let data = Box::new(UserPrims::new(items, ids));
+        ));
+    }
+    let data = Box::new(UserPrims::grouped(items, ids, group));
+    let count = u32::try_from(data.embree_count()).unwrap_or(u32::MAX);
     let geometry = Geometry::new(
         device,
         sys::RTCGeometryType::RTC_GEOMETRY_TYPE_USER,

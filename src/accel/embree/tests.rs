@@ -410,13 +410,21 @@ fn inside_only_sphere_seen_from_outside_shows_its_far_side() {
     assert!(hits > 50, "{hits} hits");
 }
 
+/// The stats name Embree and its version and count the memory the build allocated. The
+/// build runs on a pool of 7 threads, which no other test uses, so that it has a
+/// device of its own: Embree's memory monitor counts a device's allocations, and other
+/// tests' scenes freed on a shared device during this build would hide this one's.
 #[test]
 fn stats_report_embree_and_its_version() {
     let mut s = scene();
     s.geometry
         .push(Sphere::new(Vec3::new(0.0, 0.0, 5.0), 1.0), 0);
     add_triangle(&mut s, Vec3::X, Vec3::Y, Vec3::Z);
-    let accel = build(&s);
+    let pool = rayon::ThreadPoolBuilder::new()
+        .num_threads(7)
+        .build()
+        .expect("a pool");
+    let accel = pool.install(|| build(&s));
     let st = accel.stats();
     assert_eq!(st.backend, "embree");
     assert_eq!(st.prims, 2);
@@ -830,4 +838,93 @@ fn bounded_and_unbounded_of_one_kind_keep_their_prim_ids() {
     }
     assert!(seen.iter().all(|&n| n > 0), "every quadric hit: {seen:?}");
     assert!(embree.stats().bytes > 0);
+}
+
+/// A cloud of touching, overlapping and coincident spheres (an inside-only one among
+/// them) and cones, in list order unrelated to space.
+fn sphere_cloud() -> Scene {
+    let mut s = triangles_spheres_cones();
+    let mut seed = 12345u32;
+    let mut next = || {
+        seed = seed.wrapping_mul(1_664_525).wrapping_add(1_013_904_223);
+        (seed >> 8) as f32 / (1u32 << 24) as f32
+    };
+    for i in 0..300 {
+        let c = Vec3::new(next() * 6.0 - 3.0, next() * 6.0 - 3.0, 4.0 + next() * 4.0);
+        let r = 0.05 + 0.3 * next();
+        let signed = if i == 7 { -r } else { r };
+        s.geometry.push(Sphere::new(c, signed), 0);
+        if i % 50 == 0 {
+            // The same sphere twice: ties go to the lower primitive id.
+            s.geometry.push(Sphere::new(c, r), 0);
+        }
+        if i % 3 == 0 {
+            let tip = c + Vec3::new(next() - 0.5, next() - 0.5, next() - 0.5);
+            s.geometry.push(Cone::new(c, r * 0.5, tip, 0.02), 0);
+        }
+    }
+    s
+}
+
+/// Analytic primitives in groups (`--embree-group`) give every query's answer as one
+/// Embree primitive each, bit for bit (which primitive, its id, t, u, v, normal),
+/// single rays, packets and shadow rays alike; and as the BVH.
+#[test]
+fn grouped_primitives_answer_as_one_by_one() {
+    let s = sphere_cloud();
+    let mut rays = packet_rays();
+    for org in [Vec3::new(0.2, 0.1, 0.0), Vec3::new(0.0, 0.0, 6.0)] {
+        rays.extend(fan(org, Vec3::new(0.1, -0.2, 6.5), 1.2, 31));
+    }
+    // A pool of 6 threads, which no other test uses, gives the builds a device of
+    // their own, whose memory monitor counts only them.
+    let pool = rayon::ThreadPoolBuilder::new()
+        .num_threads(6)
+        .build()
+        .expect("a pool");
+    let with = |group| {
+        let options = BackendOptions {
+            embree_group: Some(group),
+            ..BackendOptions::new(Backend::Embree)
+        };
+        pool.install(|| EmbreeAccel::build_with(&s, &options).unwrap())
+    };
+    let bvh = crate::accel::bvh::Bvh::build(&s);
+    let one = with(1);
+    assert!(!one.stats().detail.contains("groups"));
+    let single: Vec<Option<Hit>> = rays.iter().map(|r| one.intersect(r)).collect();
+    let spheres = single.iter().flatten().filter(|h| h.kind() == Kind::Sphere);
+    let distinct: std::collections::HashSet<u32> = spheres.map(|h| h.prim_id).collect();
+    assert!(distinct.len() > 100, "{} spheres hit", distinct.len());
+    for group in [2, 3, 16] {
+        let grouped = with(group);
+        assert!(
+            grouped
+                .stats()
+                .detail
+                .contains(&format!("groups of {group}")),
+            "{}",
+            grouped.stats().detail
+        );
+        assert!(grouped.stats().bytes < one.stats().bytes, "group {group}");
+        let mut packets = vec![None; rays.len()];
+        grouped.intersect_coherent(&rays, &mut packets);
+        let mut shadows = vec![false; rays.len()];
+        grouped.occluded_batch(&rays, &mut shadows);
+        for (i, r) in rays.iter().enumerate() {
+            let hit = grouped.intersect(r);
+            assert_eq!(hit, single[i], "group {group}: {r:?}");
+            if hit.is_some_and(|h| h.kind() != Kind::Triangle) {
+                assert_eq!(hit, bvh.intersect(r), "group {group}, BVH: {r:?}");
+                assert_eq!(packets[i], hit, "group {group}, packets: {r:?}");
+            }
+            assert_eq!(grouped.occluded(r), one.occluded(r), "group {group}: {r:?}");
+            assert_eq!(shadows[i], one.occluded(r), "group {group}, batch: {r:?}");
+        }
+    }
+    // Large scenes rendered with few camera rays per primitive are grouped.
+    assert_eq!(crate::accel::embree_group_for(1 << 20, 1 << 10), 1);
+    assert!(crate::accel::embree_group_for(1 << 22, 1 << 18) > 1);
+    assert_eq!(crate::accel::embree_group_for(1 << 22, 1 << 20), 1);
+    assert_eq!(crate::accel::embree_group_for(1 << 22, 0), 1);
 }

@@ -37,6 +37,8 @@ use std::ffi::c_void;
 use std::panic::{AssertUnwindSafe, catch_unwind};
 use std::sync::OnceLock;
 
+use rayon::prelude::*;
+
 use super::sys;
 use crate::geometry::Analytic;
 use crate::math::{Aabb, Ray, Vec3, next_float_up};
@@ -49,10 +51,18 @@ use crate::math::{Aabb, Ray, Vec3, next_float_up};
 pub(super) struct UserPrims<'s, T> {
     /// The scene's primitives of this kind.
     items: &'s [T],
-    /// The index in `items` of each of Embree's primitives, when the geometry holds
-    /// only some of them (not the unbounded ones); `None`: Embree's primitive `k` is
-    /// item `k`.
+    /// The indices in `items` that Embree's primitives stand for, when the geometry
+    /// holds only some of the items (not the unbounded ones) or holds them in another
+    /// order (in groups); `None`: Embree's primitive `k` is item `k`.
     ids: Option<Box<[u32]>>,
+    /// Items per Embree primitive: Embree's primitive `k` stands for
+    /// `ids[k·group .. (k + 1)·group]` (fewer for the last); 1 without groups.
+    group: usize,
+    /// With groups, the items in the order of `ids`, copied so that a group's members
+    /// lie together in memory (reading them through `ids` from the scene's list, where
+    /// neighbours in space may lie far apart, costs a cache miss per member); empty
+    /// without groups.
+    grouped: Box<[T]>,
     /// The first panic caught in the bounds callback (set from Embree's build threads).
     bounds_panic: OnceLock<String>,
     /// Test hook: the bounds callback panics.
@@ -61,32 +71,95 @@ pub(super) struct UserPrims<'s, T> {
 }
 
 impl<'s, T> UserPrims<'s, T> {
-    /// The user data of the scene's list `items`, of which Embree holds those `ids`
-    /// (all of them, in order, for `None`).
-    pub(super) fn new(items: &'s [T], ids: Option<Box<[u32]>>) -> Self {
+    /// The user data of the scene's list `items`, of which Embree holds those `ids`,
+    /// `group` consecutive ids per Embree primitive (`group` ≥ 1; with `None`, all
+    /// items in order).
+    pub(super) fn grouped(items: &'s [T], ids: Option<Box<[u32]>>, group: usize) -> Self
+    where
+        T: Clone + Send + Sync,
+    {
+        let group = group.max(1);
+        let grouped = match &ids {
+            Some(ids) if group > 1 => ids
+                .par_iter()
+                .filter_map(|&id| items.get(id as usize).cloned())
+                .collect(),
+            _ => Box::default(),
+        };
         UserPrims {
             items,
             ids,
+            group,
+            grouped,
             bounds_panic: OnceLock::new(),
             #[cfg(test)]
             panic_in_bounds: inject::take(Callback::Bounds),
         }
     }
 
-    /// Embree's primitive `prim_id`: the primitive, and its index in the scene's list
-    /// (the `primID` a hit reports); `None` for an id out of range.
+    /// The number of Embree primitives: one per group of ids.
+    pub(super) fn embree_count(&self) -> usize {
+        let len = self.ids.as_ref().map_or(self.items.len(), |ids| ids.len());
+        len.div_ceil(self.group)
+    }
+
+    /// The item with index `index` in the scene's list, and that index (the `primID` a
+    /// hit reports); `None` out of range.
     #[inline(always)]
-    fn prim(&self, prim_id: u32) -> Option<(&'s T, u32)> {
-        let index = match &self.ids {
-            None => prim_id,
-            Some(ids) => *ids.get(prim_id as usize)?,
-        };
+    fn item(&self, index: u32) -> Option<(&'s T, u32)> {
         Some((self.items.get(index as usize)?, index))
+    }
+
+    /// The items Embree's primitive `prim_id` stands for, in the order their tests run:
+    /// one item, or the indices of a group; `None` for an id out of range.
+    #[inline(always)]
+    fn members(&self, prim_id: u32) -> Option<Members<'_, 's, T>> {
+        let Some(ids) = &self.ids else {
+            return self.item(prim_id).map(Members::One);
+        };
+        if self.group == 1 {
+            let index = *ids.get(prim_id as usize)?;
+            return self.item(index).map(Members::One);
+        }
+        let first = (prim_id as usize).checked_mul(self.group)?;
+        let range = first..ids.len().min(first + self.group);
+        let (members, ids) = (self.grouped.get(range.clone())?, ids.get(range)?);
+        (!members.is_empty() && members.len() == ids.len()).then_some(Members::Group(members, ids))
     }
 
     /// The pointer registered with `rtcSetGeometryUserData`.
     pub(super) fn as_user_ptr(&self) -> *mut c_void {
         std::ptr::from_ref(self).cast_mut().cast()
+    }
+}
+
+/// The items behind one Embree primitive.
+enum Members<'u, 's, T> {
+    /// One item and its index.
+    One((&'s T, u32)),
+    /// A group: copies of its items, and their indices in the scene's list.
+    Group(&'u [T], &'u [u32]),
+}
+
+impl<'u, T> Members<'u, '_, T> {
+    /// Call `f` with each member and a way to its index, in order, until it returns
+    /// `true`; whether one did. The index is read only when asked for: on a hit (a
+    /// group's indices lie apart from its members, another cache line).
+    #[inline(always)]
+    fn any(&self, mut f: impl FnMut(&T, &dyn Fn() -> u32) -> bool) -> bool {
+        match self {
+            Members::One((item, index)) => f(item, &|| *index),
+            Members::Group(items, ids) => items.iter().zip(*ids).any(|(item, id)| f(item, &|| *id)),
+        }
+    }
+
+    /// Call `f` with each member, in order, until it returns `true`; whether one did.
+    #[inline(always)]
+    fn any_item(&self, f: impl FnMut(&T) -> bool) -> bool {
+        match self {
+            Members::One((item, _)) => std::iter::once(*item).any(f),
+            Members::Group(items, _) => items.iter().any(f),
+        }
     }
 }
 
@@ -102,9 +175,11 @@ pub(super) trait UserGeometry: Send + Sync + std::fmt::Debug {
 
 impl<T: Analytic> UserGeometry for UserPrims<'_, T> {
     fn bytes(&self) -> usize {
-        self.ids
+        let ids = self
+            .ids
             .as_ref()
-            .map_or(0, |ids| std::mem::size_of_val(&**ids))
+            .map_or(0, |ids| std::mem::size_of_val(&**ids));
+        ids + std::mem::size_of_val(&*self.grouped)
     }
 
     fn bounds_panic(&self) -> Option<String> {
@@ -391,8 +466,8 @@ unsafe fn prims<'a, T>(user_ptr: *mut c_void) -> Option<&'a UserPrims<'a, T>> {
     unsafe { user_ptr.cast::<UserPrims<'a, T>>().as_ref() }
 }
 
-/// `RTCBoundsFunction`: the shape's own bounds (empty, which Embree skips, for an
-/// unknown primitive or when the shape's `bounds` panics).
+/// `RTCBoundsFunction`: the shape's own bounds, or the union of a group's (empty,
+/// which Embree skips, for an unknown primitive or when a shape's `bounds` panics).
 pub(super) unsafe extern "C" fn bounds<T: Analytic>(args: *const sys::RTCBoundsFunctionArguments) {
     // SAFETY: Embree passes a valid argument struct for the duration of the call.
     let Some(args) = (unsafe { args.as_ref() }) else {
@@ -401,13 +476,20 @@ pub(super) unsafe extern "C" fn bounds<T: Analytic>(args: *const sys::RTCBoundsF
     // SAFETY: this callback is only registered on geometries whose user data is a
     // `UserPrims<T>` (see `scene::attach_user`).
     let user = unsafe { prims::<T>(args.geometryUserPtr) };
-    let prim = user.and_then(|p| p.prim(args.primID)).map(|(prim, _)| prim);
+    let members = user.and_then(|p| p.members(args.primID));
     let b = match catch_unwind(AssertUnwindSafe(|| {
         #[cfg(test)]
         if user.is_some_and(|u| u.panic_in_bounds) {
             panic!("injected panic");
         }
-        prim.map_or(Aabb::EMPTY, T::bounds)
+        let mut b = Aabb::EMPTY;
+        if let Some(members) = &members {
+            members.any_item(|prim| {
+                b = b.union(&prim.bounds());
+                false
+            });
+        }
+        b
     })) {
         Ok(b) => b,
         Err(payload) => {
@@ -454,9 +536,10 @@ unsafe fn report_all_missed(valid: *mut i32, n: usize) {
     }
 }
 
-/// `RTCIntersectFunctionN`: nearest hit with primitive `primID` for each active ray (or
-/// one at the current `tfar` that wins the tie with the hit there); on a hit, writes
-/// `tfar`, `u`, `v`, `Ng`, `primID`, `geomID` and `instID`.
+/// `RTCIntersectFunctionN`: nearest hit with primitive `primID` (each member of its
+/// group in turn) for each active ray, or one at the current `tfar` that wins the tie
+/// with the hit there; on a hit, writes `tfar`, `u`, `v`, `Ng`, `primID` (the member's
+/// index in the scene's list), `geomID` and `instID`.
 ///
 /// Packet queries call it with all `N` lanes of a packet and a mask whenever any lane
 /// reaches the primitive, so the per-call work (the primitive, its id, the instance
@@ -473,68 +556,38 @@ pub(super) unsafe extern "C" fn intersect<T: Analytic>(
     let n = args.N as usize;
     // SAFETY: registered only with `UserPrims<T>` user data (see `bounds`).
     let user = unsafe { prims::<T>(args.geometryUserPtr) };
-    let Some((prim, prim_id)) = user.and_then(|p| p.prim(args.primID)) else {
+    let Some(members) = user.and_then(|p| p.members(args.primID)) else {
         // SAFETY: `valid` has `N` entries.
         unsafe { report_all_missed(args.valid, n) };
         return;
     };
-    let packet = Packet {
-        base: args.rayhit.cast(),
-        n,
+    let lane = Lane {
+        packet: Packet {
+            base: args.rayhit.cast(),
+            n,
+        },
+        geom_id: args.geomID,
+        // SAFETY: `context` is the live query context or null.
+        inst: unsafe { instance_ids(args.context) },
+        #[cfg(embree_instance_array)]
+        // SAFETY: as above.
+        inst_prim: unsafe { instance_prim_ids(args.context) },
     };
-    // SAFETY: `context` is the live query context or null.
-    let inst = unsafe { instance_ids(args.context) };
-    #[cfg(embree_instance_array)]
-    // SAFETY: as above.
-    let inst_prim = unsafe { instance_prim_ids(args.context) };
     let lanes = || {
         for i in 0..n {
             // SAFETY: `valid` has `N` entries.
             if unsafe { args.valid.add(i).read() } == 0 {
                 continue;
             }
-            // SAFETY: `rayhit` is a live `RTCRayHitN` packet of `N` rays and `i < N`.
-            let mut ray = unsafe { packet.ray(i) };
-            // SAFETY: as above; the hit members follow the ray's.
-            let current = unsafe { current_hit(packet.hits(), i) };
-            // A hit at `tfar` already: look up to and including `tfar` for a coincident
-            // primitive that wins the tie (`Hit::wins_tie_with`), as the BVH does.
-            let tfar = ray.tmax;
-            if current.is_some() {
-                ray.tmax = next_float_up(tfar);
-            }
-            #[cfg(test)]
-            maybe_injected_panic(Callback::Intersect);
-            let hit = prim.intersect(&ray).filter(|h| {
-                h.t < tfar
-                    || current.is_some_and(|(geom, prim, level)| {
-                        h.t == tfar && level == inst[0] && (args.geomID, prim_id) < (geom, prim)
-                    })
+            let mut hit = false;
+            members.any(|prim, prim_id| {
+                // SAFETY: ray `i` of the live packet is active.
+                hit |= unsafe { lane.test(i, prim, prim_id) };
+                false
             });
-            let Some(h) = hit else {
+            if !hit {
                 // SAFETY: `valid` has `N` entries.
                 unsafe { report_miss(args.valid, i) };
-                continue;
-            };
-            // SAFETY: ray `i` is active; Embree expects the callback to write its `tfar`
-            // and hit members on a hit. All offsets are inside the packet.
-            unsafe {
-                packet.set_f32(soa::TFAR, i, h.t);
-                let hits = packet.hits();
-                hits.set_f32(soa::NG_X, i, h.ng.x);
-                hits.set_f32(soa::NG_Y, i, h.ng.y);
-                hits.set_f32(soa::NG_Z, i, h.ng.z);
-                hits.set_f32(soa::U, i, h.u);
-                hits.set_f32(soa::V, i, h.v);
-                hits.set_u32(soa::PRIM_ID, i, prim_id);
-                hits.set_u32(soa::GEOM_ID, i, args.geomID);
-                for (level, id) in inst.iter().enumerate() {
-                    hits.set_u32(soa::INST_ID + level, i, *id);
-                }
-                #[cfg(embree_instance_array)]
-                for (level, id) in inst_prim.iter().enumerate() {
-                    hits.set_u32(soa::INST_ID + sys::MAX_INSTANCE_LEVELS + level, i, *id);
-                }
             }
         }
     };
@@ -543,8 +596,74 @@ pub(super) unsafe extern "C" fn intersect<T: Analytic>(
     }
 }
 
-/// `RTCOccludedFunctionN`: for each active ray that primitive `primID` occludes, sets
-/// `tfar = -inf` (per-call work done once, as in [`intersect`]).
+/// What the intersect callback writes a hit with, besides the hit itself.
+struct Lane {
+    /// The `RTCRayHitN` packet.
+    packet: Packet,
+    geom_id: u32,
+    inst: [u32; sys::MAX_INSTANCE_LEVELS],
+    #[cfg(embree_instance_array)]
+    inst_prim: [u32; sys::MAX_INSTANCE_LEVELS],
+}
+
+impl Lane {
+    /// Test ray `i` against `prim` (item `prim_id()` of the list), from the ray's state
+    /// in the packet (an earlier member of a group may have shortened it); on a nearer
+    /// hit, or one at `tfar` that wins the tie with the hit there, write it and return
+    /// `true`.
+    ///
+    /// # Safety
+    /// `packet` is a live `RTCRayHitN` packet and ray `i < n` is active.
+    #[inline(always)]
+    unsafe fn test<T: Analytic>(&self, i: usize, prim: &T, prim_id: &dyn Fn() -> u32) -> bool {
+        let packet = self.packet;
+        // SAFETY: by the caller's contract.
+        let mut ray = unsafe { packet.ray(i) };
+        // SAFETY: as above; the hit members follow the ray's.
+        let current = unsafe { current_hit(packet.hits(), i) };
+        // A hit at `tfar` already: look up to and including `tfar` for a coincident
+        // primitive that wins the tie (`Hit::wins_tie_with`), as the BVH does.
+        let tfar = ray.tmax;
+        if current.is_some() {
+            ray.tmax = next_float_up(tfar);
+        }
+        #[cfg(test)]
+        maybe_injected_panic(Callback::Intersect);
+        let hit = prim.intersect(&ray).filter(|h| {
+            h.t < tfar
+                || current.is_some_and(|(geom, prim, level)| {
+                    h.t == tfar && level == self.inst[0] && (self.geom_id, prim_id()) < (geom, prim)
+                })
+        });
+        let Some(h) = hit else {
+            return false;
+        };
+        // SAFETY: ray `i` is active; Embree expects the callback to write its `tfar` and
+        // hit members on a hit. All offsets are inside the packet.
+        unsafe {
+            packet.set_f32(soa::TFAR, i, h.t);
+            let hits = packet.hits();
+            hits.set_f32(soa::NG_X, i, h.ng.x);
+            hits.set_f32(soa::NG_Y, i, h.ng.y);
+            hits.set_f32(soa::NG_Z, i, h.ng.z);
+            hits.set_f32(soa::U, i, h.u);
+            hits.set_f32(soa::V, i, h.v);
+            hits.set_u32(soa::PRIM_ID, i, prim_id());
+            hits.set_u32(soa::GEOM_ID, i, self.geom_id);
+            for (level, id) in self.inst.iter().enumerate() {
+                hits.set_u32(soa::INST_ID + level, i, *id);
+            }
+            #[cfg(embree_instance_array)]
+            for (level, id) in self.inst_prim.iter().enumerate() {
+                hits.set_u32(soa::INST_ID + sys::MAX_INSTANCE_LEVELS + level, i, *id);
+            }
+        }
+        true
+    }
+}
+
+/// `RTCOccludedFunctionN`: for each active ray that primitive `primID` (a member of its
+/// group) occludes, sets `tfar = -inf` (per-call work done once, as in [`intersect`]).
 pub(super) unsafe extern "C" fn occluded<T: Analytic>(
     args: *const sys::RTCOccludedFunctionNArguments,
 ) {
@@ -555,7 +674,7 @@ pub(super) unsafe extern "C" fn occluded<T: Analytic>(
     let n = args.N as usize;
     // SAFETY: registered only with `UserPrims<T>` user data (see `bounds`).
     let user = unsafe { prims::<T>(args.geometryUserPtr) };
-    let Some((prim, _)) = user.and_then(|p| p.prim(args.primID)) else {
+    let Some(members) = user.and_then(|p| p.members(args.primID)) else {
         // SAFETY: `valid` has `N` entries.
         unsafe { report_all_missed(args.valid, n) };
         return;
@@ -574,7 +693,7 @@ pub(super) unsafe extern "C" fn occluded<T: Analytic>(
             let ray = unsafe { packet.ray(i) };
             #[cfg(test)]
             maybe_injected_panic(Callback::Occluded);
-            if prim.occluded(&ray) {
+            if members.any_item(|prim| prim.occluded(&ray)) {
                 // SAFETY: ray `i` is active; Embree reads `tfar = -inf` as "occluded".
                 unsafe { packet.set_f32(soa::TFAR, i, f32::NEG_INFINITY) };
             } else {
