@@ -5,7 +5,9 @@
 //! chosen so that `10^5 ≤ |x| · 10^k < 10^6`. With `|k| ≤ 22`, `|x| · 10^k` is one
 //! correctly rounded operation away from the exact product, so `m` is certain unless
 //! the product lies within 10⁻⁶ of a rounding tie or of the range's ends; then the
-//! text is printed and read. Reading `m · 10^-k` is again one correctly rounded
+//! text is printed and read, except for an exact tie (a product without rounding,
+//! ending in .5, as binary fractions on a grid of powers of two often do), which `%g`
+//! rounds to even. Reading `m · 10^-k` is again one correctly rounded
 //! operation on exact operands (`m < 2^24`, the power exact) when `|k| ≤ 22` (double
 //! precision) or `|k| ≤ 10` (single precision), which is the correctly rounded value
 //! of the decimal: what `str::parse` returns. Elsewhere, the text decides.
@@ -77,14 +79,29 @@ fn six_digits(x: f64) -> Option<(u64, i32)> {
     if !(1e5 + MARGIN..1e6 - MARGIN).contains(&scaled) {
         return None;
     }
-    // In that range truncation is the floor, and, ties excluded, rounding is the floor
-    // plus one above the half (no call to the library's `floor` and `round`).
+    // In that range truncation is the floor, and rounding is the floor plus one above
+    // the half (no call to the library's `floor` and `round`); an exact tie goes to the
+    // even neighbour, as `%g` rounds, and a near one to the text.
     let floor = scaled as u64;
     let frac = scaled - floor as f64;
     if (frac - 0.5).abs() < MARGIN {
-        return None;
+        let tie = frac == 0.5 && scaled_exactly(a, k, scaled);
+        return tie.then_some((floor + (floor & 1), k));
     }
     Some((floor + u64::from(frac > 0.5), k))
+}
+
+/// Whether `scaled`, [`scale`]`(a, k)`, is `a · 10^k` exactly (no rounding in the
+/// product or quotient): the fused multiply-add leaves the exact remainder.
+fn scaled_exactly(a: f64, k: i32, scaled: f64) -> bool {
+    let Some(&p) = POW10.get(k.unsigned_abs() as usize) else {
+        return false;
+    };
+    if k >= 0 {
+        a.mul_add(p, -scaled) == 0.0
+    } else {
+        scaled.mul_add(p, -a) == 0.0
+    }
 }
 
 /// `floor(log10(a))` for a positive finite `a`, or one less: from the binary exponent
@@ -178,12 +195,38 @@ mod tests {
         }
     }
 
+    /// Binary fractions `i / 2ⁿ` with more than six significant digits: many end in
+    /// an exact tie at the sixth, which `%g` rounds to even.
+    #[test]
+    fn exact_ties_round_to_even_as_the_text_does() {
+        let mut ties = 0;
+        for n in 1..=24 {
+            for i in (1..4000).chain(1_000_000..1_000_100) {
+                let x = f64::from(i) / f64::from(1u32 << n);
+                for x in [x, -x, x * 1e6, x / 1e4] {
+                    same_as_text(x);
+                    let scaled = x.abs() * 10f64.powi(5 - x.abs().log10().floor() as i32);
+                    ties += usize::from(scaled.fract() == 0.5);
+                }
+            }
+        }
+        assert!(ties > 10_000, "{ties} ties");
+    }
+
     proptest! {
         #[test]
         fn any_value_is_read_back_as_its_text_reads(
             x in proptest::num::f64::NORMAL | proptest::num::f64::SUBNORMAL,
         ) {
             same_as_text(x);
+        }
+
+        #[test]
+        fn binary_fractions_are_read_back_as_their_text_reads(
+            m in 1u64..(1 << 40), e in 1i32..60, sign in proptest::bool::ANY,
+        ) {
+            let x = m as f64 / 2f64.powi(e);
+            same_as_text(if sign { -x } else { x });
         }
 
         #[test]
