@@ -61,6 +61,7 @@ pub(crate) fn g_f32(x: f64) -> f32 {
 /// `|x|` to six significant digits as `m · 10^-k` (`m` of six digits, or `10^6` when
 /// rounding carried), or `(0, 0)` for zero; `None` when it is not certain (see the
 /// module documentation) or `x` is not finite.
+#[inline]
 fn six_digits(x: f64) -> Option<(u64, i32)> {
     let a = x.abs();
     if a == 0.0 {
@@ -85,30 +86,33 @@ fn six_digits(x: f64) -> Option<(u64, i32)> {
     // the half (no call to the library's `floor` and `round`).
     let floor = scaled as u64;
     let frac = scaled - floor as f64;
-    let up = match frac.partial_cmp(&0.5)? {
-        Ordering::Less => false,
-        Ordering::Greater => true,
-        Ordering::Equal => match exact_against_scaled(a, k, scaled)? {
-            Ordering::Less => false,
-            Ordering::Greater => true,
-            Ordering::Equal => floor % 2 == 1,
-        },
+    let up = if frac == 0.5 {
+        tie_rounds_up(a, k, scaled)?
+    } else {
+        frac > 0.5
     };
     Some((floor + u64::from(up), k))
 }
 
-/// How the exact `a · 10^k` compares with `scaled`, [`scale`]`(a, k)`: the fused
-/// multiply-add computes the remainder of the correctly rounded product or quotient
-/// exactly (it is a double).
-fn exact_against_scaled(a: f64, k: i32, scaled: f64) -> Option<Ordering> {
+/// Whether `a · 10^k` rounds up to six digits when `scaled`, [`scale`]`(a, k)`, ends in
+/// exactly .5: when the exact value is above `scaled`, or equal to it with an odd
+/// digit before the half. The fused multiply-add computes the remainder of the
+/// correctly rounded product or quotient exactly (it is a double).
+#[cold]
+fn tie_rounds_up(a: f64, k: i32, scaled: f64) -> Option<bool> {
     let p = *POW10.get(k.unsigned_abs() as usize)?;
-    if k >= 0 {
+    let exact_against_scaled = if k >= 0 {
         // a · p − scaled.
-        a.mul_add(p, -scaled).partial_cmp(&0.0)
+        a.mul_add(p, -scaled).partial_cmp(&0.0)?
     } else {
         // scaled · p − a has the sign of scaled − a / p.
-        0.0.partial_cmp(&scaled.mul_add(p, -a))
-    }
+        0.0.partial_cmp(&scaled.mul_add(p, -a))?
+    };
+    Some(match exact_against_scaled {
+        Ordering::Less => false,
+        Ordering::Greater => true,
+        Ordering::Equal => (scaled as u64) % 2 == 1,
+    })
 }
 
 /// `floor(log10(a))` for a positive finite `a`, or one less: from the binary exponent
