@@ -106,6 +106,8 @@ pub(crate) struct PrimBatch {
     capacity: usize,
     /// Scratch: the primitives made of `pending`.
     made: Vec<Option<Made>>,
+    /// Scratch: the spheres made of a batch of them.
+    spheres: Vec<Option<Sphere>>,
 }
 
 impl PrimBatch {
@@ -115,6 +117,7 @@ impl PrimBatch {
             pending: Vec::new(),
             capacity: capacity.max(1),
             made: Vec::new(),
+            spheres: Vec::new(),
         }
     }
 
@@ -166,24 +169,23 @@ impl PrimBatch {
         let queued_made = self.flush(origin, part);
         let make = |&(center, radius): &(D, f64)| sphere_of(origin, center, radius);
         let piece = self.piece_len();
-        make_all(
-            spheres,
-            piece,
-            |s| make(s).map(Made::Sphere),
-            &mut self.made,
-        );
-        let lines = (0..).map(|k| first_line.saturating_add(k));
-        add_all(&self.made, lines, part) && queued_made
+        make_all(spheres, piece, make, &mut self.spheres);
+        let all_made = self.spheres.iter().all(Option::is_some);
+        if all_made {
+            let made = self.spheres.iter().flatten().copied();
+            part.add_analytic_lines(made, Kind::Sphere, first_line);
+        }
+        all_made && queued_made
     }
 }
 
 /// `out[k] = make(&items[k])` for every item, on the current rayon pool, in pieces of
 /// at least `piece` items.
-fn make_all<T: Sync>(
+fn make_all<T: Sync, U: Send>(
     items: &[T],
     piece: usize,
-    make: impl Fn(&T) -> Option<Made> + Sync + Send,
-    out: &mut Vec<Option<Made>>,
+    make: impl Fn(&T) -> Option<U> + Sync + Send,
+    out: &mut Vec<Option<U>>,
 ) {
     items
         .par_iter()

@@ -102,6 +102,29 @@ impl Part {
         self.geometry.push(prim, m);
     }
 
+    /// Analytic primitives of one kind on consecutive lines, one each from `first_line`
+    /// on: what [`Part::add_analytic`] adds for each in turn.
+    pub fn add_analytic_lines<P: Analytic>(
+        &mut self,
+        prims: impl IntoIterator<Item = P>,
+        kind: Kind,
+        first_line: u32,
+    ) {
+        let mut prims = prims.into_iter().peekable();
+        if prims.peek().is_none() {
+            return;
+        }
+        let m = self.material_index();
+        let first = self.geometry.count(kind);
+        for prim in prims {
+            self.geometry.push(prim, m);
+        }
+        let count = self.geometry.count(kind) - first;
+        let g = &mut self.geometry;
+        g.sources
+            .add_lines(kind, first, count, &self.file, first_line);
+    }
+
     /// A polygon (`p`, or `pp` when `normals` are given, one per point) on line `line`,
     /// triangulated; a degenerate one is dropped and counted, and the first one's
     /// position, `at()`, kept for the warning.
