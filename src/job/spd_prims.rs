@@ -98,10 +98,19 @@ impl Prim {
     }
 }
 
-/// Primitives waiting to be made, with their lines, in entity order.
+/// A primitive waiting to be made: its numbers, its line and its material (the
+/// [`Part::material_index`] on its line).
+#[derive(Clone, Copy, Debug)]
+struct Queued {
+    prim: Prim,
+    line: u32,
+    material: u32,
+}
+
+/// Primitives waiting to be made, in entity order.
 #[derive(Debug)]
 pub(crate) struct PrimBatch {
-    pending: Vec<(Prim, u32)>,
+    pending: Vec<Queued>,
     /// How many wait before [`PrimBatch::push`] says the batch is full.
     capacity: usize,
     /// Scratch: the primitives made of `pending`.
@@ -131,9 +140,14 @@ impl PrimBatch {
         self.capacity
     }
 
-    /// Queue `prim` of line `line`; true when the batch is full.
-    pub fn push(&mut self, prim: Prim, line: u32) -> bool {
-        self.pending.push((prim, line));
+    /// Queue `prim` of line `line`, whose material is `material` (the part's
+    /// [`Part::material_index`] on that line); true when the batch is full.
+    pub fn push(&mut self, prim: Prim, line: u32, material: u32) -> bool {
+        self.pending.push(Queued {
+            prim,
+            line,
+            material,
+        });
         self.pending.len() >= self.capacity
     }
 
@@ -148,11 +162,10 @@ impl PrimBatch {
         make_all(
             &self.pending,
             piece,
-            |(prim, _)| prim.make(origin),
+            |q| q.prim.make(origin),
             &mut self.made,
         );
-        let lines = self.pending.iter().map(|&(_, line)| line);
-        let all_made = add_all(&self.made, lines, part);
+        let all_made = add_all(&self.made, &self.pending, part);
         self.pending.clear();
         all_made
     }
@@ -194,16 +207,16 @@ fn make_all<T: Sync, U: Send>(
         .collect_into_vec(out);
 }
 
-/// Add every primitive of `made` to `part` with its line from `lines`, in order, if
-/// all were made; whether they were.
-fn add_all(made: &[Option<Made>], lines: impl Iterator<Item = u32>, part: &mut Part) -> bool {
+/// Add every primitive of `made` to `part` with the line and material it was queued
+/// with, in order, if all were made; whether they were.
+fn add_all(made: &[Option<Made>], queued: &[Queued], part: &mut Part) -> bool {
     if !made.iter().all(Option::is_some) {
         return false;
     }
-    for (made, line) in made.iter().zip(lines) {
+    for (made, q) in made.iter().zip(queued) {
         match made {
-            Some(Made::Sphere(s)) => part.add_analytic(*s, Kind::Sphere, line),
-            Some(Made::Cone(c)) => part.add_analytic(*c, Kind::Cone, line),
+            Some(Made::Sphere(s)) => part.add_analytic_with(*s, Kind::Sphere, q.line, q.material),
+            Some(Made::Cone(c)) => part.add_analytic_with(*c, Kind::Cone, q.line, q.material),
             None => {}
         }
     }

@@ -11,9 +11,10 @@
 //! as failed: the caller then writes the text and reads it.
 //!
 //! Spheres and cones wait in a batch (`super::spd_prims`), made in parallel when it is
-//! full, before a viewpoint or a fill (the first viewpoint sets the frame, a fill the
-//! material) and at the end. Nothing else changes how they are made: lights and
-//! polygons go to lists of their own.
+//! full and at the end, each with the material in effect on its line; one before the
+//! first viewpoint fails the build at once (the frame it would be made in, the eye's,
+//! is not known yet). Nothing else changes how they are made: later viewpoints keep
+//! the first's frame, and lights and polygons go to lists of their own.
 
 use super::spd_prims::{Prim, PrimBatch, scene_point};
 use crate::load::nff::{
@@ -55,8 +56,9 @@ pub(crate) fn scene(
 /// How many primitives are made between two advances of the load's progress.
 const PROGRESS_CHUNK: u64 = 1 << 14;
 
-/// Spheres and cones made at once.
-const PRIM_BATCH: usize = 1 << 16;
+/// Spheres and cones made at once: enough for every thread of a pool to make many,
+/// few enough that the batch stays in the processor's caches.
+const PRIM_BATCH: usize = 1 << 12;
 
 /// Builds the scene of a database's entities (see the module documentation).
 struct SceneBuilder<'p, 'w> {
@@ -136,12 +138,17 @@ impl<'p, 'w> SceneBuilder<'p, 'w> {
     fn queue(&mut self, prim: Prim) {
         self.made(1);
         let line = self.entity(1);
-        if self.prims.push(prim, line) {
+        if self.origin.is_none() {
+            self.failed = true;
+            return;
+        }
+        let material = self.part.material_index();
+        if self.prims.push(prim, line, material) {
             self.make_prims();
         }
     }
 
-    /// Make the queued spheres and cones (before an entity that may change how).
+    /// Make the queued spheres and cones.
     fn make_prims(&mut self) {
         let made = self.prims.flush(self.origin, &mut self.part);
         self.check(made);
@@ -184,7 +191,6 @@ impl<'p, 'w> SceneBuilder<'p, 'w> {
 
 impl NffSink for SceneBuilder<'_, '_> {
     fn viewpoint(&mut self, from: D, at: D, up: D, angle: f64, hither: f64, res: (i32, i32)) {
-        self.make_prims();
         let line = self.entity(7) as usize;
         self.part.notes.push(Note::Viewpoint { line, col: 1 });
         if self.origin.is_none() {
@@ -226,7 +232,6 @@ impl NffSink for SceneBuilder<'_, '_> {
     }
 
     fn fill(&mut self, rgb: D, kd: f64, ks: f64, shine: f64, t: f64, ior: f64) {
-        self.make_prims();
         let line = self.entity(1);
         let color = self.vec3(rgb);
         self.warn_above_one(line, "fill", color);
