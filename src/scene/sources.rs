@@ -331,7 +331,9 @@ mod tests {
     fn items_on_consecutive_lines_at_once_or_one_by_one() {
         let f: Arc<str> = Arc::from("a.nff");
         let g: Arc<str> = Arc::from("b.nff");
-        let starts: [&[(usize, usize, &Arc<str>, u32)]; 5] = [
+        // Items first..first + count made by a line of a file.
+        type Added<'a> = (usize, usize, &'a Arc<str>, u32);
+        let starts: [&[Added]; 5] = [
             &[],
             &[(0, 1, &f, 1), (1, 1, &f, 2)],
             &[(0, 2, &f, 1), (2, 2, &f, 2)],
