@@ -5,8 +5,8 @@
 //! in parallel, as the loader parses a large file.
 //!
 //! Each primitive is made from its own numbers and the frame's origin alone, so the
-//! batch's results, added in order with their lines, are what making them one at a
-//! time would add.
+//! batch's results, added in order with the lines and materials they were queued
+//! with, are what making them one at a time would add.
 
 use crate::geometry::{Cone, Intersect, Kind, Sphere};
 use crate::load::nff::{Part, world_bounds};
