@@ -9,18 +9,22 @@
 //! them. Whatever the loader would refuse or warn about differently (a point before
 //! the first viewpoint, a number out of range, a degenerate entity) marks the build
 //! as failed: the caller then writes the text and reads it.
+//!
+//! Spheres and cones wait in a batch (`super::spd_prims`), made in parallel when it is
+//! full and at the end, each with the material in effect on its line; one before the
+//! first viewpoint fails the build at once (the frame it would be made in, the eye's,
+//! is not known yet). Nothing else changes how they are made: later viewpoints keep
+//! the first's frame, and lights and polygons go to lists of their own.
 
-use crate::geometry::{Cone, Intersect, Kind, Sphere};
+use super::spd_prims::{Prim, PrimBatch, scene_point};
 use crate::load::nff::{
     MAX_PIXELS, MAX_RESOLUTION_SIDE, Merger, Note, Part, fill, unit_normal, up_is_usable,
-    world_bounds,
 };
 use crate::load::{LoadError, LoadProgress};
 use crate::math::{DVec3, Vec3};
 use crate::scene::{Camera, Light, Scene, range};
 use crate::spd::{Database, NffSink, g_f32, g_f64};
 use glam::DVec3 as D;
-use rayon::prelude::*;
 use std::path::Path;
 use std::sync::Arc;
 
@@ -52,6 +56,10 @@ pub(crate) fn scene(
 /// How many primitives are made between two advances of the load's progress.
 const PROGRESS_CHUNK: u64 = 1 << 14;
 
+/// Spheres and cones made at once: enough for every thread of a pool to make many,
+/// few enough that the batch stays in the processor's caches.
+const PRIM_BATCH: usize = 1 << 12;
+
 /// Builds the scene of a database's entities (see the module documentation).
 struct SceneBuilder<'p, 'w> {
     path: &'p Path,
@@ -65,6 +73,8 @@ struct SceneBuilder<'p, 'w> {
     line: u32,
     /// Whether an entity could not be made as the loader would make it.
     failed: bool,
+    /// Spheres and cones not yet made.
+    prims: PrimBatch,
     /// Scratch: a polygon's vertices and normals.
     pts: Vec<Vec3>,
     nrm: Vec<Vec3>,
@@ -73,6 +83,11 @@ struct SceneBuilder<'p, 'w> {
 impl<'p, 'w> SceneBuilder<'p, 'w> {
     /// No entities yet; `path` names the scene as the loader's file name does.
     fn new(path: &'p Path, progress: &'p LoadProgress<'w>) -> Self {
+        Self::with_batch(path, progress, PRIM_BATCH)
+    }
+
+    /// [`SceneBuilder::new`], making spheres and cones `batch` at a time.
+    fn with_batch(path: &'p Path, progress: &'p LoadProgress<'w>, batch: usize) -> Self {
         SceneBuilder {
             path,
             progress,
@@ -81,13 +96,15 @@ impl<'p, 'w> SceneBuilder<'p, 'w> {
             origin: None,
             line: 1,
             failed: false,
+            prims: PrimBatch::new(batch),
             pts: Vec::new(),
             nrm: Vec::new(),
         }
     }
 
     /// The scene, or `None` when the build failed (the text then decides).
-    fn finish(self) -> Option<Result<Scene, LoadError>> {
+    fn finish(mut self) -> Option<Result<Scene, LoadError>> {
+        self.make_prims();
         if self.failed {
             return None;
         }
@@ -117,6 +134,26 @@ impl<'p, 'w> SceneBuilder<'p, 'w> {
         self.failed |= !ok;
     }
 
+    /// Queue a sphere or cone of one line, making the batch if it is full.
+    fn queue(&mut self, prim: Prim) {
+        self.made(1);
+        let line = self.entity(1);
+        if self.origin.is_none() {
+            self.failed = true;
+            return;
+        }
+        let material = self.part.material_index();
+        if self.prims.push(prim, line, material) {
+            self.make_prims();
+        }
+    }
+
+    /// Make the queued spheres and cones.
+    fn make_prims(&mut self) {
+        let made = self.prims.flush(self.origin, &mut self.part);
+        self.check(made);
+    }
+
     /// A number read in single precision.
     fn num(&mut self, x: f64) -> f32 {
         let v = g_f32(x);
@@ -130,16 +167,9 @@ impl<'p, 'w> SceneBuilder<'p, 'w> {
 
     /// A point, in the scene's frame.
     fn point(&mut self, p: D) -> Vec3 {
-        let world = D::new(g_f64(p.x), g_f64(p.y), g_f64(p.z));
-        let finite = world.is_finite() && world.as_vec3().is_finite();
-        self.check(finite && range::check_point("", world.as_vec3()).is_ok());
-        match self.origin {
-            Some(o) => (world - o).as_vec3(),
-            None => {
-                self.failed = true;
-                Vec3::ZERO
-            }
-        }
+        let point = self.origin.and_then(|o| scene_point(o, p));
+        self.check(point.is_some());
+        point.unwrap_or(Vec3::ZERO)
     }
 
     /// The loader's warning for a colour written with channels above 1 (the colour is
@@ -156,11 +186,6 @@ impl<'p, 'w> SceneBuilder<'p, 'w> {
             );
             self.part.notes.push(Note::Warning(warning));
         }
-    }
-
-    fn world_bounds_ok(&self, what: &str, bounds: &crate::math::Aabb) -> bool {
-        let origin = self.origin.unwrap_or(DVec3::ZERO);
-        range::check_bounds(what, &world_bounds(origin, bounds)).is_ok()
     }
 }
 
@@ -217,37 +242,23 @@ impl NffSink for SceneBuilder<'_, '_> {
     }
 
     fn sphere(&mut self, center: D, radius: f64) {
-        let sphere = sphere_of(self.origin, center, radius);
-        self.add_sphere(sphere);
+        self.queue(Prim::Sphere(center, radius));
     }
 
+    /// Made a batch at a time, without queueing them one by one.
     fn spheres(&mut self, spheres: &[(D, f64)]) {
-        let origin = self.origin;
-        let made: Vec<Option<Sphere>> = spheres
-            .par_iter()
-            .map(|&(center, radius)| sphere_of(origin, center, radius))
-            .collect();
-        for sphere in made {
-            self.add_sphere(sphere);
+        for batch in spheres.chunks(self.prims.capacity()) {
+            self.made(batch.len());
+            let first_line = self.entity(batch.len());
+            let made = self
+                .prims
+                .spheres(batch, first_line, self.origin, &mut self.part);
+            self.check(made);
         }
     }
 
     fn cone(&mut self, base: D, base_radius: f64, apex: D, apex_radius: f64) {
-        self.made(1);
-        let line = self.entity(1);
-        let (base, rb) = (self.point(base), self.num(base_radius));
-        let (apex, ra) = (self.point(apex), self.num(apex_radius));
-        let same_side = !((rb < 0.0 && ra > 0.0) || (rb > 0.0 && ra < 0.0));
-        self.check(!(rb == 0.0 && ra == 0.0) && same_side && base != apex);
-        if self.failed {
-            return;
-        }
-        let cone = Cone::new(base, rb, apex, ra);
-        let ok = self.world_bounds_ok("the cone", &cone.bounds());
-        self.check(ok);
-        if ok {
-            self.part.add_analytic(cone, Kind::Cone, line);
-        }
+        self.queue(Prim::Cone(base, base_radius, apex, apex_radius));
     }
 
     fn polygon(&mut self, verts: &[D]) {
@@ -259,36 +270,7 @@ impl NffSink for SceneBuilder<'_, '_> {
     }
 }
 
-/// The sphere the loader reads from `s` with `center` and `radius` printed, in the
-/// frame of the first viewpoint's eye `origin`; `None` where the loader would refuse
-/// or warn (no viewpoint yet, a number out of range, a zero radius).
-fn sphere_of(origin: Option<DVec3>, center: D, radius: f64) -> Option<Sphere> {
-    let world = D::new(g_f64(center.x), g_f64(center.y), g_f64(center.z));
-    let finite = world.is_finite() && world.as_vec3().is_finite();
-    let r = g_f32(radius);
-    if !(finite && range::check_point("", world.as_vec3()).is_ok() && r.is_finite() && r != 0.0) {
-        return None;
-    }
-    let origin = origin?;
-    let sphere = Sphere::new((world - origin).as_vec3(), r);
-    let bounds = world_bounds(origin, &sphere.bounds());
-    range::check_bounds("the sphere", &bounds)
-        .is_ok()
-        .then_some(sphere)
-}
-
 impl SceneBuilder<'_, '_> {
-    /// Add `sphere`, one line's entity, or fail the build for `None`.
-    fn add_sphere(&mut self, sphere: Option<Sphere>) {
-        self.made(1);
-        let line = self.entity(1);
-        match sphere {
-            Some(sphere) if !self.failed => self.part.add_analytic(sphere, Kind::Sphere, line),
-            Some(_) => {}
-            None => self.failed = true,
-        }
-    }
-
     /// `p` (no normals) or `pp`: one line for the count, one per vertex.
     fn polygon_with(&mut self, verts: &[D], normals: Option<&[D]>) {
         self.made(verts.len().saturating_sub(2));
@@ -324,10 +306,30 @@ impl SceneBuilder<'_, '_> {
 #[cfg(test)]
 mod tests {
     use super::*;
+    use crate::geometry::Kind;
     use crate::load::nff::parse_str;
 
     static SILENT: std::sync::LazyLock<LoadProgress<'static>> =
         std::sync::LazyLock::new(LoadProgress::silent);
+
+    /// Build `db` at `size` without the text, making spheres and cones `batch` at a
+    /// time, and check that it is the scene read from the text, down to every
+    /// primitive's, material's and light's line.
+    fn assert_builds_as_read(db: Database, size: u32, batch: usize) {
+        let path = Path::new("spd:db");
+        let what = format!("{} size {size} batch {batch}", db.name());
+        let mut builder = SceneBuilder::with_batch(path, &SILENT, batch);
+        db.emit(size, &mut builder);
+        let built = builder.finish().expect("built directly").unwrap();
+        let read = parse_str(&db.generate(size), path).unwrap();
+        assert_eq!(built, read, "{what}");
+        let origins = &built.geometry.sources;
+        assert!(origins.same_origins(&read.geometry.sources), "{what}");
+        let materials = &built.sources.materials;
+        assert!(materials.same_origins(&read.sources.materials), "{what}");
+        let lights = &built.sources.lights;
+        assert!(lights.same_origins(&read.sources.lights), "{what}");
+    }
 
     /// The scene built from each database's entities is the scene read from its text,
     /// down to every primitive's line, and it is built without the text.
@@ -335,28 +337,80 @@ mod tests {
     fn every_database_builds_the_scene_its_text_reads_as() {
         for db in Database::ALL {
             for size in [1, 2] {
-                let path = Path::new("spd:db");
-                let mut builder = SceneBuilder::new(path, &SILENT);
-                db.emit(size, &mut builder);
-                let built = builder.finish().expect("built directly").unwrap();
-                let read = parse_str(&db.generate(size), path).unwrap();
-                let what = format!("{} size {size}", db.name());
-                assert_eq!(built, read, "{what}");
-                assert!(built.geometry.sources.same_origins(&read.geometry.sources));
-                assert!(
-                    built
-                        .sources
-                        .materials
-                        .same_origins(&read.sources.materials)
-                );
-                assert!(built.sources.lights.same_origins(&read.sources.lights));
-                assert_eq!(
-                    scene(db, size, path, &LoadProgress::silent()).unwrap(),
-                    read,
-                    "{what}"
-                );
+                assert_builds_as_read(db, size, PRIM_BATCH);
+                let read = parse_str(&db.generate(size), Path::new("spd:db")).unwrap();
+                let generated = scene(db, size, Path::new("spd:db"), &LoadProgress::silent());
+                assert_eq!(generated.unwrap(), read, "{} size {size}", db.name());
             }
         }
+    }
+
+    /// Spheres and cones made in batches of a few on several threads, so that batches
+    /// end anywhere among the entities and split among threads: the same scenes.
+    #[test]
+    fn small_batches_on_several_threads_build_the_same_scenes() {
+        let pool = rayon::ThreadPoolBuilder::new()
+            .num_threads(4)
+            .build()
+            .unwrap();
+        pool.install(|| {
+            for db in Database::ALL {
+                for batch in [1, 3, 64] {
+                    assert_builds_as_read(db, 2, batch);
+                }
+            }
+            assert_builds_as_read(Database::Balls, 3, 100);
+            assert_builds_as_read(Database::Jacks, 3, 7);
+        });
+    }
+
+    /// A fill after queued spheres is their material's end: each sphere keeps the
+    /// material in effect on its line.
+    #[test]
+    fn queued_spheres_keep_the_material_of_their_line() {
+        let mut builder = SceneBuilder::new(Path::new("x"), &SILENT);
+        builder.viewpoint(D::Z, D::ZERO, D::Y, 45.0, 0.0, (8, 8));
+        builder.fill(D::X, 1.0, 0.0, 0.0, 0.0, 1.0);
+        builder.sphere(D::ZERO, 1.0);
+        builder.cone(D::ZERO, 0.5, D::X, 0.25);
+        builder.fill(D::Y, 1.0, 0.0, 0.0, 0.0, 1.0);
+        builder.spheres(&[(D::X, 1.0), (D::Y, 2.0)]);
+        let scene = builder.finish().unwrap().unwrap();
+        assert_eq!(scene.geometry.spheres().material, [0, 1, 1]);
+        assert_eq!(scene.geometry.cones().material, [0]);
+        let line = |kind, k| scene.geometry.sources.get(kind, k).unwrap().line;
+        assert_eq!(
+            [9, 12, 13].map(|l| l as u32),
+            [0, 1, 2].map(|k| line(Kind::Sphere, k))
+        );
+        assert_eq!(line(Kind::Cone, 0), 10);
+    }
+
+    /// A sphere or cone the loader would refuse fails the build, queued or not.
+    #[test]
+    fn a_refused_sphere_or_cone_fails_the_build() {
+        let start = || {
+            let mut builder = SceneBuilder::with_batch(Path::new("x"), &SILENT, 2);
+            builder.viewpoint(D::Z, D::ZERO, D::Y, 45.0, 0.0, (8, 8));
+            builder
+        };
+        let mut builder = start();
+        builder.sphere(D::ZERO, 0.0);
+        assert!(builder.finish().is_none(), "zero radius");
+        let mut builder = start();
+        builder.cone(D::ZERO, 0.5, D::X, -0.5);
+        builder.sphere(D::ZERO, 1.0);
+        builder.sphere(D::X, 1.0);
+        assert!(builder.finish().is_none(), "radii of opposite signs");
+        let mut builder = start();
+        builder.spheres(&[(D::ZERO, 1.0), (D::new(1e30, 0.0, 0.0), 1.0), (D::X, 1.0)]);
+        assert!(builder.finish().is_none(), "out of range");
+        let mut builder = start();
+        builder.cone(D::ZERO, 0.5, D::X, 0.5);
+        builder.spheres(&[(D::ZERO, 1.0), (D::X, 1.0), (D::Y, 1.0)]);
+        let scene = builder.finish().unwrap().unwrap();
+        assert_eq!(scene.geometry.count(Kind::Sphere), 3);
+        assert_eq!(scene.geometry.count(Kind::Cone), 1);
     }
 
     /// A point before the first viewpoint is in a frame not yet known: the text decides.

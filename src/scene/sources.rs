@@ -103,6 +103,50 @@ impl Sources {
         });
     }
 
+    /// Items `first..first + count` were made by lines `line..line + count`, one each:
+    /// the table that adding them one by one would make, without a look-up per item.
+    pub fn add_lines(&mut self, first: usize, count: usize, file: &Arc<str>, line: u32) {
+        let Some(rest) = count.checked_sub(1) else {
+            return;
+        };
+        self.add(first, 1, file, line);
+        if !self.extend_last(first, rest, line) {
+            self.add_each(first + 1, rest, file, line.saturating_add(1));
+        }
+    }
+
+    /// Add `rest` items to the last run, on the lines after `line`, if item `first`
+    /// ends it on `line` as a run of one item per line, and the items' indices and
+    /// lines stay within `u32`; whether it did.
+    fn extend_last(&mut self, first: usize, rest: usize, line: u32) -> bool {
+        let Some(last) = self.runs.last_mut() else {
+            return false;
+        };
+        let ends_here = last.per == 1
+            && (last.first + last.count) as usize == first + 1
+            && u64::from(last.line) + u64::from(last.count) - 1 == u64::from(line);
+        let rest_fits = u32::try_from(first + 1 + rest).is_ok();
+        match u32::try_from(rest)
+            .ok()
+            .filter(|&r| line.checked_add(r).is_some())
+        {
+            Some(rest) if ends_here && rest_fits => {
+                last.count += rest;
+                true
+            }
+            _ => false,
+        }
+    }
+
+    /// [`Sources::add`] for each of `count` items from `first` on, one per line from
+    /// `line` on (lines saturating at `u32::MAX`).
+    fn add_each(&mut self, first: usize, count: usize, file: &Arc<str>, line: u32) {
+        for k in 0..count {
+            let line = line.saturating_add(u32::try_from(k).unwrap_or(u32::MAX));
+            self.add(first + k, 1, file, line);
+        }
+    }
+
     /// Append `other`'s items after the first `offset` indices: the table that adding
     /// `other`'s items here one by one, in order, `offset` places on, would make.
     pub fn append(&mut self, other: &Sources, offset: usize) {
@@ -202,6 +246,23 @@ impl PrimSources {
         self.kinds[k].add(first, count, file, line);
     }
 
+    /// Primitives `first..first + count` of `kind` were made by lines
+    /// `line..line + count`, one each (see [`Sources::add_lines`]).
+    pub fn add_lines(
+        &mut self,
+        kind: Kind,
+        first: usize,
+        count: usize,
+        file: &Arc<str>,
+        line: u32,
+    ) {
+        let k = kind as usize;
+        if self.kinds.len() <= k {
+            self.kinds.resize_with(k + 1, Sources::default);
+        }
+        self.kinds[k].add_lines(first, count, file, line);
+    }
+
     /// Append `other`'s primitives after the first `offset(kind)` of each kind (see
     /// [`Sources::append`]).
     pub fn append(&mut self, other: &PrimSources, offset: &dyn Fn(Kind) -> usize) {
@@ -261,6 +322,47 @@ mod tests {
         // A gap (a line that made nothing, such as a dropped polygon) starts a run.
         s.add(2004, 1, &g, 9);
         assert_eq!(s.get(2004).unwrap().line, 9);
+    }
+
+    /// Items on consecutive lines, added at once, make the table that adding them one
+    /// by one makes: after runs of any shape, from another file, on an index already
+    /// recorded, past `u32::MAX`.
+    #[test]
+    fn items_on_consecutive_lines_at_once_or_one_by_one() {
+        let f: Arc<str> = Arc::from("a.nff");
+        let g: Arc<str> = Arc::from("b.nff");
+        // Items first..first + count made by a line of a file.
+        type Added<'a> = (usize, usize, &'a Arc<str>, u32);
+        let starts: [&[Added]; 5] = [
+            &[],
+            &[(0, 1, &f, 1), (1, 1, &f, 2)],
+            &[(0, 2, &f, 1), (2, 2, &f, 2)],
+            &[(0, 1, &g, 7)],
+            &[(0, 1, &f, 3)],
+        ];
+        for start in starts {
+            for (count, line) in [(0, 3), (1, 3), (5, 3), (5, 4), (4, u32::MAX - 2)] {
+                let end = start.iter().map(|&(i, n, _, _)| i + n).max().unwrap_or(0);
+                for first in [end.saturating_sub(1), end, end + 1, u32::MAX as usize - 2] {
+                    let mut at_once = Sources::default();
+                    let mut each = Sources::default();
+                    for &(i, n, file, l) in start {
+                        at_once.add(i, n, file, l);
+                        each.add(i, n, file, l);
+                    }
+                    at_once.add_lines(first, count, &f, line);
+                    each.add_each(first, count, &f, line);
+                    let what = format!("{start:?} then {count} from {first} on line {line}");
+                    assert!(at_once.same_origins(&each), "{what}");
+                    assert_eq!(at_once.runs(), each.runs(), "{what}");
+                }
+            }
+        }
+        let mut s = Sources::default();
+        s.add_lines(0, 1000, &f, 10);
+        s.add_lines(1000, 1000, &f, 1010);
+        assert_eq!(s.runs(), 1);
+        assert_eq!(s.get(1999).unwrap().line, 2009);
     }
 
     #[test]

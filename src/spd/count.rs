@@ -25,6 +25,9 @@ impl NffSink for PrimCount {
     fn sphere(&mut self, _: DVec3, _: f64) {
         self.prims += 1;
     }
+    fn spheres(&mut self, spheres: &[(DVec3, f64)]) {
+        self.prims += spheres.len() as u64;
+    }
     fn cone(&mut self, _: DVec3, _: f64, _: DVec3, _: f64) {
         self.prims += 1;
     }
@@ -33,5 +36,38 @@ impl NffSink for PrimCount {
     }
     fn polypatch(&mut self, verts: &[DVec3], _: &[DVec3]) {
         self.prims += verts.len().saturating_sub(2) as u64;
+    }
+}
+
+#[cfg(test)]
+mod tests {
+    use crate::spd::Database;
+    use std::path::Path;
+
+    /// The count is the primitives the loader makes of the database's text (the
+    /// spheres handed over in batches included), or more where it drops degenerate
+    /// polygons.
+    #[test]
+    fn counts_the_primitives_the_text_makes() {
+        for db in Database::ALL {
+            for size in [1, 2] {
+                let count = db.count(size);
+                let scene = crate::load::nff::parse_str(&db.generate(size), Path::new("x"));
+                let scene = scene.unwrap();
+                let prims = scene.geometry.prim_count() as u64;
+                let what = format!("{} size {size}", db.name());
+                if scene.load_stats.degenerate_dropped == 0 {
+                    assert_eq!(count.prims, prims, "{what}");
+                } else {
+                    assert!(count.prims > prims, "{what}");
+                }
+                let camera = &scene.camera;
+                assert_eq!(
+                    count.res,
+                    (camera.width as i32, camera.height as i32),
+                    "{what}"
+                );
+            }
+        }
     }
 }

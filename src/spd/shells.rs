@@ -11,6 +11,7 @@
 
 use super::NffSink;
 use glam::DVec3;
+use rayon::prelude::*;
 use std::f64::consts::PI;
 
 /// The SPD program's default size factor: `shells.c` sets `size_factor = 5`, 5761
@@ -27,19 +28,29 @@ const BETA: f64 = -2.0;
 /// Radius divisor `γ`.
 const GAMMA: f64 = 1.0;
 
-/// The spheres (centre, radius) at size factor `size`, in the SPD's order.
+/// The spheres (centre, radius) at size factor `size`, in the SPD's order, each
+/// computed from its index alone (in parallel on the current rayon pool).
 fn spheres(size: u32) -> Vec<(DVec3, f64)> {
-    let steps = (180.0 * 2.0f64.powi(size as i32)) as i64;
+    let steps = steps(size);
     (-steps * 2 / 3..=steps / 3)
-        .map(|i| {
-            let angle = 3.0 * 6.0 * PI * i as f64 / steps as f64;
-            let r = K * (A * angle).exp();
-            (
-                DVec3::new(r * angle.sin(), r * angle.cos(), BETA * r),
-                r / GAMMA,
-            )
-        })
+        .into_par_iter()
+        .map(|i| sphere(i, steps))
         .collect()
+}
+
+/// `180·2ˢⁱᶻᵉ`, the spheres per nine turns.
+fn steps(size: u32) -> i64 {
+    (180.0 * 2.0f64.powi(size as i32)) as i64
+}
+
+/// Sphere `i` of the spiral of `steps` steps.
+fn sphere(i: i64, steps: i64) -> (DVec3, f64) {
+    let angle = 3.0 * 6.0 * PI * i as f64 / steps as f64;
+    let r = K * (A * angle).exp();
+    (
+        DVec3::new(r * angle.sin(), r * angle.cos(), BETA * r),
+        r / GAMMA,
+    )
 }
 
 /// Write the database at size factor `size`.
@@ -62,9 +73,7 @@ pub fn generate(size: u32, w: &mut impl NffSink) {
         0.0,
         1.0,
     );
-    for (c, r) in spheres(size) {
-        w.sphere(c, r);
-    }
+    w.spheres(&spheres(size));
 }
 
 #[cfg(test)]
@@ -80,6 +89,25 @@ mod tests {
         }
         assert_eq!(spheres(DEFAULT_SIZE).len(), 5761);
         assert!(spheres(DEFAULT_SIZE + 1).len() >= 10_000);
+    }
+
+    /// Made in parallel, the spheres are those of the plain loop, in its order.
+    #[test]
+    fn spheres_made_on_several_threads_are_the_loops() {
+        let pool = rayon::ThreadPoolBuilder::new()
+            .num_threads(4)
+            .build()
+            .unwrap();
+        let bits = |s: &[(DVec3, f64)]| -> Vec<[u64; 4]> {
+            s.iter()
+                .map(|(c, r)| [c.x, c.y, c.z, *r].map(f64::to_bits))
+                .collect()
+        };
+        let steps = steps(6);
+        let want: Vec<_> = (-steps * 2 / 3..=steps / 3)
+            .map(|i| sphere(i, steps))
+            .collect();
+        assert_eq!(bits(&pool.install(|| spheres(6))), bits(&want));
     }
 
     #[test]

@@ -71,9 +71,10 @@ impl Part {
         }
     }
 
-    /// The material of the next primitive.
+    /// The material of the next primitive: [`INHERITED`] before the part's first `f`
+    /// (the part then inherits), else the index of its last.
     #[inline]
-    fn material_index(&mut self) -> u32 {
+    pub fn material_index(&mut self) -> u32 {
         match self.materials.len() {
             0 => {
                 self.inherits = true;
@@ -98,8 +99,45 @@ impl Part {
     #[inline]
     pub fn add_analytic<P: Analytic>(&mut self, prim: P, kind: Kind, line: u32) {
         let m = self.material_index();
+        self.add_analytic_with(prim, kind, line, m);
+    }
+
+    /// An analytic primitive on line `line` with material `material`, the
+    /// [`Part::material_index`] of its line (taken when it was read, for a primitive
+    /// added after the entities that followed it).
+    #[inline]
+    pub fn add_analytic_with<P: Analytic>(
+        &mut self,
+        prim: P,
+        kind: Kind,
+        line: u32,
+        material: u32,
+    ) {
         self.record(kind, 1, line);
-        self.geometry.push(prim, m);
+        self.geometry.push(prim, material);
+    }
+
+    /// Analytic primitives of one kind on consecutive lines, one each from `first_line`
+    /// on: what [`Part::add_analytic`] adds for each in turn.
+    pub fn add_analytic_lines<P: Analytic>(
+        &mut self,
+        prims: impl IntoIterator<Item = P>,
+        kind: Kind,
+        first_line: u32,
+    ) {
+        let mut prims = prims.into_iter().peekable();
+        if prims.peek().is_none() {
+            return;
+        }
+        let m = self.material_index();
+        let first = self.geometry.count(kind);
+        for prim in prims {
+            self.geometry.push(prim, m);
+        }
+        let count = self.geometry.count(kind) - first;
+        let g = &mut self.geometry;
+        g.sources
+            .add_lines(kind, first, count, &self.file, first_line);
     }
 
     /// A polygon (`p`, or `pp` when `normals` are given, one per point) on line `line`,
