@@ -205,7 +205,9 @@ impl Intersect for Cone {
     }
 
     /// Whether a hit lies in `(ray.tmin, ray.tmax)`.
-    #[inline]
+    // Always inlined: the shadow-ray callbacks and leaf loops call it once per
+    // candidate, and a call there costs more than the test's set-up.
+    #[inline(always)]
     fn occluded(&self, ray: &Ray) -> bool {
         self.first(ray).is_some()
     }

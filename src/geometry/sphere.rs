@@ -120,7 +120,9 @@ impl Intersect for Sphere {
     }
 
     /// Whether a hit lies in `(ray.tmin, ray.tmax)`.
-    #[inline]
+    // Always inlined: the shadow-ray callbacks and leaf loops call it once per
+    // candidate, and a call there costs more than the test's set-up.
+    #[inline(always)]
     fn occluded(&self, ray: &Ray) -> bool {
         match self.roots(ray) {
             Some((t0, t1)) => {

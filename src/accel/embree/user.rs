@@ -142,17 +142,6 @@ enum Members<'u, 's, T> {
 }
 
 impl<'u, T> Members<'u, '_, T> {
-    /// Call `f` with each member and a way to its index, in order, until it returns
-    /// `true`; whether one did. The index is read only when asked for: on a hit (a
-    /// group's indices lie apart from its members, another cache line).
-    #[inline(always)]
-    fn any(&self, mut f: impl FnMut(&T, &dyn Fn() -> u32) -> bool) -> bool {
-        match self {
-            Members::One((item, index)) => f(item, &|| *index),
-            Members::Group(items, ids) => items.iter().zip(*ids).any(|(item, id)| f(item, &|| *id)),
-        }
-    }
-
     /// Call `f` with each member, in order, until it returns `true`; whether one did.
     #[inline(always)]
     fn any_item(&self, f: impl FnMut(&T) -> bool) -> bool {
@@ -372,6 +361,25 @@ impl Packet {
         unsafe { self.word(field, i).write(value) }
     }
 
+    /// Whether ray `i` is `occluded` (tested on the ray in our terms); if it is, the
+    /// ray is marked so (`tfar = -inf`, which Embree reads as "occluded").
+    ///
+    /// # Safety
+    /// As [`Packet::ray`].
+    #[inline(always)]
+    unsafe fn occlude_if(self, i: usize, occluded: impl FnOnce(&Ray) -> bool) -> bool {
+        // SAFETY: by the caller's contract.
+        let ray = unsafe { self.ray(i) };
+        #[cfg(test)]
+        maybe_injected_panic(Callback::Occluded);
+        let hit = occluded(&ray);
+        if hit {
+            // SAFETY: as above; `tfar` is a member of every ray.
+            unsafe { self.set_f32(soa::TFAR, i, f32::NEG_INFINITY) };
+        }
+        hit
+    }
+
     /// Ray `i` in our terms (`tnear` → `tmin`, `tfar`, the closest hit so far, → `tmax`).
     ///
     /// # Safety
@@ -536,6 +544,33 @@ unsafe fn report_all_missed(valid: *mut i32, n: usize) {
     }
 }
 
+/// Call `answer` with each active ray `i` of a call's `n`, which says whether the
+/// ray hit; a ray that did not is reported missed.
+///
+/// # Safety
+/// `valid` points to the live mask of at least `n` rays.
+#[inline(always)]
+unsafe fn answer_lanes(valid: *mut i32, n: usize, mut answer: impl FnMut(usize) -> bool) {
+    for i in 0..n {
+        // SAFETY: by the caller's contract.
+        if unsafe { valid.add(i).read() } == 0 {
+            continue;
+        }
+        if !answer(i) {
+            // SAFETY: as above.
+            unsafe { report_miss(valid, i) };
+        }
+    }
+}
+
+/// Whether any of a group's members occludes `ray`. Kept out of line, so that the
+/// shape's test is inlined where a primitive stands alone (the common case) rather
+/// than called there.
+#[inline(never)]
+fn any_occludes<T: Analytic>(prims: &[T], ray: &Ray) -> bool {
+    prims.iter().any(|prim| prim.occluded(ray))
+}
+
 /// `RTCIntersectFunctionN`: nearest hit with primitive `primID` (each member of its
 /// group in turn) for each active ray, or one at the current `tfar` that wins the tie
 /// with the hit there; on a hit, writes `tfar`, `u`, `v`, `Ng`, `primID` (the member's
@@ -573,23 +608,24 @@ pub(super) unsafe extern "C" fn intersect<T: Analytic>(
         // SAFETY: as above.
         inst_prim: unsafe { instance_prim_ids(args.context) },
     };
-    let lanes = || {
-        for i in 0..n {
-            // SAFETY: `valid` has `N` entries.
-            if unsafe { args.valid.add(i).read() } == 0 {
-                continue;
-            }
-            let mut hit = false;
-            members.any(|prim, prim_id| {
-                // SAFETY: ray `i` of the live packet is active.
-                hit |= unsafe { lane.test(i, prim, prim_id) };
-                false
-            });
-            if !hit {
-                // SAFETY: `valid` has `N` entries.
-                unsafe { report_miss(args.valid, i) };
-            }
-        }
+    // The kind of members is matched once per call, not once per lane: a primitive
+    // alone is the common case and its loop stays free of the group's.
+    let lanes = || match members {
+        // SAFETY: `valid` has `N` entries, and `answer_lanes` passes active rays of the
+        // live packet only.
+        Members::One((prim, id)) => unsafe {
+            answer_lanes(args.valid, n, |i| lane.test(i, prim, || id))
+        },
+        // SAFETY: as above.
+        Members::Group(prims, ids) => unsafe {
+            answer_lanes(args.valid, n, |i| {
+                let mut hit = false;
+                for (prim, &id) in prims.iter().zip(ids) {
+                    hit |= lane.test(i, prim, || id);
+                }
+                hit
+            })
+        },
     };
     if let Err(payload) = catch_unwind(AssertUnwindSafe(lanes)) {
         record_query_panic(Callback::Intersect, T::KIND.name(), &*payload);
@@ -615,7 +651,7 @@ impl Lane {
     /// # Safety
     /// `packet` is a live `RTCRayHitN` packet and ray `i < n` is active.
     #[inline(always)]
-    unsafe fn test<T: Analytic>(&self, i: usize, prim: &T, prim_id: &dyn Fn() -> u32) -> bool {
+    unsafe fn test<T: Analytic>(&self, i: usize, prim: &T, prim_id: impl Fn() -> u32) -> bool {
         let packet = self.packet;
         // SAFETY: by the caller's contract.
         let mut ray = unsafe { packet.ray(i) };
@@ -683,24 +719,20 @@ pub(super) unsafe extern "C" fn occluded<T: Analytic>(
         base: args.ray.cast(),
         n,
     };
-    let lanes = || {
-        for i in 0..n {
-            // SAFETY: `valid` has `N` entries.
-            if unsafe { args.valid.add(i).read() } == 0 {
-                continue;
-            }
-            // SAFETY: `ray` is a live `RTCRayN` packet of `N` rays and `i < N`.
-            let ray = unsafe { packet.ray(i) };
-            #[cfg(test)]
-            maybe_injected_panic(Callback::Occluded);
-            if members.any_item(|prim| prim.occluded(&ray)) {
-                // SAFETY: ray `i` is active; Embree reads `tfar = -inf` as "occluded".
-                unsafe { packet.set_f32(soa::TFAR, i, f32::NEG_INFINITY) };
-            } else {
-                // SAFETY: `valid` has `N` entries.
-                unsafe { report_miss(args.valid, i) };
-            }
-        }
+    let lanes = || match members {
+        // SAFETY: `valid` has `N` entries, and `answer_lanes` passes active rays of the
+        // live `RTCRayN` packet only.
+        Members::One((prim, _)) => unsafe {
+            answer_lanes(args.valid, n, |i| {
+                packet.occlude_if(i, |ray| prim.occluded(ray))
+            })
+        },
+        // SAFETY: as above.
+        Members::Group(prims, _) => unsafe {
+            answer_lanes(args.valid, n, |i| {
+                packet.occlude_if(i, |ray| any_occludes(prims, ray))
+            })
+        },
     };
     if let Err(payload) = catch_unwind(AssertUnwindSafe(lanes)) {
         record_query_panic(Callback::Occluded, T::KIND.name(), &*payload);
