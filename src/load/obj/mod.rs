@@ -382,7 +382,7 @@ fn read_geometry(
 
     let libs = libs::read(path, &obj.mtllibs);
     let t_libs = t0.elapsed();
-    runs::check(&mut obj, &libs.names_read_at()).map_err(|e| e.at(path))?;
+    runs::check(&mut obj, &libs.names_read_at(), cuts.faces).map_err(|e| e.at(path))?;
     let origin = match origin {
         Origin::At(p) => p,
         Origin::Centre => obj.centre(),
