@@ -4,15 +4,17 @@
 //! A stretch's line numbers and element indices are already the file's (see
 //! [`super::parse`]); the join moves its face and `usemtl` indices past the earlier
 //! stretches', points its faces at its own list of corners (kept as it is: the
-//! largest list is not copied), and adds the vertex colours counted before it. The first
+//! largest list is not copied), and adds the vertex colours counted before it; the
+//! other lists are moved after the earlier stretches' in parallel. The first
 //! stretch stopped by a problem ends the join: its problem is the error, unless the
 //! file has a bad number on an earlier line, in this stretch or an earlier one. With
 //! none, the forward references are checked against the elements of the whole file,
 //! and a number that does not parse anywhere is the error.
 
+use super::append::{append_list, append_mapped};
 use super::colours::Colours;
 use super::located::Located;
-use super::parse::{Corner, ForwardRef, KINDS, Obj, Part};
+use super::parse::{Corner, Face, ForwardRef, KINDS, Obj, Part};
 
 /// The stretches joined so far.
 #[derive(Default)]
@@ -104,19 +106,20 @@ fn first_bad_before(obj: &mut Obj, e: Located) -> Located {
 fn append(obj: &mut Obj, mut next: Obj, corners: Vec<Corner>) {
     let (part, faces, usemtl) = (obj.corners.len(), obj.faces.len(), obj.usemtl.len());
     let colours = obj.counts.colours;
-    append_list(&mut obj.positions, next.positions);
-    append_list(&mut obj.world, next.world);
-    append_list(&mut obj.texcoords, next.texcoords);
-    append_list(&mut obj.normals, next.normals);
+    append_list(&mut obj.positions, &mut next.positions);
+    append_list(&mut obj.world, &mut next.world);
+    append_list(&mut obj.texcoords, &mut next.texcoords);
+    append_list(&mut obj.normals, &mut next.normals);
     obj.corners.push(corners);
     if part == 0 {
         // The faces of the first stretch name its list already.
-        append_list(&mut obj.faces, next.faces);
+        append_list(&mut obj.faces, &mut next.faces);
     } else {
-        obj.faces.extend(next.faces.into_iter().map(|mut f| {
+        let in_part = move |mut f: Face| {
             f.part = part;
             f
-        }));
+        };
+        append_mapped(&mut obj.faces, &mut next.faces, in_part);
     }
     obj.usemtl.extend(next.usemtl.into_iter().map(|mut u| {
         u.first_face += faces;
@@ -134,14 +137,4 @@ fn append(obj: &mut Obj, mut next: Obj, corners: Vec<Corner>) {
     obj.lines += next.lines;
     obj.counts = next.counts;
     obj.counts.colours += colours;
-}
-
-/// `list` followed by `next`: `next` itself when `list` is empty (the first stretch's
-/// lists are not copied).
-fn append_list<T>(list: &mut Vec<T>, mut next: Vec<T>) {
-    if list.is_empty() {
-        *list = next;
-    } else {
-        list.append(&mut next);
-    }
 }

@@ -157,6 +157,7 @@
 //! A model without a single non-degenerate face has nothing to frame: [`load`] reports
 //! an error.
 
+mod append;
 mod build;
 mod colours;
 mod convert;

@@ -6,8 +6,9 @@
 //! stretch where it starts. A second parallel pass parses the stretches
 //! ([`parse::parse`]), a batch at a time, and [`Joined`] joins them in file order,
 //! each batch while the next is parsed, so that the join, which copies the stretches'
-//! lists into the file's on one thread, does not leave the other threads idle. A
-//! small file is one stretch, parsed without the count.
+//! lists into the file's (with the other threads' help, see [`super::append`]), does
+//! not leave the other threads idle. A small file is one stretch, parsed without the
+//! count.
 
 use super::join::Joined;
 use super::located::Located;
