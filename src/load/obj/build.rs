@@ -10,6 +10,7 @@ use super::smoothing::{self, GroupKey, unit};
 use crate::geometry::polygon::Triangulator;
 use crate::geometry::{Kind, QuadUv, Triangle};
 use crate::math::Vec3;
+use crate::scene::Geometry;
 use glam::Vec2;
 use std::collections::HashMap;
 use std::ops::Range;
@@ -56,12 +57,18 @@ impl<'a> Model<'a> {
     }
 }
 
-/// Convert `faces` of `model` (a range of [`Obj::faces`]), in order, with room made
-/// first for `expected` triangles.
+/// Convert `faces` of `model` (a range of [`Obj::faces`]), in order, into `geometry`
+/// (empty: its lists' memory is reused), with room made first for `expected`
+/// triangles.
 // Kept out of line so that profiles show the conversion.
 #[inline(never)]
-pub(super) fn convert(model: &Model, faces: Range<usize>, expected: usize) -> Converted {
-    let mut b = Builder::new(model);
+pub(super) fn convert(
+    model: &Model,
+    faces: Range<usize>,
+    expected: usize,
+    geometry: Geometry,
+) -> Converted {
+    let mut b = Builder::new(model, geometry);
     let g = &mut b.out.geometry;
     g.triangles.items.reserve(expected);
     g.triangles.material.reserve(expected);
@@ -95,10 +102,13 @@ struct FaceContext {
 }
 
 impl<'a> Builder<'a> {
-    fn new(model: &'a Model<'a>) -> Self {
+    fn new(model: &'a Model<'a>, geometry: Geometry) -> Self {
         Builder {
             model,
-            out: Converted::default(),
+            out: Converted {
+                geometry,
+                ..Converted::default()
+            },
             pts: Vec::new(),
             nrm: Vec::new(),
             tris: Vec::new(),

@@ -4,6 +4,7 @@
 //! numbered on, the bounds, the counts, the first lines noted, and the first error).
 
 use super::located::whole_file;
+use super::triangle_lists::append_triangles;
 use crate::load::LoadError;
 use crate::math::Aabb;
 use crate::scene::{Geometry, LoadStats};
@@ -55,17 +56,18 @@ pub(super) struct Converted {
 
 impl Converted {
     /// Join the faces that follow: what converting both in a row gives. Nothing is
-    /// joined after a stop.
-    pub fn append(&mut self, next: Converted) {
+    /// joined after a stop. Returns `next`'s geometry emptied, with its lists' memory.
+    pub fn append(&mut self, mut next: Converted) -> Geometry {
+        let mut spare = std::mem::take(&mut next.geometry);
         if self.stop.is_some() {
-            return;
+            return emptied(spare);
         }
         let before = self.geometry.vertex_normals.len();
         if too_many_smooth(before, next.smooth_tried) {
             self.stop = Some(Stop::TooManySmooth);
-            return;
+            return emptied(spare);
         }
-        self.geometry.append(next.geometry, |m| m);
+        append_triangles(&mut self.geometry, &mut spare);
         self.bounds = self.bounds.union(&next.bounds);
         self.stats.polygons += next.stats.polygons;
         self.stats.degenerate_dropped += next.stats.degenerate_dropped;
@@ -75,7 +77,23 @@ impl Converted {
         self.default_used |= next.default_used;
         self.smooth_tried = before + next.smooth_tried;
         self.stop = next.stop;
+        spare
     }
+}
+
+/// `g` without its triangles (a chunk's geometry holds nothing else), with its lists'
+/// memory.
+fn emptied(mut g: Geometry) -> Geometry {
+    g.triangles.items.clear();
+    g.triangles.material.clear();
+    g.triangle_normals.clear();
+    g.vertex_normals.clear();
+    g.triangle_uvs.clear();
+    g.vertex_uvs.clear();
+    g.triangle_quads.clear();
+    g.quads.clear();
+    g.sources = Default::default();
+    g
 }
 
 /// Whether trying `tried` smooth triangles after `before` of them goes past
@@ -106,7 +124,8 @@ mod tests {
     #[test]
     fn joins_in_order_and_keeps_the_first_lines() {
         let mut a = one_triangle(-1.0, 5);
-        a.append(one_triangle(2.0, 9));
+        let spare = a.append(one_triangle(2.0, 9));
+        assert_eq!(spare, Geometry::default());
         assert_eq!(a.geometry.triangles.len(), 2);
         assert_eq!(a.geometry.triangle_normals, [0, 1]);
         assert_eq!(a.geometry.triangles.items[1].p[0].x, 2.0);
@@ -119,7 +138,9 @@ mod tests {
     fn nothing_joins_after_a_stop() {
         let mut a = one_triangle(0.0, 1);
         a.stop = Some(Stop::MissingVertex);
-        a.append(one_triangle(1.0, 2));
+        let spare = a.append(one_triangle(1.0, 2));
+        assert_eq!(spare, Geometry::default());
+        assert!(spare.triangles.items.capacity() > 0);
         assert_eq!(a.geometry.triangles.len(), 1);
         assert_eq!(a.stop, Some(Stop::MissingVertex));
         let mut b = one_triangle(0.0, 1);

@@ -176,6 +176,7 @@ mod smoothing;
 mod stretches;
 mod texmap;
 mod textures;
+mod triangle_lists;
 
 pub use framing::{
     AUTO_AMBIENT, AUTO_ELEVATION_DEG, AUTO_FOV_DEG, AUTO_LIGHT_OFFSET, AUTO_MARGIN,
