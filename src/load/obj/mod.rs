@@ -172,6 +172,8 @@ mod mtl;
 mod numbers;
 mod parse;
 mod runs;
+mod sink;
+mod sized;
 mod smoothing;
 mod stretches;
 mod texmap;

@@ -19,6 +19,7 @@
 use super::colours::{ColourNote, Colours};
 use super::located::{Located, article, col_of, comment_hint, name_after_space, show};
 use super::numbers::{self, Element};
+use super::sink::Sink;
 use crate::load::LoadProgress;
 use glam::{DVec3, Vec2, Vec3};
 use rayon::prelude::*;
@@ -149,11 +150,15 @@ pub(super) struct ForwardRef {
 }
 
 /// Where a stretch starts: after `line` lines of the file, which define `counts`
-/// elements (their vertex colours are not counted: see [`count`]).
+/// elements (their vertex colours are not counted: see [`count`]) and `faces` faces
+/// and lines; `part` is its place among the stretches (the list of corners its faces
+/// name: see [`Face::part`]).
 #[derive(Clone, Copy, Debug, Default, PartialEq, Eq)]
 pub(super) struct Start {
     pub line: usize,
     pub counts: Counts,
+    pub faces: usize,
+    pub part: usize,
 }
 
 /// What a stretch gives. In [`Part::obj`], line numbers and element indices are the
@@ -162,10 +167,13 @@ pub(super) struct Start {
 #[derive(Debug, Default)]
 pub(super) struct Part {
     /// The statements read ([`Obj::colour_mismatch`] is left for the join), but for
-    /// the corners.
+    /// the corners, and for the elements and faces when they go to the file's lists
+    /// (see [`super::sink`]).
     pub obj: Obj,
-    /// The corners of the faces and lines read (their [`Face::part`] is 0).
+    /// The corners of the faces and lines read.
     pub corners: Vec<Corner>,
+    /// How many faces and lines were read.
+    pub faces: usize,
     /// Per kind: forward references, each larger than the one before in the stretch
     /// (the first in the file that turns out out of range is always among them).
     pub forward: [Vec<ForwardRef>; 3],
@@ -179,9 +187,12 @@ pub(super) struct Part {
 }
 
 /// The parser's state between lines.
-#[derive(Default)]
-struct Parser {
+struct Parser<S> {
     part: Part,
+    /// Where the elements and faces go.
+    sink: S,
+    /// The stretch's place among the file's ([`Start::part`]).
+    index: usize,
 }
 
 /// The words of a statement after its keyword: how many, and the first seven.
@@ -266,9 +277,19 @@ pub(super) fn corners_of<'a>(lists: &'a [Vec<Corner>], face: &Face) -> &'a [Corn
 }
 
 /// Parse a stretch of OBJ text (lines split as [`str::lines`] does) that starts at
-/// `start`, telling `progress` of its bytes as they are read.
-pub(super) fn parse(text: &str, start: Start, progress: &LoadProgress<'_>) -> Part {
-    let mut p = Parser::default();
+/// `start`, its elements and faces into `sink`, telling `progress` of its bytes as
+/// they are read.
+pub(super) fn parse(
+    text: &str,
+    start: Start,
+    sink: impl Sink,
+    progress: &LoadProgress<'_>,
+) -> Part {
+    let mut p = Parser {
+        part: Part::default(),
+        sink,
+        index: start.part,
+    };
     p.part.obj.counts = start.counts;
     // Bytes read since `progress` was last advanced, and before.
     let (mut read, mut told) = (0, 0);
@@ -284,7 +305,16 @@ pub(super) fn parse(text: &str, start: Start, progress: &LoadProgress<'_>) -> Pa
         }
     }
     progress.advance(text.len().saturating_sub(told) as u64);
+    if !p.sink.filled() {
+        p.part.error = Some(miscounted());
+    }
     p.part
+}
+
+/// The error when a stretch reads more or fewer elements or faces than the count pass
+/// found (which cannot be: both go by the same keywords).
+fn miscounted() -> Located {
+    Located::whole_file("internal error: a stretch of the file was miscounted".into())
 }
 
 /// The lines of a stretch and the elements they define, as far as their keywords
@@ -297,6 +327,7 @@ pub(super) fn count(text: &str) -> Start {
             Some("v") => n.counts.v += 1,
             Some("vt") => n.counts.vt += 1,
             Some("vn") => n.counts.vn += 1,
+            Some("f" | "l") => n.faces += 1,
             _ => {}
         }
     }
@@ -326,7 +357,7 @@ fn offset(line: &str, word: &str) -> usize {
     (word.as_ptr() as usize).saturating_sub(line.as_ptr() as usize)
 }
 
-impl Parser {
+impl<S: Sink> Parser<S> {
     fn statement(&mut self, ln: usize, line: &str) -> Result<(), Located> {
         let Some(kw) = keyword(line) else {
             return Ok(());
@@ -351,10 +382,7 @@ impl Parser {
                     None | Some("off") | Some("0") => 0,
                     Some(w) => w.parse::<u32>().unwrap_or(u32::MAX).max(1),
                 };
-                self.part
-                    .obj
-                    .smoothing
-                    .push((self.part.obj.faces.len(), group));
+                self.part.obj.smoothing.push((self.part.faces, group));
             }
             "g" | "o" => self.cut(ln, None),
             _ => {}
@@ -365,7 +393,7 @@ impl Parser {
     /// A statement that may end a run of faces.
     fn cut(&mut self, ln: usize, usemtl: Option<usize>) {
         self.part.obj.cuts.push(Cut {
-            first_face: self.part.obj.faces.len(),
+            first_face: self.part.faces,
             line: ln,
             counts: self.part.obj.counts,
             usemtl,
@@ -393,8 +421,10 @@ impl Parser {
             col: col_of(line, kw),
         });
         let read = self.numbers(Element::Vertex, ln, line, w);
-        self.part.obj.positions.push(Vec3::from(read.values));
-        self.part.obj.world.push(DVec3::from(read.exact));
+        let (p, world) = (Vec3::from(read.values), DVec3::from(read.exact));
+        if !self.sink.vertex(&mut self.part.obj, p, world) {
+            return Err(miscounted());
+        }
         self.part.obj.counts.v += 1;
         self.part.obj.counts.colours += read.colours;
         Ok(())
@@ -416,12 +446,16 @@ impl Parser {
             ));
         }
         let [a, b, c] = self.numbers(kind, ln, line, w).values;
-        if kind == Element::Texture {
-            self.part.obj.texcoords.push(Vec2::new(a, b));
-            self.part.obj.counts.vt += 1;
+        let obj = &mut self.part.obj;
+        let room = if kind == Element::Texture {
+            obj.counts.vt += 1;
+            self.sink.texcoord(obj, Vec2::new(a, b))
         } else {
-            self.part.obj.normals.push(Vec3::new(a, b, c));
-            self.part.obj.counts.vn += 1;
+            obj.counts.vn += 1;
+            self.sink.normal(obj, Vec3::new(a, b, c))
+        };
+        if !room {
+            return Err(miscounted());
         }
         Ok(())
     }
@@ -449,7 +483,7 @@ impl Parser {
         }
         let k = self.part.obj.usemtl.len();
         self.part.obj.usemtl.push(UseMtl {
-            first_face: self.part.obj.faces.len(),
+            first_face: self.part.faces,
             name: name.to_string(),
             line: ln,
         });
@@ -485,9 +519,9 @@ impl Parser {
                 "face without vertices".into(),
             ));
         }
-        self.part.obj.faces.push(Face {
+        let face = Face {
             line: ln,
-            part: 0,
+            part: self.index,
             first,
             arity,
             is_line,
@@ -495,7 +529,11 @@ impl Parser {
             all_texcoords: all_texcoords && !is_line,
             texcoords_defined: false,
             normals_defined: false,
-        });
+        };
+        if !self.sink.face(&mut self.part.obj, face) {
+            return Err(miscounted());
+        }
+        self.part.faces += 1;
         Ok(())
     }
 
