@@ -133,19 +133,20 @@ mod tests {
         let mut obj = Obj::default();
         let mut positions = [Vec3::ZERO; 2];
         let mut world = [DVec3::ZERO; 2];
-        let mut s = Slices {
-            positions: Places::new(&mut positions),
-            world: Places::new(&mut world),
-            ..Slices::default()
-        };
-        assert!(!s.filled());
-        assert!(s.vertex(&mut obj, Vec3::X, DVec3::X));
-        assert!(!s.filled());
-        assert!(s.vertex(&mut obj, Vec3::Y, DVec3::Y));
-        assert!(s.filled());
-        assert!(!s.vertex(&mut obj, Vec3::Z, DVec3::Z));
-        assert!(!s.texcoord(&mut obj, Vec2::ONE));
-        drop(s);
+        {
+            let mut s = Slices {
+                positions: Places::new(&mut positions),
+                world: Places::new(&mut world),
+                ..Slices::default()
+            };
+            assert!(!s.filled());
+            assert!(s.vertex(&mut obj, Vec3::X, DVec3::X));
+            assert!(!s.filled());
+            assert!(s.vertex(&mut obj, Vec3::Y, DVec3::Y));
+            assert!(s.filled());
+            assert!(!s.vertex(&mut obj, Vec3::Z, DVec3::Z));
+            assert!(!s.texcoord(&mut obj, Vec2::ONE));
+        }
         assert_eq!(positions, [Vec3::X, Vec3::Y]);
         assert!(obj.positions.is_empty());
         assert!(Lists.vertex(&mut obj, Vec3::Z, DVec3::Z));
