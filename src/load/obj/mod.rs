@@ -10,9 +10,12 @@
 //! reads it; the faces are then triangulated and the materials mapped. A file larger
 //! than 4 MB is cut into stretches of about 4 MB at line starts, parsed in parallel
 //! on the current thread pool (when it has more than one thread) and joined in file
-//! order (`stretches`, `join`): the
-//! model, the warnings and the error are those of reading the file from start to end,
-//! whatever the cut, as `tests/obj_stretches.rs` checks.
+//! order (`stretches`, `join`); a first pass counts each stretch's elements and faces,
+//! so that the stretches parse into their places in the file's lists (`sized`,
+//! `sink`). The faces are then converted to triangles in chunks, in parallel, joined
+//! in face order (`convert`, `converted`, `triangle_lists`). The model, the warnings
+//! and the error are those of reading the file from start to end, whatever the cut,
+//! as `tests/obj_stretches.rs` and `tests/obj_chunks.rs` check.
 //!
 //! - Faces (`f`) with 3 vertices become one triangle directly; larger ones, convex or
 //!   not, are cut by ear clipping ([`crate::geometry::polygon`]), never as a blind fan,
