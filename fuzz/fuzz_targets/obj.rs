@@ -1,6 +1,7 @@
 //! OBJ loader (through a file, as the loader reads MTL files beside it): any bytes give
 //! a scene or a `LoadError`, never a panic; and the model or error is the same when
-//! the file is parsed in stretches of a few bytes.
+//! the file is parsed in stretches of a few bytes, and when its faces are converted
+//! to triangles in chunks of two faces.
 #![no_main]
 
 use libfuzzer_sys::fuzz_target;
@@ -24,4 +25,10 @@ fuzz_target!(|data: &[u8]| {
     let cut = emray::load::obj::load_geometry_in_stretches(p, 7);
     // Debug forms: NaN texture coordinates compare equal.
     assert_eq!(format!("{whole:?}"), format!("{cut:?}"));
+    let chunks = emray::load::obj::load_geometry_in_chunks(p, usize::MAX, 2);
+    assert_eq!(format!("{whole:?}"), format!("{chunks:?}"));
+    // The triangles' origins do not show in the Debug forms.
+    if let (Ok(a), Ok(b)) = (&whole, &chunks) {
+        assert!(a.geometry.sources.same_origins(&b.geometry.sources));
+    }
 });

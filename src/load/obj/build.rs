@@ -1,34 +1,90 @@
-//! Faces to triangles: ear clipping of larger faces, shading normals (the file's, or a
-//! smoothing group's), texture coordinates, degenerate faces dropped and counted, and
-//! each face's material.
+//! Faces to triangles, for a run of consecutive faces on one thread: ear clipping of
+//! larger faces, shading normals (the file's, or a smoothing group's), texture
+//! coordinates, degenerate faces dropped and counted, and each face's material.
 
-use super::located::whole_file;
-use super::material::{DEFAULT_SLOT, Materials};
+use super::converted::{Converted, MAX_SMOOTH, Stop};
+use super::in_force::InForce;
+use super::material::DEFAULT_SLOT;
 use super::parse::{Face, Obj};
 use super::smoothing::{self, GroupKey, unit};
 use crate::geometry::polygon::Triangulator;
 use crate::geometry::{Kind, QuadUv, Triangle};
-use crate::load::LoadError;
-use crate::math::{Aabb, Vec3};
-use crate::scene::{Geometry, LoadStats};
+use crate::math::Vec3;
+use crate::scene::Geometry;
 use glam::Vec2;
 use std::collections::HashMap;
+use std::ops::Range;
 use std::path::Path;
 use std::sync::Arc;
 
-/// The triangles of a model, with what was noted on the way.
-pub(super) struct Builder<'a> {
-    path: &'a Path,
+/// What converting any faces of a model needs, shared by the threads that convert
+/// them.
+pub(super) struct Model<'a> {
+    obj: &'a Obj,
     /// The file, as the triangles' origins name it.
     file: Arc<str>,
-    pub geometry: Geometry,
-    pub bounds: Aabb,
-    pub stats: LoadStats,
-    /// Line of the first degenerate face.
-    pub first_degenerate: Option<usize>,
-    /// Faces with a zero-length normal, and the line of the first.
-    pub zero_normals: usize,
-    pub first_zero_normal: Option<usize>,
+    /// Each `usemtl` as (index of the first face after it, its material slot).
+    slots: Vec<(usize, u32)>,
+    /// The index the default material has in the model's list once a face uses it.
+    default_material: u32,
+    /// The smoothing groups' normals ([`smoothing::group_normals`]).
+    group_normals: HashMap<GroupKey, Vec3>,
+}
+
+impl<'a> Model<'a> {
+    /// The faces of `obj` from the file at `path`; `slots` are the material slots of
+    /// its `usemtl` statements, `default_material` the index of the default material
+    /// once added. Sums the smoothing groups' normals (over every face, in order).
+    pub fn new(path: &Path, obj: &'a Obj, slots: &[u32], default_material: u32) -> Self {
+        let starts = obj.usemtl.iter().map(|u| u.first_face);
+        Model {
+            obj,
+            file: Arc::from(path.display().to_string()),
+            slots: starts.zip(slots.iter().copied()).collect(),
+            default_material,
+            group_normals: smoothing::group_normals(obj),
+        }
+    }
+
+    /// How many faces (and lines) the model has.
+    pub fn faces(&self) -> usize {
+        self.obj.faces.len()
+    }
+
+    /// Triangles the whole model is likely to make: enough for faces of 3 vertices.
+    pub fn triangles_expected(&self) -> usize {
+        self.obj.corner_count() / 3
+    }
+}
+
+/// Convert `faces` of `model` (a range of [`Obj::faces`]), in order, into `geometry`
+/// (empty: its lists' memory is reused), with room made first for `expected`
+/// triangles.
+// Kept out of line so that profiles show the conversion.
+#[inline(never)]
+pub(super) fn convert(
+    model: &Model,
+    faces: Range<usize>,
+    expected: usize,
+    geometry: Geometry,
+) -> Converted {
+    let mut b = Builder::new(model, geometry);
+    let g = &mut b.out.geometry;
+    g.triangles.items.reserve(expected);
+    g.triangles.material.reserve(expected);
+    g.triangle_normals.reserve(expected);
+    let stop = b.faces(faces).err();
+    let mut out = b.out;
+    out.stop = stop;
+    out.smooth_tried =
+        out.geometry.vertex_normals.len() + usize::from(stop == Some(Stop::TooManySmooth));
+    out
+}
+
+/// Faces to triangles, one after the other.
+struct Builder<'a> {
+    model: &'a Model<'a>,
+    out: Converted,
     // Scratch for polygons, reused from face to face.
     pts: Vec<Vec3>,
     nrm: Vec<Vec3>,
@@ -38,25 +94,21 @@ pub(super) struct Builder<'a> {
 }
 
 /// What applies to a face besides its vertices.
-struct FaceContext<'a> {
+struct FaceContext {
     /// The material slot of the `usemtl` in force.
     slot: u32,
     /// The smoothing group (0: none).
     group: u32,
-    group_normals: &'a HashMap<GroupKey, Vec3>,
 }
 
 impl<'a> Builder<'a> {
-    pub fn new(path: &'a Path) -> Self {
+    fn new(model: &'a Model<'a>, geometry: Geometry) -> Self {
         Builder {
-            path,
-            file: Arc::from(path.display().to_string()),
-            geometry: Geometry::default(),
-            bounds: Aabb::EMPTY,
-            stats: LoadStats::default(),
-            first_degenerate: None,
-            zero_normals: 0,
-            first_zero_normal: None,
+            model,
+            out: Converted {
+                geometry,
+                ..Converted::default()
+            },
             pts: Vec::new(),
             nrm: Vec::new(),
             tris: Vec::new(),
@@ -65,83 +117,70 @@ impl<'a> Builder<'a> {
         }
     }
 
-    /// Add the faces of `obj` in file order; `slots` are the material slots of its
-    /// `usemtl` statements.
-    // Kept out of line (called once) so that profiles show the conversion.
-    #[inline(never)]
-    pub fn build(
-        &mut self,
-        obj: &Obj,
-        slots: &[u32],
-        materials: &mut Materials,
-    ) -> Result<(), LoadError> {
-        let corners = obj.corner_count();
-        self.geometry.triangles.items.reserve(corners / 3);
-        self.geometry.triangles.material.reserve(corners / 3);
-        self.geometry.triangle_normals.reserve(corners / 3);
-        let groups = smoothing::face_groups(obj);
-        let group_normals = smoothing::group_normals(obj, &groups);
-        let mut next_usemtl = obj.usemtl.iter().zip(slots).peekable();
-        let mut slot = DEFAULT_SLOT;
-        for (k, (face, &group)) in obj.faces.iter().zip(&groups).enumerate() {
-            while let Some((_, &s)) = next_usemtl.next_if(|(u, _)| u.first_face <= k) {
-                slot = s;
-            }
+    /// Add the triangles of `faces`, in order, up to the first that stops them.
+    fn faces(&mut self, faces: Range<usize>) -> Result<(), Stop> {
+        let model = self.model;
+        let mut slots = InForce::from(&model.slots, DEFAULT_SLOT, faces.start);
+        let mut groups = InForce::from(&model.obj.smoothing, 0, faces.start);
+        let list = model.obj.faces.get(faces.clone()).unwrap_or_default();
+        for (k, face) in faces.zip(list) {
+            let context = FaceContext {
+                slot: slots.at(k),
+                group: groups.at(k),
+            };
             if face.is_line {
                 continue;
             }
-            self.stats.polygons += 1;
-            let context = FaceContext {
-                slot,
-                group,
-                group_normals: &group_normals,
-            };
-            self.face(obj, face, &context, materials)?;
+            self.out.stats.polygons += 1;
+            self.face(face, &context)?;
         }
         Ok(())
     }
 
     /// Add the triangles of one face (nothing if it is degenerate).
-    fn face(
-        &mut self,
-        obj: &Obj,
-        face: &Face,
-        context: &FaceContext,
-        materials: &mut Materials,
-    ) -> Result<(), LoadError> {
+    fn face(&mut self, face: &Face, context: &FaceContext) -> Result<(), Stop> {
         if face.arity < 3 {
             self.degenerate(face.line);
             return Ok(());
         }
+        let obj = self.model.obj;
         if !smoothing::positions(obj, face, &mut self.pts) {
-            return Err(whole_file(
-                self.path,
-                "internal error: a face names a vertex the file does not define".into(),
-            ));
+            return Err(Stop::MissingVertex);
         }
-        let smooth = self.shading_normals(obj, face, context);
-        self.texcoords(obj, face);
+        let smooth = self.shading_normals(face, context);
+        self.texcoords(face);
         if !self.triangulate() {
             self.degenerate(face.line);
             return Ok(());
         }
-        let m = materials.index(context.slot);
-        let first = self.geometry.triangles.len();
+        let m = self.material(context.slot);
+        let first = self.out.geometry.triangles.len();
         for t in 0..self.tris.len() {
             self.triangle(t, smooth, m)?;
         }
-        let count = self.geometry.triangles.len() - first;
+        let count = self.out.geometry.triangles.len() - first;
         let line = u32::try_from(face.line).unwrap_or(u32::MAX);
-        let g = &mut self.geometry;
+        let g = &mut self.out.geometry;
         g.sources
-            .add(Kind::Triangle, first, count, &self.file, line);
+            .add(Kind::Triangle, first, count, &self.model.file, line);
         self.quad_uv(face, first);
         Ok(())
     }
 
+    /// The material index of `slot`, noting a use of the default material.
+    fn material(&mut self, slot: u32) -> u32 {
+        if slot == DEFAULT_SLOT {
+            self.out.default_used = true;
+            self.model.default_material
+        } else {
+            slot
+        }
+    }
+
     /// The face's shading normals into `nrm`: the file's (a face with a zero-length
     /// one is noted and flat), else its smoothing group's. Whether it is smooth.
-    fn shading_normals(&mut self, obj: &Obj, face: &Face, context: &FaceContext) -> bool {
+    fn shading_normals(&mut self, face: &Face, context: &FaceContext) -> bool {
+        let obj = self.model.obj;
         self.nrm.clear();
         if face.all_normals && face.normals_defined {
             let normals = obj
@@ -156,7 +195,8 @@ impl<'a> Builder<'a> {
             smooth
         } else if context.group != 0 {
             let grouped = |p: &Vec3| {
-                let sum = context
+                let sum = self
+                    .model
                     .group_normals
                     .get(&smoothing::key(*p, context.group));
                 sum.and_then(|n| unit(*n))
@@ -169,7 +209,8 @@ impl<'a> Builder<'a> {
     }
 
     /// The face's texture coordinates into `uvs`, when it has them.
-    fn texcoords(&mut self, obj: &Obj, face: &Face) {
+    fn texcoords(&mut self, face: &Face) {
+        let obj = self.model.obj;
         self.uvs.clear();
         if !(face.all_texcoords && face.texcoords_defined) {
             return;
@@ -200,7 +241,7 @@ impl<'a> Builder<'a> {
 
     /// Add triangle `t` of `tris` with material `m`, smooth or flat, and its texture
     /// coordinates.
-    fn triangle(&mut self, t: usize, smooth: bool, m: u32) -> Result<(), LoadError> {
+    fn triangle(&mut self, t: usize, smooth: bool, m: u32) -> Result<(), Stop> {
         let Some(&[a, b, c]) = self.tris.get(t) else {
             return Ok(());
         };
@@ -211,9 +252,10 @@ impl<'a> Builder<'a> {
         let n = smooth.then(|| [a, b, c].map(|i| corner(&self.nrm, i)));
         self.push(tri, n, m)?;
         if !self.uvs.is_empty() {
-            let i = self.geometry.triangles.len() - 1;
+            let g = &mut self.out.geometry;
+            let i = g.triangles.len() - 1;
             let uv = [a, b, c].map(|i| self.uvs.get(i).copied().unwrap_or_default());
-            self.geometry.set_triangle_uvs(i, uv);
+            g.set_triangle_uvs(i, uv);
         }
         Ok(())
     }
@@ -227,40 +269,42 @@ impl<'a> Builder<'a> {
         ) else {
             return;
         };
-        if face.arity != 4 || self.geometry.triangles.len() != first + 2 {
+        let g = &mut self.out.geometry;
+        if face.arity != 4 || g.triangles.len() != first + 2 {
             return;
         }
         if let Some(q) = QuadUv::new(p, uv) {
-            let k = self.geometry.add_quad(q);
-            self.geometry.set_triangle_quad(first, k);
-            self.geometry.set_triangle_quad(first + 1, k);
+            let k = g.add_quad(q);
+            g.set_triangle_quad(first, k);
+            g.set_triangle_quad(first + 1, k);
         }
     }
 
     #[inline]
-    fn push(&mut self, tri: Triangle, normals: Option<[Vec3; 3]>, m: u32) -> Result<(), LoadError> {
+    fn push(&mut self, tri: Triangle, normals: Option<[Vec3; 3]>, m: u32) -> Result<(), Stop> {
+        let out = &mut self.out;
         for p in tri.p {
-            self.bounds = self.bounds.grow(p);
+            out.bounds = out.bounds.grow(p);
         }
         match normals {
             Some(n) => {
-                if self.geometry.vertex_normals.len() >= u32::MAX as usize {
-                    return Err(whole_file(self.path, "too many smooth triangles".into()));
+                if out.geometry.vertex_normals.len() >= MAX_SMOOTH {
+                    return Err(Stop::TooManySmooth);
                 }
-                self.geometry.add_smooth_triangle(tri, n, m);
+                out.geometry.add_smooth_triangle(tri, n, m);
             }
-            None => self.geometry.add_triangle(tri, m),
+            None => out.geometry.add_triangle(tri, m),
         }
         Ok(())
     }
 
     fn degenerate(&mut self, line: usize) {
-        self.stats.degenerate_dropped += 1;
-        self.first_degenerate.get_or_insert(line);
+        self.out.stats.degenerate_dropped += 1;
+        self.out.first_degenerate.get_or_insert(line);
     }
 
     fn zero_normal(&mut self, line: usize) {
-        self.zero_normals += 1;
-        self.first_zero_normal.get_or_insert(line);
+        self.out.zero_normals += 1;
+        self.out.first_zero_normal.get_or_insert(line);
     }
 }

@@ -1,15 +1,18 @@
 //! Joining the parsed stretches of a file, in file order, into what parsing the whole
 //! file gives: the statements of one [`Obj`], or the file's first problem.
 //!
-//! A stretch's line numbers and element indices are already the file's (see
-//! [`super::parse`]); the join moves its face and `usemtl` indices past the earlier
-//! stretches', points its faces at its own list of corners (kept as it is: the
-//! largest list is not copied), and adds the vertex colours counted before it. The first
+//! A stretch's line numbers and element indices are already the file's, and its faces
+//! name its own list of corners (see [`super::parse`]), which the join keeps as it is
+//! (the largest list is not copied). The join moves the stretch's face and `usemtl`
+//! indices past the earlier stretches' and adds the vertex colours counted before it.
+//! The elements and faces of a file of several stretches are in the file's lists
+//! already ([`super::sized`]); a stretch's own lists are moved. The first
 //! stretch stopped by a problem ends the join: its problem is the error, unless the
 //! file has a bad number on an earlier line, in this stretch or an earlier one. With
 //! none, the forward references are checked against the elements of the whole file,
 //! and a number that does not parse anywhere is the error.
 
+use super::append::append_list;
 use super::colours::Colours;
 use super::located::Located;
 use super::parse::{Corner, ForwardRef, KINDS, Obj, Part};
@@ -18,6 +21,9 @@ use super::parse::{Corner, ForwardRef, KINDS, Obj, Part};
 #[derive(Default)]
 pub(super) struct Joined {
     obj: Obj,
+    /// The faces and lines of the stretches joined (the file's list of faces may be
+    /// filled in place: see [`super::sink`]).
+    faces: usize,
     forward: [Vec<ForwardRef>; 3],
     colours: Colours,
     fatal_number: bool,
@@ -36,7 +42,8 @@ impl Joined {
         if let Some(e) = part.error {
             return Err(first_bad_before(obj, e));
         }
-        append(obj, part.obj, part.corners);
+        append(obj, part.obj, part.corners, self.faces);
+        self.faces += part.faces;
         for (all, refs) in self.forward.iter_mut().zip(part.forward) {
             all.extend(refs);
         }
@@ -100,24 +107,16 @@ fn first_bad_before(obj: &mut Obj, e: Located) -> Located {
 }
 
 /// Append the statements of the next stretch, with its `corners`, to those of the
-/// earlier ones.
-fn append(obj: &mut Obj, mut next: Obj, corners: Vec<Corner>) {
-    let (part, faces, usemtl) = (obj.corners.len(), obj.faces.len(), obj.usemtl.len());
+/// earlier ones, which have `faces` faces and lines.
+fn append(obj: &mut Obj, mut next: Obj, corners: Vec<Corner>, faces: usize) {
+    let usemtl = obj.usemtl.len();
     let colours = obj.counts.colours;
-    append_list(&mut obj.positions, next.positions);
-    append_list(&mut obj.world, next.world);
-    append_list(&mut obj.texcoords, next.texcoords);
-    append_list(&mut obj.normals, next.normals);
+    append_list(&mut obj.positions, &mut next.positions);
+    append_list(&mut obj.world, &mut next.world);
+    append_list(&mut obj.texcoords, &mut next.texcoords);
+    append_list(&mut obj.normals, &mut next.normals);
     obj.corners.push(corners);
-    if part == 0 {
-        // The faces of the first stretch name its list already.
-        append_list(&mut obj.faces, next.faces);
-    } else {
-        obj.faces.extend(next.faces.into_iter().map(|mut f| {
-            f.part = part;
-            f
-        }));
-    }
+    append_list(&mut obj.faces, &mut next.faces);
     obj.usemtl.extend(next.usemtl.into_iter().map(|mut u| {
         u.first_face += faces;
         u
@@ -134,14 +133,4 @@ fn append(obj: &mut Obj, mut next: Obj, corners: Vec<Corner>) {
     obj.lines += next.lines;
     obj.counts = next.counts;
     obj.counts.colours += colours;
-}
-
-/// `list` followed by `next`: `next` itself when `list` is empty (the first stretch's
-/// lists are not copied).
-fn append_list<T>(list: &mut Vec<T>, mut next: Vec<T>) {
-    if list.is_empty() {
-        *list = next;
-    } else {
-        list.append(&mut next);
-    }
 }

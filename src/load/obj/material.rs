@@ -90,6 +90,12 @@ impl Materials {
         slots
     }
 
+    /// The index [`DEFAULT_MATERIAL`] has in [`Materials::list`], or will have once a
+    /// face uses it ([`Materials::index`] of [`DEFAULT_SLOT`] adds it).
+    pub fn default_index(&self) -> u32 {
+        self.default_index.unwrap_or(self.list.len() as u32)
+    }
+
     /// The index in [`Materials::list`] of a slot.
     pub fn index(&mut self, slot: u32) -> u32 {
         if slot != DEFAULT_SLOT {

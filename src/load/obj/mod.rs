@@ -10,9 +10,12 @@
 //! reads it; the faces are then triangulated and the materials mapped. A file larger
 //! than 4 MB is cut into stretches of about 4 MB at line starts, parsed in parallel
 //! on the current thread pool (when it has more than one thread) and joined in file
-//! order (`stretches`, `join`): the
-//! model, the warnings and the error are those of reading the file from start to end,
-//! whatever the cut, as `tests/obj_stretches.rs` checks.
+//! order (`stretches`, `join`); a first pass counts each stretch's elements and faces,
+//! so that the stretches parse into their places in the file's lists (`sized`,
+//! `sink`). The faces are then converted to triangles in chunks, in parallel, joined
+//! in face order (`convert`, `converted`, `triangle_lists`). The model, the warnings
+//! and the error are those of reading the file from start to end, whatever the cut,
+//! as `tests/obj_stretches.rs` and `tests/obj_chunks.rs` check.
 //!
 //! - Faces (`f`) with 3 vertices become one triangle directly; larger ones, convex or
 //!   not, are cut by ear clipping ([`crate::geometry::polygon`]), never as a blind fan,
@@ -157,9 +160,13 @@
 //! A model without a single non-degenerate face has nothing to frame: [`load`] reports
 //! an error.
 
+mod append;
 mod build;
 mod colours;
+mod convert;
+mod converted;
 mod framing;
+mod in_force;
 mod join;
 mod libs;
 mod located;
@@ -168,10 +175,13 @@ mod mtl;
 mod numbers;
 mod parse;
 mod runs;
+mod sink;
+mod sized;
 mod smoothing;
 mod stretches;
 mod texmap;
 mod textures;
+mod triangle_lists;
 
 pub use framing::{
     AUTO_AMBIENT, AUTO_ELEVATION_DEG, AUTO_FOV_DEG, AUTO_LIGHT_OFFSET, AUTO_MARGIN,
@@ -181,23 +191,44 @@ pub use framing::{
 use super::{LoadError, LoadProgress, text};
 use crate::math::{Aabb, DVec3, Vec3};
 use crate::scene::{Environment, Geometry, LoadStats, Material, Scene, Texture};
-use build::Builder;
+use build::Model;
+use converted::Converted;
 use located::whole_file;
-use material::Materials;
+use material::{DEFAULT_SLOT, Materials};
 use std::path::Path;
 use std::time::{Duration, Instant};
 
 /// The size of the stretches a large file is cut into to be parsed in parallel.
 const STRETCH: usize = 4 << 20;
 
-/// The size of the stretches on the current thread pool: [`STRETCH`], or the whole
-/// file when there is one thread to parse them (stretches would only add work: their
-/// count, and the copy that joins them).
-fn stretch() -> usize {
-    if rayon::current_num_threads() > 1 {
-        STRETCH
-    } else {
-        usize::MAX
+/// The faces in a chunk of faces converted to triangles in parallel.
+const FACE_CHUNK: usize = 1 << 14;
+
+/// How a load is cut to run on the threads of a pool.
+#[derive(Clone, Copy, Debug)]
+struct Cuts {
+    /// The size of the stretches of text parsed in parallel.
+    stretch: usize,
+    /// The faces of a chunk converted to triangles in parallel.
+    faces: usize,
+}
+
+impl Cuts {
+    /// The cuts on the current thread pool: [`STRETCH`] and [`FACE_CHUNK`], or none
+    /// when there is one thread (stretches and chunks would only add work: the count of
+    /// the stretches, and the copies that join them).
+    fn for_pool() -> Self {
+        if rayon::current_num_threads() > 1 {
+            Cuts {
+                stretch: STRETCH,
+                faces: FACE_CHUNK,
+            }
+        } else {
+            Cuts {
+                stretch: usize::MAX,
+                faces: usize::MAX,
+            }
+        }
     }
 }
 
@@ -263,7 +294,7 @@ pub fn load(path: &Path) -> Result<Scene, LoadError> {
 /// # Errors
 /// As [`load`].
 pub fn load_with(path: &Path, progress: &LoadProgress<'_>) -> Result<Scene, LoadError> {
-    let data = read_geometry(path, Origin::Centre, stretch(), progress)?;
+    let data = read_geometry(path, Origin::Centre, Cuts::for_pool(), progress)?;
     for w in &data.warnings {
         log::warn!("{w}");
     }
@@ -309,7 +340,7 @@ pub fn load_geometry(path: &Path) -> Result<ObjData, LoadError> {
 /// # Errors
 /// As [`load_geometry`].
 pub fn load_geometry_at(path: &Path, origin: Origin) -> Result<ObjData, LoadError> {
-    read_geometry(path, origin, stretch(), &LoadProgress::silent())
+    read_geometry(path, origin, Cuts::for_pool(), &LoadProgress::silent())
 }
 
 /// [`load_geometry`], with the text cut into stretches of about `stretch` bytes that
@@ -319,32 +350,46 @@ pub fn load_geometry_at(path: &Path, origin: Origin) -> Result<ObjData, LoadErro
 /// # Errors
 /// As [`load_geometry`].
 pub fn load_geometry_in_stretches(path: &Path, stretch: usize) -> Result<ObjData, LoadError> {
-    read_geometry(
-        path,
-        Origin::At(DVec3::ZERO),
+    let cuts = Cuts {
         stretch,
-        &LoadProgress::silent(),
-    )
+        ..Cuts::for_pool()
+    };
+    read_geometry(path, Origin::At(DVec3::ZERO), cuts, &LoadProgress::silent())
 }
 
-/// [`load_geometry_at`] in stretches of `stretch` bytes, telling `progress` how many
-/// of the file's bytes are parsed.
+/// [`load_geometry_in_stretches`], with the faces converted to triangles in parallel
+/// in chunks of `faces` faces (at least one). The model, the warnings and the error
+/// are the same whatever the sizes.
+///
+/// # Errors
+/// As [`load_geometry`].
+pub fn load_geometry_in_chunks(
+    path: &Path,
+    stretch: usize,
+    faces: usize,
+) -> Result<ObjData, LoadError> {
+    let cuts = Cuts { stretch, faces };
+    read_geometry(path, Origin::At(DVec3::ZERO), cuts, &LoadProgress::silent())
+}
+
+/// [`load_geometry_at`] cut as `cuts` says, telling `progress` how many of the file's
+/// bytes are parsed.
 fn read_geometry(
     path: &Path,
     origin: Origin,
-    stretch: usize,
+    cuts: Cuts,
     progress: &LoadProgress<'_>,
 ) -> Result<ObjData, LoadError> {
     let t0 = Instant::now();
     let text = text::read_lossy(path)?;
     progress.expect(text.len() as u64);
     let t_read = t0.elapsed();
-    let mut obj = stretches::parse(&text, stretch, progress).map_err(|e| e.at(path))?;
+    let mut obj = stretches::parse(&text, cuts.stretch, progress).map_err(|e| e.at(path))?;
     let t_parse = t0.elapsed();
 
     let libs = libs::read(path, &obj.mtllibs);
     let t_libs = t0.elapsed();
-    runs::check(&mut obj, &libs.names_read_at()).map_err(|e| e.at(path))?;
+    runs::check(&mut obj, &libs.names_read_at(), cuts.faces).map_err(|e| e.at(path))?;
     let origin = match origin {
         Origin::At(p) => p,
         Origin::Centre => obj.centre(),
@@ -364,8 +409,14 @@ fn read_geometry(
     );
     let t_materials = t0.elapsed();
 
-    let mut b = Builder::new(path);
-    b.build(&obj, &slots, &mut materials)?;
+    let model = Model::new(path, &obj, &slots, materials.default_index());
+    let b = convert::convert(&model, cuts.faces);
+    if let Some(stop) = b.stop {
+        return Err(stop.error(path));
+    }
+    if b.default_used {
+        materials.index(DEFAULT_SLOT);
+    }
     let t_build = t0.elapsed();
     let ms = |a: Duration, b: Duration| b.saturating_sub(a).as_secs_f64() * 1e3;
     log::info!(
@@ -393,7 +444,7 @@ fn read_geometry(
 
 /// The warnings that sum up the faces: degenerate ones dropped, zero-length normals,
 /// lines ignored.
-fn summary_warnings(path: &Path, b: &Builder, lines: usize) -> Vec<String> {
+fn summary_warnings(path: &Path, b: &Converted, lines: usize) -> Vec<String> {
     let mut warnings = Vec::new();
     if let Some(line) = b.first_degenerate {
         warnings.push(format!(

@@ -19,11 +19,16 @@
 use super::colours::{ColourNote, Colours};
 use super::located::{Located, article, col_of, comment_hint, name_after_space, show};
 use super::numbers::{self, Element};
+use super::sink::Sink;
 use crate::load::LoadProgress;
 use glam::{DVec3, Vec2, Vec3};
+use rayon::prelude::*;
 
 /// How many bytes are read between two advances of the load's progress.
 const PROGRESS_CHUNK: usize = 1 << 20;
+
+/// The fewest vertices a thread takes at a time when they are walked in parallel.
+const ELEMENT_CHUNK: usize = 1 << 16;
 
 /// Index of an element a corner does not name.
 pub(super) const NONE: usize = usize::MAX;
@@ -145,11 +150,15 @@ pub(super) struct ForwardRef {
 }
 
 /// Where a stretch starts: after `line` lines of the file, which define `counts`
-/// elements (their vertex colours are not counted: see [`count`]).
+/// elements (their vertex colours are not counted: see [`count`]) and `faces` faces
+/// and lines; `part` is its place among the stretches (the list of corners its faces
+/// name: see [`Face::part`]).
 #[derive(Clone, Copy, Debug, Default, PartialEq, Eq)]
 pub(super) struct Start {
     pub line: usize,
     pub counts: Counts,
+    pub faces: usize,
+    pub part: usize,
 }
 
 /// What a stretch gives. In [`Part::obj`], line numbers and element indices are the
@@ -158,10 +167,13 @@ pub(super) struct Start {
 #[derive(Debug, Default)]
 pub(super) struct Part {
     /// The statements read ([`Obj::colour_mismatch`] is left for the join), but for
-    /// the corners.
+    /// the corners, and for the elements and faces when they go to the file's lists
+    /// (see [`super::sink`]).
     pub obj: Obj,
-    /// The corners of the faces and lines read (their [`Face::part`] is 0).
+    /// The corners of the faces and lines read.
     pub corners: Vec<Corner>,
+    /// How many faces and lines were read.
+    pub faces: usize,
     /// Per kind: forward references, each larger than the one before in the stretch
     /// (the first in the file that turns out out of range is always among them).
     pub forward: [Vec<ForwardRef>; 3],
@@ -175,9 +187,12 @@ pub(super) struct Part {
 }
 
 /// The parser's state between lines.
-#[derive(Default)]
-struct Parser {
+struct Parser<S> {
     part: Part,
+    /// Where the elements and faces go.
+    sink: S,
+    /// The stretch's place among the file's ([`Start::part`]).
+    index: usize,
 }
 
 /// The words of a statement after its keyword: how many, and the first seven.
@@ -223,12 +238,18 @@ impl Obj {
     }
 
     /// The centre of the box around the finite vertex positions (the origin 0 when
-    /// there is none): where a model alone is re-centred.
+    /// there is none): where a model alone is re-centred. Found in parallel on the
+    /// current thread pool; `min` and `max` pick one of their operands, so the box is
+    /// the one found in a row, to the bit.
     pub fn centre(&self) -> DVec3 {
-        let finite = self.world.iter().filter(|p| p.is_finite());
-        let (lo, hi) = finite.fold((DVec3::INFINITY, DVec3::NEG_INFINITY), |(lo, hi), p| {
-            (lo.min(*p), hi.max(*p))
-        });
+        let empty = || (DVec3::INFINITY, DVec3::NEG_INFINITY);
+        let (lo, hi) = self
+            .world
+            .par_iter()
+            .with_min_len(ELEMENT_CHUNK)
+            .filter(|p| p.is_finite())
+            .fold(empty, |(lo, hi), p| (lo.min(*p), hi.max(*p)))
+            .reduce(empty, |(lo, hi), (l, h)| (lo.min(l), hi.max(h)));
         if lo.cmple(hi).all() {
             (lo + hi) * 0.5
         } else {
@@ -237,11 +258,14 @@ impl Obj {
     }
 
     /// Move the positions into the frame whose origin is the world point `origin`:
-    /// each becomes `world − origin`, computed in double precision.
+    /// each becomes `world − origin`, computed in double precision (in parallel on the
+    /// current thread pool).
     pub fn recentre(&mut self, origin: DVec3) {
-        for (p, w) in self.positions.iter_mut().zip(&self.world) {
-            *p = (*w - origin).as_vec3();
-        }
+        self.positions
+            .par_iter_mut()
+            .zip(self.world.par_iter())
+            .with_min_len(ELEMENT_CHUNK)
+            .for_each(|(p, w)| *p = (*w - origin).as_vec3());
     }
 }
 
@@ -253,9 +277,19 @@ pub(super) fn corners_of<'a>(lists: &'a [Vec<Corner>], face: &Face) -> &'a [Corn
 }
 
 /// Parse a stretch of OBJ text (lines split as [`str::lines`] does) that starts at
-/// `start`, telling `progress` of its bytes as they are read.
-pub(super) fn parse(text: &str, start: Start, progress: &LoadProgress<'_>) -> Part {
-    let mut p = Parser::default();
+/// `start`, its elements and faces into `sink`, telling `progress` of its bytes as
+/// they are read.
+pub(super) fn parse(
+    text: &str,
+    start: Start,
+    sink: impl Sink,
+    progress: &LoadProgress<'_>,
+) -> Part {
+    let mut p = Parser {
+        part: Part::default(),
+        sink,
+        index: start.part,
+    };
     p.part.obj.counts = start.counts;
     // Bytes read since `progress` was last advanced, and before.
     let (mut read, mut told) = (0, 0);
@@ -271,7 +305,16 @@ pub(super) fn parse(text: &str, start: Start, progress: &LoadProgress<'_>) -> Pa
         }
     }
     progress.advance(text.len().saturating_sub(told) as u64);
+    if !p.sink.filled() {
+        p.part.error = Some(miscounted());
+    }
     p.part
+}
+
+/// The error when a stretch reads more or fewer elements or faces than the count pass
+/// found (which cannot be: both go by the same keywords).
+fn miscounted() -> Located {
+    Located::whole_file("internal error: a stretch of the file was miscounted".into())
 }
 
 /// The lines of a stretch and the elements they define, as far as their keywords
@@ -284,6 +327,7 @@ pub(super) fn count(text: &str) -> Start {
             Some("v") => n.counts.v += 1,
             Some("vt") => n.counts.vt += 1,
             Some("vn") => n.counts.vn += 1,
+            Some("f" | "l") => n.faces += 1,
             _ => {}
         }
     }
@@ -313,7 +357,7 @@ fn offset(line: &str, word: &str) -> usize {
     (word.as_ptr() as usize).saturating_sub(line.as_ptr() as usize)
 }
 
-impl Parser {
+impl<S: Sink> Parser<S> {
     fn statement(&mut self, ln: usize, line: &str) -> Result<(), Located> {
         let Some(kw) = keyword(line) else {
             return Ok(());
@@ -338,10 +382,7 @@ impl Parser {
                     None | Some("off") | Some("0") => 0,
                     Some(w) => w.parse::<u32>().unwrap_or(u32::MAX).max(1),
                 };
-                self.part
-                    .obj
-                    .smoothing
-                    .push((self.part.obj.faces.len(), group));
+                self.part.obj.smoothing.push((self.part.faces, group));
             }
             "g" | "o" => self.cut(ln, None),
             _ => {}
@@ -352,7 +393,7 @@ impl Parser {
     /// A statement that may end a run of faces.
     fn cut(&mut self, ln: usize, usemtl: Option<usize>) {
         self.part.obj.cuts.push(Cut {
-            first_face: self.part.obj.faces.len(),
+            first_face: self.part.faces,
             line: ln,
             counts: self.part.obj.counts,
             usemtl,
@@ -380,8 +421,10 @@ impl Parser {
             col: col_of(line, kw),
         });
         let read = self.numbers(Element::Vertex, ln, line, w);
-        self.part.obj.positions.push(Vec3::from(read.values));
-        self.part.obj.world.push(DVec3::from(read.exact));
+        let (p, world) = (Vec3::from(read.values), DVec3::from(read.exact));
+        if !self.sink.vertex(&mut self.part.obj, p, world) {
+            return Err(miscounted());
+        }
         self.part.obj.counts.v += 1;
         self.part.obj.counts.colours += read.colours;
         Ok(())
@@ -403,12 +446,16 @@ impl Parser {
             ));
         }
         let [a, b, c] = self.numbers(kind, ln, line, w).values;
-        if kind == Element::Texture {
-            self.part.obj.texcoords.push(Vec2::new(a, b));
-            self.part.obj.counts.vt += 1;
+        let obj = &mut self.part.obj;
+        let room = if kind == Element::Texture {
+            obj.counts.vt += 1;
+            self.sink.texcoord(obj, Vec2::new(a, b))
         } else {
-            self.part.obj.normals.push(Vec3::new(a, b, c));
-            self.part.obj.counts.vn += 1;
+            obj.counts.vn += 1;
+            self.sink.normal(obj, Vec3::new(a, b, c))
+        };
+        if !room {
+            return Err(miscounted());
         }
         Ok(())
     }
@@ -436,7 +483,7 @@ impl Parser {
         }
         let k = self.part.obj.usemtl.len();
         self.part.obj.usemtl.push(UseMtl {
-            first_face: self.part.obj.faces.len(),
+            first_face: self.part.faces,
             name: name.to_string(),
             line: ln,
         });
@@ -472,9 +519,9 @@ impl Parser {
                 "face without vertices".into(),
             ));
         }
-        self.part.obj.faces.push(Face {
+        let face = Face {
             line: ln,
-            part: 0,
+            part: self.index,
             first,
             arity,
             is_line,
@@ -482,7 +529,11 @@ impl Parser {
             all_texcoords: all_texcoords && !is_line,
             texcoords_defined: false,
             normals_defined: false,
-        });
+        };
+        if !self.sink.face(&mut self.part.obj, face) {
+            return Err(miscounted());
+        }
+        self.part.faces += 1;
         Ok(())
     }
 
@@ -580,6 +631,36 @@ mod tests {
 
     fn parse(text: &str) -> Result<Obj, Located> {
         super::super::stretches::parse(text, usize::MAX, &LoadProgress::silent())
+    }
+
+    #[test]
+    fn the_centre_found_in_parallel_is_the_one_found_in_a_row() {
+        // Signed zeros tie: `min` and `max` keep the later of equal operands, which
+        // joins in order. Infinite and NaN positions are left out.
+        let world: Vec<DVec3> = (0..5 * ELEMENT_CHUNK + 17)
+            .map(|k| match k % 7 {
+                0 => DVec3::new(-0.0, 0.0, -0.0),
+                1 => DVec3::new(0.0, -0.0, 0.0),
+                2 if k % 3 == 0 => DVec3::new(f64::INFINITY, 1.0, f64::NAN),
+                _ => DVec3::new(0.0, (k % 11) as f64, -((k % 5) as f64)),
+            })
+            .collect();
+        let obj = Obj {
+            world,
+            ..Obj::default()
+        };
+        let finite = obj.world.iter().filter(|p| p.is_finite());
+        let (lo, hi) = finite.fold((DVec3::INFINITY, DVec3::NEG_INFINITY), |(lo, hi), p| {
+            (lo.min(*p), hi.max(*p))
+        });
+        let bits = |v: DVec3| v.to_array().map(f64::to_bits);
+        let pool = rayon::ThreadPoolBuilder::new()
+            .num_threads(3)
+            .build()
+            .unwrap();
+        let centre = pool.install(|| obj.centre());
+        assert_eq!(bits(centre), bits((lo + hi) * 0.5));
+        assert_eq!(centre, DVec3::new(0.0, 5.0, -2.0));
     }
 
     #[test]

@@ -13,10 +13,15 @@
 //! Then the elements that faces use must be in range: every position (within
 //! ±[`range::MAX_COORDINATE`]) and every normal used (finite), where a run with normals
 //! whose first vertex has no normal index uses the file's first normal.
+//!
+//! The faces of a long run, and the elements of all faces, are checked in parallel on
+//! the current thread pool, in chunks of a given number of faces; the problem reported
+//! is the first in file order, as checking the faces in a row finds.
 
 use super::located::Located;
 use super::parse::{Corner, Counts, Face, NONE, Obj, corners_of};
 use crate::scene::range;
+use rayon::prelude::*;
 use std::collections::HashMap;
 use std::ops::Range;
 
@@ -42,16 +47,21 @@ impl OutOfBounds {
 
 /// Check the runs of `obj` and mark which faces' texture coordinates and normals are
 /// defined. `materials` are the names the libraries define, in the order read, each
-/// with the line of the `mtllib` that read it.
+/// with the line of the `mtllib` that read it. The faces are checked in parallel in
+/// chunks of `chunk` faces or more.
 ///
 /// # Errors
 /// The file's first bad number if it has one and some run or element fails; else
 /// [`Obj::colour_mismatch`] for a missing vertex colour, or a message for the whole
 /// file.
-pub(super) fn check(obj: &mut Obj, materials: &[(usize, &str)]) -> Result<(), Located> {
+pub(super) fn check(
+    obj: &mut Obj,
+    materials: &[(usize, &str)],
+    chunk: usize,
+) -> Result<(), Located> {
     let mut normal0_used = false;
     for (run, counts) in runs(obj, materials) {
-        if let Err(e) = end_run(obj, run, counts, &mut normal0_used) {
+        if let Err(e) = end_run(obj, run, counts, chunk, &mut normal0_used) {
             return Err(obj
                 .first_bad_number
                 .take()
@@ -61,7 +71,7 @@ pub(super) fn check(obj: &mut Obj, materials: &[(usize, &str)]) -> Result<(), Lo
                 }));
         }
     }
-    if !elements_in_range(obj, normal0_used) {
+    if !elements_in_range(obj, normal0_used, chunk) {
         return Err(obj
             .first_bad_number
             .take()
@@ -105,27 +115,34 @@ fn runs(obj: &Obj, materials: &[(usize, &str)]) -> Vec<(Range<usize>, Counts)> {
 }
 
 /// Check the indices of a run against the elements defined at its end, and mark its
-/// faces' texture coordinates and normals as defined or not.
+/// faces' texture coordinates and normals as defined or not; in parallel, in chunks
+/// of `chunk` faces or more.
 fn end_run(
     obj: &mut Obj,
     run: Range<usize>,
     counts: Counts,
+    chunk: usize,
     normal0_used: &mut bool,
 ) -> Result<(), OutOfBounds> {
-    let faces = obj.faces.get_mut(run).unwrap_or_default();
-    let mut first_corner = true;
-    for face in faces.iter_mut() {
-        for c in corners_of(&obj.corners, face) {
-            check_corner(c, &counts)?;
-            if first_corner && counts.vn > 0 && c.vn == NONE {
-                *normal0_used = true;
-            }
-            first_corner = false;
+    let Obj { faces, corners, .. } = obj;
+    let faces = faces.get_mut(run).unwrap_or_default();
+    let first = faces.iter().find_map(|f| corners_of(corners, f).first());
+    if let Some(c) = first {
+        check_corner(c, &counts)?;
+        if counts.vn > 0 && c.vn == NONE {
+            *normal0_used = true;
         }
-        face.texcoords_defined = counts.vt > 0;
-        face.normals_defined = counts.vn > 0;
     }
-    Ok(())
+    let problem = faces
+        .par_iter_mut()
+        .with_min_len(chunk.max(1))
+        .find_map_first(|face| {
+            face.texcoords_defined = counts.vt > 0;
+            face.normals_defined = counts.vn > 0;
+            let corners = corners_of(corners, face);
+            corners.iter().find_map(|c| check_corner(c, &counts).err())
+        });
+    problem.map_or(Ok(()), Err)
 }
 
 /// Check one vertex's indices against the elements defined.
@@ -145,8 +162,9 @@ fn check_corner(c: &Corner, counts: &Counts) -> Result<(), OutOfBounds> {
     Ok(())
 }
 
-/// Whether every position and normal that faces use is in range.
-fn elements_in_range(obj: &Obj, normal0_used: bool) -> bool {
+/// Whether every position and normal that faces use is in range (the faces checked in
+/// parallel, in chunks of `chunk` faces or more).
+fn elements_in_range(obj: &Obj, normal0_used: bool, chunk: usize) -> bool {
     let usable_position = |i: usize| {
         obj.world.get(i).is_some_and(|p| {
             p.to_array()
@@ -158,11 +176,14 @@ fn elements_in_range(obj: &Obj, normal0_used: bool) -> bool {
     if normal0_used && !usable_normal(0) {
         return false;
     }
-    obj.faces.iter().all(|f: &Face| {
-        obj.corners_of(f).iter().all(|c| {
-            usable_position(c.v) && (!f.normals_defined || c.vn == NONE || usable_normal(c.vn))
+    obj.faces
+        .par_iter()
+        .with_min_len(chunk.max(1))
+        .all(|f: &Face| {
+            obj.corners_of(f).iter().all(|c| {
+                usable_position(c.v) && (!f.normals_defined || c.vn == NONE || usable_normal(c.vn))
+            })
         })
-    })
 }
 
 #[cfg(test)]
@@ -172,7 +193,7 @@ mod tests {
 
     fn checked(src: &str, materials: &[(usize, &str)]) -> Result<Obj, Located> {
         let mut obj = parse(src, usize::MAX, &crate::load::LoadProgress::silent()).unwrap();
-        check(&mut obj, materials).map(|()| obj)
+        check(&mut obj, materials, 1).map(|()| obj)
     }
 
     #[test]
@@ -191,6 +212,37 @@ mod tests {
         // A bad number anywhere is the error.
         let e = checked(&format!("f 1 2 3\ng\nv 0 0 nan\n{tri}"), &[]).unwrap_err();
         assert_eq!(e.line, 3);
+    }
+
+    #[test]
+    fn the_first_problem_in_file_order_is_reported_whatever_the_chunks() {
+        // Face 40 names a vertex, face 70 a texture coordinate, defined after their
+        // run ends: checked in chunks of any size, the vertex comes first.
+        let mut src = String::from("v 0 0 0\nv 1 0 0\nv 0 1 0\nvt 0 0\n");
+        for k in 0..100 {
+            src.push_str(match k {
+                40 => "f 1 2 4\n",
+                70 => "f 1/2 2/1 3/1\n",
+                _ => "f 1 2 3\n",
+            });
+        }
+        src.push_str("g\nv 1 1 1\nvt 1 1\n");
+        let pool = rayon::ThreadPoolBuilder::new()
+            .num_threads(3)
+            .build()
+            .unwrap();
+        let first = |src: &str, chunk| {
+            let mut obj = parse(src, usize::MAX, &crate::load::LoadProgress::silent()).unwrap();
+            pool.install(|| check(&mut obj, &[], chunk))
+                .unwrap_err()
+                .message
+        };
+        for chunk in [1, 7, usize::MAX] {
+            let e = first(&src, chunk);
+            assert!(e.contains("vertex index out"), "{chunk}: {e}");
+            let e = first(&src.replace("f 1 2 4\n", "f 1 2 3\n"), chunk);
+            assert!(e.contains("texcoord index out"), "{chunk}: {e}");
+        }
     }
 
     #[test]

@@ -1,6 +1,7 @@
 //! Smoothing groups (`s 1`, `s 2`, ...; `s off` and `s 0` end one): the normals of
 //! faces without `vn` in a group, averaged over the group's faces around each position.
 
+use super::in_force::InForce;
 use super::parse::{Face, Obj};
 use crate::math::Vec3;
 use std::collections::HashMap;
@@ -13,31 +14,19 @@ pub(super) fn key(p: Vec3, group: u32) -> GroupKey {
     (p.to_array().map(f32::to_bits), group)
 }
 
-/// The smoothing group of each face, in file order (0: none).
-pub(super) fn face_groups(obj: &Obj) -> Vec<u32> {
-    let mut groups = Vec::with_capacity(obj.faces.len());
-    let mut next = obj.smoothing.iter().peekable();
-    let mut group = 0;
-    for k in 0..obj.faces.len() {
-        while let Some(&(_, g)) = next.next_if(|(first, _)| *first <= k) {
-            group = g;
-        }
-        groups.push(group);
-    }
-    groups
-}
-
 /// For faces without `vn` in a smoothing group: the sum of the area-weighted normals
 /// of the group's faces around each position (keyed by the position's bits, so groups
-/// join across `g`/`o` boundaries, and the group number). `groups` are the faces'
-/// groups ([`face_groups`]).
-pub(super) fn group_normals(obj: &Obj, groups: &[u32]) -> HashMap<GroupKey, Vec3> {
+/// join across `g`/`o` boundaries, and the group number). The sums are made in face
+/// order, on one thread: they are the same whoever uses them.
+pub(super) fn group_normals(obj: &Obj) -> HashMap<GroupKey, Vec3> {
     let mut sums: HashMap<GroupKey, Vec3> = HashMap::new();
     if obj.smoothing.iter().all(|&(_, g)| g == 0) {
         return sums;
     }
     let mut pts = Vec::new();
-    for (face, &group) in obj.faces.iter().zip(groups) {
+    let mut groups = InForce::from(&obj.smoothing, 0, 0);
+    for (k, face) in obj.faces.iter().enumerate() {
+        let group = groups.at(k);
         if group == 0 || face.is_line || face.all_normals || face.arity < 3 {
             continue;
         }
@@ -92,9 +81,7 @@ mod tests {
     fn groups_sum_area_weighted_normals_at_shared_positions() {
         let src = "v 0 0 0\nv 1 0 0\nv 0 1 0\nv 0 0 1\ns 1\nf 1 2 3\nf 1 4 2\ns off\nf 1 3 4\n";
         let obj = parse(src, usize::MAX, &crate::load::LoadProgress::silent()).unwrap();
-        let groups = face_groups(&obj);
-        assert_eq!(groups, [1, 1, 0]);
-        let sums = group_normals(&obj, &groups);
+        let sums = group_normals(&obj);
         // The origin is in both faces of group 1: +z (area 1) and +y (area 1).
         let n = sums[&key(Vec3::ZERO, 1)];
         assert_eq!(n, Vec3::new(0.0, 1.0, 1.0));

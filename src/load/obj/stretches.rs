@@ -6,12 +6,15 @@
 //! stretch where it starts. A second parallel pass parses the stretches
 //! ([`parse::parse`]), a batch at a time, and [`Joined`] joins them in file order,
 //! each batch while the next is parsed, so that the join, which copies the stretches'
-//! lists into the file's on one thread, does not leave the other threads idle. A
-//! small file is one stretch, parsed without the count.
+//! lists into the file's (with the other threads' help, see [`super::append`]), does
+//! not leave the other threads idle. A small file is one stretch, parsed without the
+//! count.
 
 use super::join::Joined;
 use super::located::Located;
 use super::parse::{self, Obj, Part, Start};
+use super::sink::{Lists, Slices};
+use super::sized::Sized;
 use crate::load::LoadProgress;
 use rayon::prelude::*;
 
@@ -26,15 +29,39 @@ pub(super) fn parse(
     progress: &LoadProgress<'_>,
 ) -> Result<Obj, Located> {
     let pieces = cut(text, stretch);
-    let starts = starts(&pieces);
+    if pieces.len() <= 1 {
+        // One stretch, into lists of its own, without the count.
+        let mut joined = Joined::default();
+        for piece in pieces {
+            joined.add(parse::parse(piece, Start::default(), Lists, progress))?;
+        }
+        return joined.finish();
+    }
+    let (starts, total) = starts(&pieces);
+    let mut lists = Sized::new(&total);
+    let mut obj = parse_into(&pieces, &starts, lists.slices(&starts), progress)?;
+    lists.into_obj(&mut obj);
+    Ok(obj)
+}
+
+/// Parse the stretches `pieces`, which start at `starts`, into their `slices` of the
+/// file's lists, a batch at a time, each batch joined while the next is parsed.
+fn parse_into(
+    pieces: &[&str],
+    starts: &[Start],
+    slices: Vec<Slices<'_>>,
+    progress: &LoadProgress<'_>,
+) -> Result<Obj, Located> {
     let batch = rayon::current_num_threads().max(1) * 4;
+    let mut slices = slices.into_iter();
     let mut joined = Joined::default();
     let mut pending = Vec::new();
     for (pieces, starts) in pieces.chunks(batch).zip(starts.chunks(batch)) {
+        let into: Vec<Slices> = slices.by_ref().take(pieces.len()).collect();
         let earlier = std::mem::take(&mut pending);
         let (added, parsed) = rayon::join(
             || add(&mut joined, earlier),
-            || parse_batch(pieces, starts, progress),
+            || parse_batch(pieces, starts, into, progress),
         );
         added?;
         pending = parsed;
@@ -43,12 +70,18 @@ pub(super) fn parse(
     joined.finish()
 }
 
-/// Parse a batch of stretches in parallel, in order.
-fn parse_batch(pieces: &[&str], starts: &[Start], progress: &LoadProgress<'_>) -> Vec<Part> {
+/// Parse a batch of stretches in parallel, in order, each into its slices.
+fn parse_batch(
+    pieces: &[&str],
+    starts: &[Start],
+    into: Vec<Slices<'_>>,
+    progress: &LoadProgress<'_>,
+) -> Vec<Part> {
     pieces
         .par_iter()
         .zip(starts)
-        .map(|(piece, &start)| parse::parse(piece, start, progress))
+        .zip(into)
+        .map(|((piece, &start), sink)| parse::parse(piece, start, sink, progress))
         .collect()
 }
 
@@ -57,23 +90,21 @@ fn add(joined: &mut Joined, parts: Vec<Part>) -> Result<(), Located> {
     parts.into_iter().try_for_each(|part| joined.add(part))
 }
 
-/// Where each stretch starts: the lines and elements of the stretches before it.
-fn starts(pieces: &[&str]) -> Vec<Start> {
-    let Some((_, earlier)) = pieces.split_last() else {
-        return Vec::new();
-    };
-    let counts: Vec<Start> = earlier.par_iter().map(|p| parse::count(p)).collect();
+/// Where each stretch starts: the lines, elements and faces of the stretches before
+/// it, and its place; and what the whole file has.
+fn starts(pieces: &[&str]) -> (Vec<Start>, Start) {
+    let counts: Vec<Start> = pieces.par_iter().map(|p| parse::count(p)).collect();
     let mut at = Start::default();
     let mut out = Vec::with_capacity(pieces.len());
-    out.push(at);
-    for n in counts {
+    for (part, n) in counts.into_iter().enumerate() {
+        out.push(Start { part, ..at });
         at.line += n.line;
         at.counts.v += n.counts.v;
         at.counts.vt += n.counts.vt;
         at.counts.vn += n.counts.vn;
-        out.push(at);
+        at.faces += n.faces;
     }
-    out
+    (out, at)
 }
 
 /// `text` cut into stretches of about `size` bytes, each but the last ending with a
@@ -117,19 +148,29 @@ mod tests {
         }
         assert_eq!(cut(text, 1).len(), 6);
         assert!(cut("", 1).is_empty());
-        let starts = starts(&cut(text, 1));
-        let at = |s: &Start| (s.line, s.counts.v, s.counts.vt, s.counts.vn);
+        let (starts, total) = starts(&cut(text, 1));
+        let at = |s: &Start| {
+            (
+                s.line,
+                s.counts.v,
+                s.counts.vt,
+                s.counts.vn,
+                s.faces,
+                s.part,
+            )
+        };
         let got: Vec<_> = starts.iter().map(at).collect();
         assert_eq!(
             got,
             [
-                (0, 0, 0, 0),
-                (1, 1, 0, 0),
-                (2, 1, 1, 0),
-                (3, 1, 1, 0),
-                (4, 1, 1, 0),
-                (5, 1, 1, 0)
+                (0, 0, 0, 0, 0, 0),
+                (1, 1, 0, 0, 0, 1),
+                (2, 1, 1, 0, 0, 2),
+                (3, 1, 1, 0, 0, 3),
+                (4, 1, 1, 0, 1, 4),
+                (5, 1, 1, 0, 1, 5)
             ]
         );
+        assert_eq!(at(&total), (6, 1, 1, 1, 1, 0));
     }
 }
