@@ -155,8 +155,9 @@ pub struct BackendOptions {
     /// Embree's `RTC_SCENE_FLAG_COMPACT` on every scene it commits; `None` chooses by
     /// the scene's size ([`embree_compact_for`]).
     pub embree_compact: Option<bool>,
-    /// Analytic primitives per Embree user primitive (1: one each); a group's members
-    /// are neighbours in space and its callbacks test each, so the hits are the same.
+    /// Analytic primitives per Embree user primitive, at most (1: one each); a group's
+    /// members are neighbours in space and its callbacks test each, so the hits are
+    /// the same.
     /// `None` chooses by the scene's size and the render's camera rays
     /// ([`embree_group_for`]).
     pub embree_group: Option<u32>,
@@ -212,25 +213,27 @@ pub fn embree_compact_for(prims: usize) -> bool {
     prims >= EMBREE_COMPACT_FROM
 }
 
-/// Analytic primitives per Embree user primitive when grouping pays.
+/// Analytic primitives per Embree user primitive, at most, when grouping pays.
 pub const EMBREE_GROUP_LARGE: u32 = 4;
 
 /// Primitives per camera ray from which grouping pays (see [`embree_group_for`]).
-pub const EMBREE_GROUP_PRIMS_PER_RAY: u64 = 16;
+pub const EMBREE_GROUP_PRIMS_PER_RAY: u64 = 4;
 
-/// How many analytic primitives one Embree user primitive stands for, when not told,
-/// in a scene of `prims` primitives rendered with `camera_rays` camera rays (0: not
-/// known): [`EMBREE_GROUP_LARGE`] from [`EMBREE_COMPACT_FROM`] primitives on when there
-/// are at least [`EMBREE_GROUP_PRIMS_PER_RAY`] per camera ray, one otherwise.
+/// How many analytic primitives one Embree user primitive stands for at most, when not
+/// told, in a scene of `prims` primitives rendered with `camera_rays` camera rays (0:
+/// not known): [`EMBREE_GROUP_LARGE`] from [`EMBREE_COMPACT_FROM`] primitives on when
+/// there are at least [`EMBREE_GROUP_PRIMS_PER_RAY`] per camera ray, one otherwise.
 ///
 /// Groups trade render time for build time and memory. Measured on balls at 5.4 M
-/// spheres, 512² `--spd`, 2 threads: groups of 4 build in 1.0 s instead of 3.4 s and
-/// peak at 0.42 GB instead of 0.72 GB, but the render takes 1.9 s instead of 0.6 s: a
-/// group's box is larger than its members', so more rays reach it (8 times as many
-/// intersect calls), and each tests four primitives. The build's saving (0.43 µs per
-/// primitive) equals the render's loss (5 µs per camera ray) at about 12 primitives per
-/// camera ray; the rule keeps a margin, and leaves scenes whose render is not known
-/// (a library's own builds) ungrouped.
+/// spheres, 512² `--spd`, 2 threads, with the machine otherwise idle: groups of at
+/// most 4 (3.0 on average there: a group ends where its box would grow much larger
+/// than its members') build in 1.4–1.6 s instead of 3.1 s and peak at 0.48–0.53 GB
+/// instead of 0.74 GB, and the render takes 0.40–0.43 s instead of 0.27 s: a group's
+/// box is larger than its members', so more rays reach it, and each tests its
+/// members. The build's saving (about 0.28 µs per primitive) equals the render's loss
+/// (about 0.6 µs per camera ray) at about 2 primitives per camera ray; the rule keeps
+/// a margin, and leaves scenes whose render is not known (a library's own builds)
+/// ungrouped.
 pub fn embree_group_for(prims: usize, camera_rays: u64) -> u32 {
     let prims_per_ray = (prims as u64).checked_div(camera_rays).unwrap_or(0);
     if prims >= EMBREE_COMPACT_FROM && prims_per_ray >= EMBREE_GROUP_PRIMS_PER_RAY {

@@ -311,10 +311,10 @@ pub struct RenderOptions {
     )]
     #[serde(skip_serializing_if = "Option::is_none")]
     pub embree_compact: Option<bool>,
-    /// Analytic primitives (spheres, cones, ...) per Embree user primitive, grouped
-    /// with their neighbours in space; the same hits, less memory and a faster build,
-    /// a somewhat slower render; 1 to 64 [default: 4 from 4 Mi (4 194 304) primitives,
-    /// 1 below].
+    /// Analytic primitives (spheres, cones, ...) per Embree user primitive, at most,
+    /// grouped with their neighbours in space; the same hits, less memory and a faster
+    /// build, a somewhat slower render; 1 to 64 [default: 4 from 4 Mi (4 194 304)
+    /// primitives with at least 4 per camera ray, 1 otherwise].
     #[cfg_attr(feature = "cli", arg(long, value_name = "N", help_heading = "Backend"))]
     #[serde(skip_serializing_if = "Option::is_none")]
     pub embree_group: Option<u32>,

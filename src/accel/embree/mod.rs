@@ -114,7 +114,7 @@ impl<'s> EmbreeAccel<'s> {
             quality.name(),
             if compact { ", compact" } else { "" },
             if group > 1 {
-                format!(", analytic primitives in groups of {group}")
+                format!(", analytic primitives in groups of at most {group}")
             } else {
                 String::new()
             },

@@ -218,7 +218,7 @@ impl<'s> KindVisitor<'s> for AttachUser<'_, 's> {
             let start = std::time::Instant::now();
             let order = morton_order(items, ids);
             log::info!(
-                "ordered {held} {} in groups of {} in {:.0?}",
+                "ordered {held} {} for groups of at most {} in {:.0?}",
                 P::KIND.name(),
                 self.group,
                 start.elapsed()
@@ -837,8 +837,8 @@ fn attach_triangles(
 }
 
 /// One user geometry holding the primitives `ids` of the scene's list `items` of kind
-/// `T::KIND` (all of them for `None`; no geometry when that is none), `group` of them
-/// per Embree primitive (consecutive ids; see `group`). Returns the boxed
+/// `T::KIND` (all of them for `None`; no geometry when that is none), in runs of at
+/// most `group` consecutive ids per Embree primitive (see `group`). Returns the boxed
 /// user data Embree's callbacks read, which must outlive `scene`'s handle.
 fn attach_user<'s, T: Analytic>(
     device: &Device,
@@ -859,6 +859,14 @@ fn attach_user<'s, T: Analytic>(
         ));
     }
     let data = Box::new(UserPrims::grouped(items, ids, group));
+    if group > 1 {
+        log::info!(
+            "{} {} in {} groups of at most {group}",
+            len,
+            kind.name(),
+            data.embree_count()
+        );
+    }
     let count = u32::try_from(data.embree_count()).unwrap_or(u32::MAX);
     let geometry = Geometry::new(
         device,

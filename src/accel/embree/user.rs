@@ -55,9 +55,10 @@ pub(super) struct UserPrims<'s, T> {
     /// holds only some of the items (not the unbounded ones) or holds them in another
     /// order (in groups); `None`: Embree's primitive `k` is item `k`.
     ids: Option<Box<[u32]>>,
-    /// Items per Embree primitive: Embree's primitive `k` stands for
-    /// `ids[k·group .. (k + 1)·group]` (fewer for the last); 1 without groups.
-    group: usize,
+    /// With groups, where each starts in `ids`: Embree's primitive `k` stands for
+    /// `ids[starts[k] .. starts[k + 1]]` (the last entry is `ids.len()`); empty without
+    /// groups (Embree's primitive `k` is then one item).
+    starts: Box<[u32]>,
     /// With groups, the items in the order of `ids`, copied so that a group's members
     /// lie together in memory (reading them through `ids` from the scene's list, where
     /// neighbours in space may lie far apart, costs a cache miss per member); empty
@@ -71,25 +72,29 @@ pub(super) struct UserPrims<'s, T> {
 }
 
 impl<'s, T> UserPrims<'s, T> {
-    /// The user data of the scene's list `items`, of which Embree holds those `ids`,
-    /// `group` consecutive ids per Embree primitive (`group` ≥ 1; with `None`, all
-    /// items in order).
+    /// The user data of the scene's list `items`, of which Embree holds those `ids`
+    /// (all items in order for `None`), one item per Embree primitive or, with `ids`
+    /// in Morton order and `group` > 1, in runs of at most `group` neighbours
+    /// ([`group::cut_runs`](super::group::cut_runs)).
     pub(super) fn grouped(items: &'s [T], ids: Option<Box<[u32]>>, group: usize) -> Self
     where
-        T: Clone + Send + Sync,
+        T: Analytic + Clone + Send + Sync,
     {
-        let group = group.max(1);
-        let grouped = match &ids {
-            Some(ids) if group > 1 => ids
-                .par_iter()
-                .filter_map(|&id| items.get(id as usize).cloned())
-                .collect(),
-            _ => Box::default(),
+        let (grouped, starts): (Box<[T]>, Box<[u32]>) = match &ids {
+            Some(ids) if group > 1 => {
+                let copies = ids
+                    .par_iter()
+                    .filter_map(|&id| items.get(id as usize).cloned());
+                let grouped: Box<[T]> = copies.collect();
+                let starts = super::group::cut_runs(&grouped, group);
+                (grouped, starts)
+            }
+            _ => (Box::default(), Box::default()),
         };
         UserPrims {
             items,
             ids,
-            group,
+            starts,
             grouped,
             bounds_panic: OnceLock::new(),
             #[cfg(test)]
@@ -99,8 +104,10 @@ impl<'s, T> UserPrims<'s, T> {
 
     /// The number of Embree primitives: one per group of ids.
     pub(super) fn embree_count(&self) -> usize {
-        let len = self.ids.as_ref().map_or(self.items.len(), |ids| ids.len());
-        len.div_ceil(self.group)
+        if !self.starts.is_empty() {
+            return self.starts.len() - 1;
+        }
+        self.ids.as_ref().map_or(self.items.len(), |ids| ids.len())
     }
 
     /// The item with index `index` in the scene's list, and that index (the `primID` a
@@ -117,12 +124,12 @@ impl<'s, T> UserPrims<'s, T> {
         let Some(ids) = &self.ids else {
             return self.item(prim_id).map(Members::One);
         };
-        if self.group == 1 {
+        if self.starts.is_empty() {
             let index = *ids.get(prim_id as usize)?;
             return self.item(index).map(Members::One);
         }
-        let first = (prim_id as usize).checked_mul(self.group)?;
-        let range = first..ids.len().min(first + self.group);
+        let k = prim_id as usize;
+        let range = *self.starts.get(k)? as usize..*self.starts.get(k.checked_add(1)?)? as usize;
         let (members, ids) = (self.grouped.get(range.clone())?, ids.get(range)?);
         (!members.is_empty() && members.len() == ids.len()).then_some(Members::Group(members, ids))
     }
@@ -168,7 +175,7 @@ impl<T: Analytic> UserGeometry for UserPrims<'_, T> {
             .ids
             .as_ref()
             .map_or(0, |ids| std::mem::size_of_val(&**ids));
-        ids + std::mem::size_of_val(&*self.grouped)
+        ids + std::mem::size_of_val(&*self.grouped) + std::mem::size_of_val(&*self.starts)
     }
 
     fn bounds_panic(&self) -> Option<String> {
