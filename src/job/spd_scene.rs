@@ -15,13 +15,14 @@
 //! material in effect on its line; one before the first viewpoint fails the build at
 //! once (the frame it would be made in, the eye's, is not known yet). Nothing else
 //! changes how they are made: later viewpoints keep the first's frame, and lights go
-//! to a list of their own.
+//! to a list of their own. A fill with the numbers of one of the last few made (and
+//! no warning) adds that material again without making it.
 
 use super::spd_prims::{Prim, PrimBatch, scene_point};
 use crate::load::nff::{MAX_PIXELS, MAX_RESOLUTION_SIDE, Merger, Note, Part, fill, up_is_usable};
 use crate::load::{LoadError, LoadProgress};
 use crate::math::{DVec3, Vec3};
-use crate::scene::{Camera, Light, Scene, range};
+use crate::scene::{Camera, Light, Material, Scene, range};
 use crate::spd::{Database, NffSink, g_f32, g_f64};
 use glam::DVec3 as D;
 use std::path::Path;
@@ -52,6 +53,9 @@ pub(crate) fn scene(
     }
 }
 
+/// The most fills [`SceneBuilder`] remembers.
+const FILLS: usize = 8;
+
 /// How many primitives are made between two advances of the load's progress.
 const PROGRESS_CHUNK: u64 = 1 << 14;
 
@@ -74,6 +78,12 @@ struct SceneBuilder<'p, 'w> {
     failed: bool,
     /// Spheres and cones not yet made.
     prims: PrimBatch,
+    /// The last fills made without a warning, by their numbers as the database gave
+    /// them: a database that writes the same few fills again and again (`lattice`,
+    /// one before each primitive) does not make them again.
+    fills: Vec<([u64; 8], Material)>,
+    /// Where the next fill goes in `fills` once it is full.
+    next_fill: usize,
 }
 
 impl<'p, 'w> SceneBuilder<'p, 'w> {
@@ -93,6 +103,8 @@ impl<'p, 'w> SceneBuilder<'p, 'w> {
             line: 1,
             failed: false,
             prims: PrimBatch::new(batch),
+            fills: Vec::new(),
+            next_fill: 0,
         }
     }
 
@@ -227,12 +239,26 @@ impl NffSink for SceneBuilder<'_, '_> {
 
     fn fill(&mut self, rgb: D, kd: f64, ks: f64, shine: f64, t: f64, ior: f64) {
         let line = self.entity(1);
+        let key = [rgb.x, rgb.y, rgb.z, kd, ks, shine, t, ior].map(f64::to_bits);
+        if let Some(&(_, material)) = self.fills.iter().find(|(k, _)| *k == key) {
+            self.part.add_material(material, line);
+            return;
+        }
         let color = self.vec3(rgb);
         self.warn_above_one(line, "fill", color);
         let [kd, ks, shine, t, ior] = [kd, ks, shine, t, ior].map(|x| self.num(x));
         self.check(shine >= 0.0 && range::check_ior(t, ior).is_ok());
-        self.part
-            .add_material(fill(color, kd, ks, shine, t, ior), line);
+        let material = fill(color, kd, ks, shine, t, ior);
+        self.part.add_material(material, line);
+        // A fill that warned warns again; one that failed the build ends it.
+        if !self.failed && color.max_element() <= 1.0 {
+            if self.fills.len() < FILLS {
+                self.fills.push((key, material));
+            } else {
+                self.fills[self.next_fill] = (key, material);
+                self.next_fill = (self.next_fill + 1) % FILLS;
+            }
+        }
     }
 
     fn sphere(&mut self, center: D, radius: f64) {
@@ -462,6 +488,37 @@ mod tests {
         let (built, read) = (built.expect("built").unwrap(), read.unwrap());
         assert_eq!(built, read);
         assert_eq!(built.materials.len(), 1, "the default, for the triangle");
+    }
+
+    /// Fills written again and again, more kinds than are remembered, one with a
+    /// colour above 1: the materials and warnings the text gives.
+    #[test]
+    fn repeated_fills_make_the_materials_of_their_text() {
+        let emit = |w: &mut dyn NffSink| {
+            w.viewpoint(D::Z * 5.0, D::ZERO, D::Y, 45.0, 0.0, (8, 8));
+            for round in 0..3 {
+                for k in 0..FILLS + 3 {
+                    let color = D::new(0.1 * k as f64, 0.5, round as f64 * 0.0);
+                    w.fill(color, 0.5, 0.5, 3.0, 0.0, 1.0);
+                    w.sphere(D::X * k as f64, 0.5);
+                }
+                for _ in 0..2 {
+                    w.fill(D::splat(2.0), 0.5, 0.5, 3.0, 0.0, 1.0);
+                    w.cone(D::ZERO, 0.5, D::Y, 0.5);
+                }
+            }
+        };
+        let (built, read) = built_and_read(5, emit);
+        let (built, read) = (built.expect("built").unwrap(), read.unwrap());
+        assert_eq!(built, read);
+        assert_eq!(built.materials.len(), 3 * (FILLS + 5));
+        let materials = &built.sources.materials;
+        assert!(materials.same_origins(&read.sources.materials));
+        let mut builder = SceneBuilder::new(Path::new("x"), &SILENT);
+        emit(&mut builder);
+        let warnings = (builder.part.notes.iter())
+            .filter(|n| matches!(n, Note::Warning(w) if w.contains("channels above 1")));
+        assert_eq!(warnings.count(), 6);
     }
 
     /// A fill after queued spheres is their material's end: each sphere keeps the
