@@ -84,6 +84,9 @@ struct SceneBuilder<'p, 'w> {
     fills: Vec<([u64; 8], Material)>,
     /// Where the next fill goes in `fills` once it is full.
     next_fill: usize,
+    /// The fill of `fills` added last (a database that cycles through a few fills
+    /// adds the one after it next).
+    last_fill: usize,
 }
 
 impl<'p, 'w> SceneBuilder<'p, 'w> {
@@ -105,6 +108,7 @@ impl<'p, 'w> SceneBuilder<'p, 'w> {
             prims: PrimBatch::new(batch),
             fills: Vec::new(),
             next_fill: 0,
+            last_fill: 0,
         }
     }
 
@@ -178,6 +182,18 @@ impl<'p, 'w> SceneBuilder<'p, 'w> {
         point.unwrap_or(Vec3::ZERO)
     }
 
+    /// The material of a remembered fill whose numbers' bits are `key`, looked for
+    /// from the one after the last added on.
+    fn remembered_fill(&mut self, key: &[u64; 8]) -> Option<Material> {
+        let n = self.fills.len();
+        let same = |k: &[u64; 8]| k.iter().zip(key).fold(0, |d, (a, b)| d | (a ^ b)) == 0;
+        let k = (1..=n)
+            .map(|i| (self.last_fill + i) % n)
+            .find(|&k| same(&self.fills[k].0))?;
+        self.last_fill = k;
+        Some(self.fills[k].1)
+    }
+
     /// The loader's warning for a colour written with channels above 1 (the colour is
     /// the entity's first number, at column 3).
     fn warn_above_one(&mut self, line: u32, what: &str, c: Vec3) {
@@ -240,7 +256,7 @@ impl NffSink for SceneBuilder<'_, '_> {
     fn fill(&mut self, rgb: D, kd: f64, ks: f64, shine: f64, t: f64, ior: f64) {
         let line = self.entity(1);
         let key = [rgb.x, rgb.y, rgb.z, kd, ks, shine, t, ior].map(f64::to_bits);
-        if let Some(&(_, material)) = self.fills.iter().find(|(k, _)| *k == key) {
+        if let Some(material) = self.remembered_fill(&key) {
             self.part.add_material(material, line);
             return;
         }
@@ -253,8 +269,10 @@ impl NffSink for SceneBuilder<'_, '_> {
         // A fill that warned warns again; one that failed the build ends it.
         if !self.failed && color.max_element() <= 1.0 {
             if self.fills.len() < FILLS {
+                self.last_fill = self.fills.len();
                 self.fills.push((key, material));
             } else {
+                self.last_fill = self.next_fill;
                 self.fills[self.next_fill] = (key, material);
                 self.next_fill = (self.next_fill + 1) % FILLS;
             }
