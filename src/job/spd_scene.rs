@@ -437,7 +437,9 @@ mod tests {
         let tri = [D::ZERO, D::X, D::Y];
         let nan = D::new(f64::NAN, 0.0, 0.0);
         let far = D::new(1e30, 0.0, 0.0);
-        let refused: [(&[D], Option<&[D]>, &str); 5] = [
+        // A polygon's vertices, its normals if it is a patch, and the loader's error.
+        type Refused<'a> = (&'a [D], Option<&'a [D]>, &'a str);
+        let refused: [Refused; 5] = [
             (&[D::ZERO, nan, D::Y], None, "the polygon vertex x"),
             (
                 &[D::ZERO, D::X, far],
