@@ -1,15 +1,19 @@
-//! The spheres and cones of an SPD database as the NFF loader makes them from their
-//! printed numbers ([`sphere_of`], [`cone_of`]), and [`PrimBatch`], which gathers
-//! them in entity order and makes a batch of them at once on the current rayon pool,
-//! so that the scene builder (`super::spd_scene`) makes a large database's primitives
-//! in parallel, as the loader parses a large file.
+//! The spheres, cones and polygons of an SPD database as the NFF loader makes them
+//! from their printed numbers ([`sphere_of`], [`cone_of`], [`Piece::polygon`]), and
+//! [`PrimBatch`], which gathers them in entity order and makes a batch of them at once
+//! on the current rayon pool, so that the scene builder (`super::spd_scene`) makes a
+//! large database's primitives in parallel, as the loader parses a large file.
 //!
-//! Each primitive is made from its own numbers and the frame's origin alone, so the
-//! batch's results, added in order with the lines and materials they were queued
-//! with, are what making them one at a time would add.
+//! Each primitive is made from its own numbers and the frame's origin alone (a polygon
+//! is rounded and triangulated by the thread that makes it, with a triangulator of its
+//! own), so the batch's results, added in order with the lines and materials they were
+//! queued with, are what making them one at a time would add. A batch is cut into
+//! pieces of about equal work, a polygon counting as many as its triangles, made one
+//! piece per task.
 
-use crate::geometry::{Cone, Intersect, Kind, Sphere};
-use crate::load::nff::{Part, world_bounds};
+use crate::geometry::polygon::Triangulator;
+use crate::geometry::{Cone, Intersect, Kind, Sphere, Triangle};
+use crate::load::nff::{Part, unit_normal, world_bounds};
 use crate::math::{DVec3, Vec3};
 use crate::scene::range;
 use crate::spd::{g_f32, g_f64};
@@ -72,13 +76,20 @@ pub(crate) fn cone_of(
         .then_some(cone)
 }
 
-/// A sphere's or a cone's numbers, as the database gave them.
+/// A sphere's, a cone's or a polygon's numbers, as the database gave them.
 #[derive(Clone, Copy, Debug)]
 pub(crate) enum Prim {
     /// `s`: centre, radius.
     Sphere(D, f64),
     /// `c`: base, base radius, apex, apex radius.
     Cone(D, f64, D, f64),
+    /// `p` or `pp`: `len` vertices from `first` on in the batch's vertices, and for a
+    /// `pp` their normals from `normals` on in its normals.
+    Polygon {
+        first: usize,
+        len: usize,
+        normals: Option<usize>,
+    },
 }
 
 /// A primitive as the loader makes it.
@@ -86,20 +97,19 @@ pub(crate) enum Prim {
 enum Made {
     Sphere(Sphere),
     Cone(Cone),
-}
-
-impl Prim {
-    /// The primitive the loader makes of these numbers in the frame of `origin`.
-    fn make(&self, origin: Option<DVec3>) -> Option<Made> {
-        match *self {
-            Prim::Sphere(c, r) => sphere_of(origin, c, r).map(Made::Sphere),
-            Prim::Cone(b, rb, a, ra) => cone_of(origin, b, rb, a, ra).map(Made::Cone),
-        }
-    }
+    /// A polygon's triangles: `len` of its piece's triangles from `first` on, and for a
+    /// `pp` as many of its vertex normals from `normals` on.
+    Polygon {
+        first: usize,
+        len: usize,
+        normals: Option<usize>,
+    },
+    /// A polygon the loader drops as degenerate.
+    Degenerate,
 }
 
 /// A primitive waiting to be made: its numbers, its line and its material (the
-/// [`Part::material_index`] on its line).
+/// [`Part::material_index`] on its line, `INHERITED` before the first `f`).
 #[derive(Clone, Copy, Debug)]
 struct Queued {
     prim: Prim,
@@ -107,14 +117,144 @@ struct Queued {
     material: u32,
 }
 
+/// What one thread makes of consecutive queued primitives, and its scratch, kept from
+/// batch to batch.
+#[derive(Debug, Default)]
+struct Piece {
+    /// Per primitive: what it made, `None` if the loader would refuse it.
+    made: Vec<Option<Made>>,
+    /// The polygons' triangles, and the vertex normals of those of `pp`s.
+    tris: Vec<Triangle>,
+    normals: Vec<[Vec3; 3]>,
+    /// Scratch: a polygon's points and unit normals, and its triangles' corners.
+    pts: Vec<Vec3>,
+    nrm: Vec<Vec3>,
+    corners: Vec<[usize; 3]>,
+    triangulator: Triangulator,
+}
+
+impl Piece {
+    /// Make `queued` (whose polygons' numbers are in `verts` and `normals`) in the frame
+    /// of `origin`.
+    fn make(&mut self, queued: &[Queued], verts: &[D], normals: &[D], origin: Option<DVec3>) {
+        self.made.clear();
+        self.tris.clear();
+        self.normals.clear();
+        for q in queued {
+            let made = match q.prim {
+                Prim::Sphere(c, r) => sphere_of(origin, c, r).map(Made::Sphere),
+                Prim::Cone(b, rb, a, ra) => cone_of(origin, b, rb, a, ra).map(Made::Cone),
+                Prim::Polygon {
+                    first,
+                    len,
+                    normals: n,
+                } => {
+                    let vs = &verts[first..first + len];
+                    let ns = n.map(|n| &normals[n..n + len]);
+                    self.polygon(vs, ns, origin)
+                }
+            };
+            self.made.push(made);
+        }
+    }
+
+    /// The polygon the loader reads from `p` (or `pp`, with `normals`) with its numbers
+    /// printed, triangulated into the piece's triangles; `None` where the loader would
+    /// refuse it (a point not finite or out of range, a zero normal).
+    fn polygon(
+        &mut self,
+        verts: &[D],
+        normals: Option<&[D]>,
+        origin: Option<DVec3>,
+    ) -> Option<Made> {
+        let origin = origin?;
+        self.pts.clear();
+        self.nrm.clear();
+        for (k, &v) in verts.iter().enumerate() {
+            self.pts.push(scene_point(origin, v)?);
+            if let Some(n) = normals {
+                let n = n[k];
+                let n = Vec3::new(finite_f32(n.x)?, finite_f32(n.y)?, finite_f32(n.z)?);
+                self.nrm.push(unit_normal(n)?);
+            }
+        }
+        if self
+            .triangulator
+            .triangulate(&self.pts, &mut self.corners)
+            .is_err()
+        {
+            return Some(Made::Degenerate);
+        }
+        let first = self.tris.len();
+        let first_normal = normals.map(|_| self.normals.len());
+        let (pts, nrm) = (&self.pts, &self.nrm);
+        self.tris
+            .extend(self.corners.iter().map(|&[a, b, c]| Triangle {
+                p: [pts[a], pts[b], pts[c]],
+            }));
+        if normals.is_some() {
+            let corners = self.corners.iter();
+            self.normals
+                .extend(corners.map(|&[a, b, c]| [nrm[a], nrm[b], nrm[c]]));
+        }
+        let len = self.corners.len();
+        Some(Made::Polygon {
+            first,
+            len,
+            normals: first_normal,
+        })
+    }
+
+    /// Add what the piece made of `queued` to `part` in order, with the lines and
+    /// materials they were queued with, if the loader would have made all of them;
+    /// whether it would.
+    fn add(&self, queued: &[Queued], part: &mut Part) -> bool {
+        if !self.made.iter().all(Option::is_some) {
+            return false;
+        }
+        for (made, q) in self.made.iter().zip(queued) {
+            let (line, material) = (q.line, q.material);
+            match *made {
+                Some(Made::Sphere(s)) => part.add_analytic_with(s, Kind::Sphere, line, material),
+                Some(Made::Cone(c)) => part.add_analytic_with(c, Kind::Cone, line, material),
+                Some(Made::Polygon {
+                    first,
+                    len,
+                    normals,
+                }) => {
+                    let tris = &self.tris[first..first + len];
+                    let normals = normals.map(|n| &self.normals[n..n + len]);
+                    let added = part.add_triangulated(tris, normals, line, material);
+                    if added.is_err() {
+                        return false;
+                    }
+                }
+                Some(Made::Degenerate) => part.add_degenerate(|| (line as usize, 1)),
+                None => {}
+            }
+        }
+        true
+    }
+}
+
 /// Primitives waiting to be made, in entity order.
 #[derive(Debug)]
 pub(crate) struct PrimBatch {
     pending: Vec<Queued>,
-    /// How many wait before [`PrimBatch::push`] says the batch is full.
+    /// The queued polygons' vertices and the queued `pp`s' normals.
+    verts: Vec<D>,
+    normals: Vec<D>,
+    /// How much work waits before [`PrimBatch::push`] says the batch is full: one for
+    /// a sphere or cone, a polygon's triangles (its vertices less two) for a polygon.
     capacity: usize,
-    /// Scratch: the primitives made of `pending`.
-    made: Vec<Option<Made>>,
+    /// The work queued.
+    queued: usize,
+    /// Where the pieces made one after the other on one thread end in `pending`, and
+    /// the work queued since the last one.
+    cuts: Vec<usize>,
+    piece_work: usize,
+    /// Scratch: what each piece made.
+    pieces: Vec<Piece>,
     /// Scratch: the spheres made of a batch of them.
     spheres: Vec<Option<Sphere>>,
 }
@@ -124,13 +264,18 @@ impl PrimBatch {
     pub fn new(capacity: usize) -> Self {
         PrimBatch {
             pending: Vec::new(),
+            verts: Vec::new(),
+            normals: Vec::new(),
             capacity: capacity.max(1),
-            made: Vec::new(),
+            queued: 0,
+            cuts: Vec::new(),
+            piece_work: 0,
+            pieces: Vec::new(),
             spheres: Vec::new(),
         }
     }
 
-    /// The fewest primitives made one after the other on one thread.
+    /// The least work made one after the other on one thread.
     fn piece_len(&self) -> usize {
         self.capacity.div_ceil(PIECES)
     }
@@ -143,30 +288,76 @@ impl PrimBatch {
     /// Queue `prim` of line `line`, whose material is `material` (the part's
     /// [`Part::material_index`] on that line); true when the batch is full.
     pub fn push(&mut self, prim: Prim, line: u32, material: u32) -> bool {
+        self.queue(prim, line, material, 1)
+    }
+
+    /// Queue the polygon `verts` (a `pp` with `normals`, one per vertex) of line `line`,
+    /// whose material is `material` (the part's [`Part::material_index`] on that line,
+    /// `INHERITED` before its first `f`, even if it then inherits nothing); true when
+    /// the batch is full.
+    pub fn push_polygon(
+        &mut self,
+        verts: &[D],
+        normals: Option<&[D]>,
+        line: u32,
+        material: u32,
+    ) -> bool {
+        let prim = Prim::Polygon {
+            first: self.verts.len(),
+            len: verts.len(),
+            normals: normals.map(|_| self.normals.len()),
+        };
+        self.verts.extend_from_slice(verts);
+        if let Some(n) = normals {
+            self.normals.extend_from_slice(&n[..verts.len()]);
+        }
+        self.queue(prim, line, material, verts.len().saturating_sub(2).max(1))
+    }
+
+    fn queue(&mut self, prim: Prim, line: u32, material: u32, work: usize) -> bool {
         self.pending.push(Queued {
             prim,
             line,
             material,
         });
-        self.pending.len() >= self.capacity
+        self.queued += work;
+        self.piece_work += work;
+        if self.piece_work >= self.piece_len() {
+            self.cuts.push(self.pending.len());
+            self.piece_work = 0;
+        }
+        self.queued >= self.capacity
     }
 
     /// Make the queued primitives in the frame of `origin`, in parallel, and add them
-    /// to `part` in order. Returns false, adding none, if the loader would have refused
-    /// or warned about one of them (see [`sphere_of`]).
+    /// to `part` in order. Returns false if the loader would have refused one of them
+    /// (see [`sphere_of`], [`Piece::polygon`]): the build has failed, and what was added
+    /// is of no use.
     pub fn flush(&mut self, origin: Option<DVec3>, part: &mut Part) -> bool {
         if self.pending.is_empty() {
             return true;
         }
-        let piece = self.piece_len();
-        make_all(
-            &self.pending,
-            piece,
-            |q| q.prim.make(origin),
-            &mut self.made,
-        );
-        let all_made = add_all(&self.made, &self.pending, part);
+        if self.cuts.last() != Some(&self.pending.len()) {
+            self.cuts.push(self.pending.len());
+        }
+        let n = self.cuts.len();
+        if self.pieces.len() < n {
+            self.pieces.resize_with(n, Piece::default);
+        }
+        let (pending, cuts) = (&self.pending[..], &self.cuts[..]);
+        let (verts, normals) = (&self.verts[..], &self.normals[..]);
+        let range = |k: usize| if k == 0 { 0 } else { cuts[k - 1] }..cuts[k];
+        self.pieces[..n]
+            .par_iter_mut()
+            .enumerate()
+            .for_each(|(k, piece)| piece.make(&pending[range(k)], verts, normals, origin));
+        let all_made = (self.pieces[..n].iter().enumerate())
+            .all(|(k, piece)| piece.add(&pending[range(k)], part));
         self.pending.clear();
+        self.verts.clear();
+        self.normals.clear();
+        self.cuts.clear();
+        (self.queued, self.piece_work) = (0, 0);
         all_made
     }
 
@@ -205,20 +396,4 @@ fn make_all<T: Sync, U: Send>(
         .with_min_len(piece)
         .map(make)
         .collect_into_vec(out);
-}
-
-/// Add every primitive of `made` to `part` with the line and material it was queued
-/// with, in order, if all were made; whether they were.
-fn add_all(made: &[Option<Made>], queued: &[Queued], part: &mut Part) -> bool {
-    if !made.iter().all(Option::is_some) {
-        return false;
-    }
-    for (made, q) in made.iter().zip(queued) {
-        match made {
-            Some(Made::Sphere(s)) => part.add_analytic_with(*s, Kind::Sphere, q.line, q.material),
-            Some(Made::Cone(c)) => part.add_analytic_with(*c, Kind::Cone, q.line, q.material),
-            None => {}
-        }
-    }
-    true
 }

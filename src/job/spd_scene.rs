@@ -10,19 +10,19 @@
 //! the first viewpoint, a number out of range, a degenerate entity) marks the build
 //! as failed: the caller then writes the text and reads it.
 //!
-//! Spheres and cones wait in a batch (`super::spd_prims`), made in parallel when it is
-//! full and at the end, each with the material in effect on its line; one before the
-//! first viewpoint fails the build at once (the frame it would be made in, the eye's,
-//! is not known yet). Nothing else changes how they are made: later viewpoints keep
-//! the first's frame, and lights and polygons go to lists of their own.
+//! Spheres, cones and polygons wait in a batch (`super::spd_prims`), made in parallel
+//! (polygons rounded and triangulated) when it is full and at the end, each with the
+//! material in effect on its line; one before the first viewpoint fails the build at
+//! once (the frame it would be made in, the eye's, is not known yet). Nothing else
+//! changes how they are made: later viewpoints keep the first's frame, and lights go
+//! to a list of their own. A fill with the numbers of one of the last few made (and
+//! no warning) adds that material again without making it.
 
 use super::spd_prims::{Prim, PrimBatch, scene_point};
-use crate::load::nff::{
-    MAX_PIXELS, MAX_RESOLUTION_SIDE, Merger, Note, Part, fill, unit_normal, up_is_usable,
-};
+use crate::load::nff::{MAX_PIXELS, MAX_RESOLUTION_SIDE, Merger, Note, Part, fill, up_is_usable};
 use crate::load::{LoadError, LoadProgress};
 use crate::math::{DVec3, Vec3};
-use crate::scene::{Camera, Light, Scene, range};
+use crate::scene::{Camera, Light, Material, Scene, range};
 use crate::spd::{Database, NffSink, g_f32, g_f64};
 use glam::DVec3 as D;
 use std::path::Path;
@@ -53,6 +53,9 @@ pub(crate) fn scene(
     }
 }
 
+/// The most fills [`SceneBuilder`] remembers.
+const FILLS: usize = 8;
+
 /// How many primitives are made between two advances of the load's progress.
 const PROGRESS_CHUNK: u64 = 1 << 14;
 
@@ -75,9 +78,15 @@ struct SceneBuilder<'p, 'w> {
     failed: bool,
     /// Spheres and cones not yet made.
     prims: PrimBatch,
-    /// Scratch: a polygon's vertices and normals.
-    pts: Vec<Vec3>,
-    nrm: Vec<Vec3>,
+    /// The last fills made without a warning, by their numbers as the database gave
+    /// them: a database that writes the same few fills again and again (`lattice`,
+    /// one before each primitive) does not make them again.
+    fills: Vec<([u64; 8], Material)>,
+    /// Where the next fill goes in `fills` once it is full.
+    next_fill: usize,
+    /// The fill of `fills` added last (a database that cycles through a few fills
+    /// adds the one after it next).
+    last_fill: usize,
 }
 
 impl<'p, 'w> SceneBuilder<'p, 'w> {
@@ -97,8 +106,9 @@ impl<'p, 'w> SceneBuilder<'p, 'w> {
             line: 1,
             failed: false,
             prims: PrimBatch::new(batch),
-            pts: Vec::new(),
-            nrm: Vec::new(),
+            fills: Vec::new(),
+            next_fill: 0,
+            last_fill: 0,
         }
     }
 
@@ -172,6 +182,18 @@ impl<'p, 'w> SceneBuilder<'p, 'w> {
         point.unwrap_or(Vec3::ZERO)
     }
 
+    /// The material of a remembered fill whose numbers' bits are `key`, looked for
+    /// from the one after the last added on.
+    fn remembered_fill(&mut self, key: &[u64; 8]) -> Option<Material> {
+        let n = self.fills.len();
+        let same = |k: &[u64; 8]| k.iter().zip(key).fold(0, |d, (a, b)| d | (a ^ b)) == 0;
+        let k = (1..=n)
+            .map(|i| (self.last_fill + i) % n)
+            .find(|&k| same(&self.fills[k].0))?;
+        self.last_fill = k;
+        Some(self.fills[k].1)
+    }
+
     /// The loader's warning for a colour written with channels above 1 (the colour is
     /// the entity's first number, at column 3).
     fn warn_above_one(&mut self, line: u32, what: &str, c: Vec3) {
@@ -233,12 +255,28 @@ impl NffSink for SceneBuilder<'_, '_> {
 
     fn fill(&mut self, rgb: D, kd: f64, ks: f64, shine: f64, t: f64, ior: f64) {
         let line = self.entity(1);
+        let key = [rgb.x, rgb.y, rgb.z, kd, ks, shine, t, ior].map(f64::to_bits);
+        if let Some(material) = self.remembered_fill(&key) {
+            self.part.add_material(material, line);
+            return;
+        }
         let color = self.vec3(rgb);
         self.warn_above_one(line, "fill", color);
         let [kd, ks, shine, t, ior] = [kd, ks, shine, t, ior].map(|x| self.num(x));
         self.check(shine >= 0.0 && range::check_ior(t, ior).is_ok());
-        self.part
-            .add_material(fill(color, kd, ks, shine, t, ior), line);
+        let material = fill(color, kd, ks, shine, t, ior);
+        self.part.add_material(material, line);
+        // A fill that warned warns again; one that failed the build ends it.
+        if !self.failed && color.max_element() <= 1.0 {
+            if self.fills.len() < FILLS {
+                self.last_fill = self.fills.len();
+                self.fills.push((key, material));
+            } else {
+                self.last_fill = self.next_fill;
+                self.fills[self.next_fill] = (key, material);
+                self.next_fill = (self.next_fill + 1) % FILLS;
+            }
+        }
     }
 
     fn sphere(&mut self, center: D, radius: f64) {
@@ -271,35 +309,20 @@ impl NffSink for SceneBuilder<'_, '_> {
 }
 
 impl SceneBuilder<'_, '_> {
-    /// `p` (no normals) or `pp`: one line for the count, one per vertex.
+    /// `p` (no normals) or `pp`: one line for the count, one per vertex; queued with
+    /// the spheres and cones, and made with them.
     fn polygon_with(&mut self, verts: &[D], normals: Option<&[D]>) {
         self.made(verts.len().saturating_sub(2));
         let line = self.entity(1 + verts.len());
         self.check(!verts.is_empty() && normals.is_none_or(|n| n.len() >= verts.len()));
+        self.check(self.origin.is_some());
         if self.failed {
             return;
         }
-        let mut pts = std::mem::take(&mut self.pts);
-        let mut nrm = std::mem::take(&mut self.nrm);
-        pts.clear();
-        nrm.clear();
-        for (k, &v) in verts.iter().enumerate() {
-            pts.push(self.point(v));
-            if let Some(n) = normals {
-                let n = self.vec3(n[k]);
-                let unit = unit_normal(n);
-                self.check(unit.is_some());
-                nrm.push(unit.unwrap_or(Vec3::Z));
-            }
+        let material = self.part.material_in_effect();
+        if self.prims.push_polygon(verts, normals, line, material) {
+            self.make_prims();
         }
-        if !self.failed {
-            let normals = normals.map(|_| &nrm[..]);
-            let added = self
-                .part
-                .add_polygon(&pts, normals, line, || (line as usize, 1));
-            self.check(added.is_ok());
-        }
-        (self.pts, self.nrm) = (pts, nrm);
     }
 }
 
@@ -362,6 +385,160 @@ mod tests {
             assert_builds_as_read(Database::Balls, 3, 100);
             assert_builds_as_read(Database::Jacks, 3, 7);
         });
+    }
+
+    /// The databases of polygons, made in batches of a few to many (so that batches
+    /// and pieces end anywhere among their polygons, flat and smooth mixed in one
+    /// piece) on one and on several threads: the scenes their texts read as.
+    #[test]
+    fn queued_polygons_build_the_same_scenes_in_any_batch_on_any_pool() {
+        let polygons = [
+            Database::Tetra,
+            Database::Gears,
+            Database::Teapot,
+            Database::Sombrero,
+            Database::Mount,
+        ];
+        for threads in [1, 3] {
+            let pool = rayon::ThreadPoolBuilder::new()
+                .num_threads(threads)
+                .build()
+                .unwrap();
+            pool.install(|| {
+                for db in polygons {
+                    for batch in [1, 2, 5, 100, 4096] {
+                        assert_builds_as_read(db, 2, batch);
+                    }
+                }
+                assert_builds_as_read(Database::Teapot, 3, 300);
+            });
+        }
+    }
+
+    /// The same entities to the scene builder, made `batch` at a time, and to the text:
+    /// the built scene (or `None`, the build failed) and the scene the text reads as.
+    fn built_and_read(
+        batch: usize,
+        entities: impl Fn(&mut dyn NffSink),
+    ) -> (Option<Result<Scene, LoadError>>, Result<Scene, LoadError>) {
+        let path = Path::new("x");
+        let mut builder = SceneBuilder::with_batch(path, &SILENT, batch);
+        entities(&mut builder);
+        let mut text = crate::spd::NffWriter::new();
+        entities(&mut text);
+        (builder.finish(), parse_str(&text.finish(), path))
+    }
+
+    /// A polygon the loader refuses (a vertex or a normal not finite, out of range,
+    /// a zero normal) fails the build, queued among others or not: the scene is then
+    /// the text's, whose error is the loader's.
+    #[test]
+    fn a_refused_polygon_fails_the_build_with_the_texts_error() {
+        let tri = [D::ZERO, D::X, D::Y];
+        let nan = D::new(f64::NAN, 0.0, 0.0);
+        let far = D::new(1e30, 0.0, 0.0);
+        // A polygon's vertices, its normals if it is a patch, and the loader's error.
+        type Refused<'a> = (&'a [D], Option<&'a [D]>, &'a str);
+        let refused: [Refused; 5] = [
+            (&[D::ZERO, nan, D::Y], None, "the polygon vertex x"),
+            (
+                &[D::ZERO, D::X, far],
+                None,
+                "the polygon vertex (1e30, 0, 0) lies outside",
+            ),
+            (&tri, Some(&[D::Z, D::Z, nan]), "the vertex normal x"),
+            (&tri, Some(&[D::Z, D::ZERO, D::Z]), "vertex normal is zero"),
+            (
+                &tri,
+                Some(&[D::Z, D::Z, D::new(0.0, 0.0, 1e300)]),
+                "the vertex normal z",
+            ),
+        ];
+        for (verts, normals, message) in refused {
+            for batch in [1, 2, 4096] {
+                let (built, read) = built_and_read(batch, |w| {
+                    w.viewpoint(D::Z * 5.0, D::ZERO, D::Y, 45.0, 0.0, (8, 8));
+                    w.polygon(&tri);
+                    match normals {
+                        Some(n) => w.polypatch(verts, n),
+                        None => w.polygon(verts),
+                    }
+                    w.sphere(D::ZERO, 1.0);
+                    w.polygon(&tri);
+                });
+                let what = format!("{verts:?} {normals:?} batch {batch}");
+                assert!(built.is_none(), "{what}");
+                let error = read.unwrap_err();
+                assert!((12..=15).contains(&error.line), "{what}: {error}");
+                assert!(error.to_string().contains(message), "{what}: {error}");
+            }
+        }
+    }
+
+    /// A degenerate polygon is dropped and counted as the loader drops it, with the
+    /// first one's line; one before the first fill does not make the default material
+    /// (nothing uses it), one after does not change the materials of the others.
+    #[test]
+    fn degenerate_polygons_are_dropped_as_the_text_drops_them() {
+        let line = [D::ZERO, D::X, D::X * 2.0];
+        let point = [D::ZERO, D::ZERO, D::ZERO];
+        for batch in [1, 3, 4096] {
+            let (built, read) = built_and_read(batch, |w| {
+                w.viewpoint(D::Z * 5.0, D::ZERO, D::Y, 45.0, 0.0, (8, 8));
+                w.polygon(&line);
+                w.polypatch(&point, &[D::Z, D::Z, D::Z]);
+                w.fill(D::X, 1.0, 0.0, 0.0, 0.0, 1.0);
+                w.polygon(&[D::ZERO, D::X, D::X + D::Y, D::Y]);
+                w.polygon(&line);
+                w.polypatch(&[D::ZERO, D::X, D::Y], &[D::Z, D::X, D::Y]);
+            });
+            let (built, read) = (built.expect("built").unwrap(), read.unwrap());
+            assert_eq!(built, read, "batch {batch}");
+            assert_eq!(built.materials.len(), 1, "batch {batch}");
+            assert_eq!(built.load_stats.polygons, 5);
+            assert_eq!(built.load_stats.degenerate_dropped, 3);
+            let lines = built.geometry.sources.get(Kind::Triangle, 2).unwrap().line;
+            assert_eq!(lines, 26, "batch {batch}");
+        }
+        let (built, read) = built_and_read(2, |w| {
+            w.viewpoint(D::Z * 5.0, D::ZERO, D::Y, 45.0, 0.0, (8, 8));
+            w.polygon(&line);
+            w.polygon(&[D::ZERO, D::X, D::Y]);
+        });
+        let (built, read) = (built.expect("built").unwrap(), read.unwrap());
+        assert_eq!(built, read);
+        assert_eq!(built.materials.len(), 1, "the default, for the triangle");
+    }
+
+    /// Fills written again and again, more kinds than are remembered, one with a
+    /// colour above 1: the materials and warnings the text gives.
+    #[test]
+    fn repeated_fills_make_the_materials_of_their_text() {
+        let emit = |w: &mut dyn NffSink| {
+            w.viewpoint(D::Z * 5.0, D::ZERO, D::Y, 45.0, 0.0, (8, 8));
+            for round in 0..3 {
+                for k in 0..FILLS + 3 {
+                    let color = D::new(0.1 * k as f64, 0.5, round as f64 * 0.0);
+                    w.fill(color, 0.5, 0.5, 3.0, 0.0, 1.0);
+                    w.sphere(D::X * k as f64, 0.5);
+                }
+                for _ in 0..2 {
+                    w.fill(D::splat(2.0), 0.5, 0.5, 3.0, 0.0, 1.0);
+                    w.cone(D::ZERO, 0.5, D::Y, 0.5);
+                }
+            }
+        };
+        let (built, read) = built_and_read(5, emit);
+        let (built, read) = (built.expect("built").unwrap(), read.unwrap());
+        assert_eq!(built, read);
+        assert_eq!(built.materials.len(), 3 * (FILLS + 5));
+        let materials = &built.sources.materials;
+        assert!(materials.same_origins(&read.sources.materials));
+        let mut builder = SceneBuilder::new(Path::new("x"), &SILENT);
+        emit(&mut builder);
+        let warnings = (builder.part.notes.iter())
+            .filter(|n| matches!(n, Note::Warning(w) if w.contains("channels above 1")));
+        assert_eq!(warnings.count(), 6);
     }
 
     /// A fill after queued spheres is their material's end: each sphere keeps the

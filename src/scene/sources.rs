@@ -150,6 +150,27 @@ impl Sources {
     /// Append `other`'s items after the first `offset` indices: the table that adding
     /// `other`'s items here one by one, in order, `offset` places on, would make.
     pub fn append(&mut self, other: &Sources, offset: usize) {
+        let end = other
+            .runs
+            .last()
+            .map_or(0, |r| (r.first + r.count) as usize);
+        let fits = u32::try_from(end + offset).is_ok();
+        if self.runs.is_empty() && self.files.is_empty() && fits {
+            // Each run of `other` was added where the run before it refused it, as it
+            // would be here: adding them one by one remakes them, `offset` places on.
+            self.files.clone_from(&other.files);
+            let shift = |r: &Run| Run {
+                first: r.first + offset as u32,
+                ..*r
+            };
+            self.runs = other.runs.iter().map(shift).collect();
+            return;
+        }
+        self.append_each(other, offset);
+    }
+
+    /// [`Sources::append`], adding `other`'s runs one by one.
+    fn append_each(&mut self, other: &Sources, offset: usize) {
         for run in &other.runs {
             let file = &other.files[run.file as usize];
             let first = run.first as usize + offset;
@@ -363,6 +384,42 @@ mod tests {
         s.add_lines(1000, 1000, &f, 1010);
         assert_eq!(s.runs(), 1);
         assert_eq!(s.get(1999).unwrap().line, 2009);
+    }
+
+    /// Appended to an empty table, a table's runs are copied: the table that adding
+    /// them one by one makes, whatever runs it holds and wherever it is appended.
+    #[test]
+    fn appending_to_an_empty_table_copies_the_runs() {
+        let f: Arc<str> = Arc::from("a.nff");
+        let g: Arc<str> = Arc::from("b.nff");
+        let mut table = Sources::default();
+        table.add_lines(0, 10, &f, 1);
+        table.add(10, 2, &f, 11);
+        table.add(12, 2, &f, 12);
+        table.add(14, 3, &f, 13);
+        table.add(17, 1, &g, 13);
+        table.add(18, 1, &f, 15);
+        table.add(20, 4, &f, 20);
+        table.add_lines(24, 5, &f, 21);
+        let end = 29;
+        for offset in [
+            0,
+            1,
+            1000,
+            u32::MAX as usize - end,
+            u32::MAX as usize - end + 1,
+        ] {
+            let (mut copied, mut each) = (Sources::default(), Sources::default());
+            copied.append(&table, offset);
+            each.append_each(&table, offset);
+            assert!(copied.same_origins(&each), "offset {offset}");
+            assert_eq!(copied.runs, each.runs, "offset {offset}");
+        }
+        let mut s = Sources::default();
+        s.append(&table, 3);
+        assert_eq!(s.get(3).unwrap().line, 1);
+        assert_eq!(s.get(20).unwrap().to_string(), "b.nff:13");
+        assert_eq!(s.get(22), None);
     }
 
     #[test]

@@ -93,12 +93,22 @@ fn cell_corner(k: usize) -> (u32, u32) {
 }
 
 /// The teapot: every patch, every parameter cell, two triangles per cell (corners
-/// 0-1-2 and 2-3-0), skipping triangles degenerate at a cusp.
+/// 0-1-2 and 2-3-0), skipping triangles degenerate at a cusp. Each grid point of a
+/// patch is evaluated once, for the cells around it.
 fn teapot(size: u32, w: &mut impl NffSink) {
     material(w, TEAPOT_COLOR, 0.75, 0.25, 37.0);
     let n = f64::from(size);
+    let side = size as usize + 1;
+    let mut grid = Vec::with_capacity(side * side);
     for index in 0..PATCHES.len() {
         let patch = Patch::new(index);
+        grid.clear();
+        for si in 0..=size {
+            for ti in 0..=size {
+                let e = patch.eval(f64::from(si) / n, f64::from(ti) / n);
+                grid.push((e.point, e.normal()));
+            }
+        }
         for si in 0..size {
             for ti in 0..size {
                 for tri in 0..2 {
@@ -106,11 +116,8 @@ fn teapot(size: u32, w: &mut impl NffSink) {
                     let mut norms = [DVec3::ZERO; 3];
                     for v in 0..3 {
                         let (ds, dt) = cell_corner((v + 2 * tri) % 4);
-                        let s = f64::from(si + ds) / n;
-                        let t = f64::from(ti + dt) / n;
-                        let e = patch.eval(s, t);
-                        verts[v] = e.point;
-                        norms[v] = e.normal();
+                        let k = (si + ds) as usize * side + (ti + dt) as usize;
+                        (verts[v], norms[v]) = grid[k];
                     }
                     if fix_cusp(&verts, &mut norms) {
                         w.polypatch(&verts, &norms);

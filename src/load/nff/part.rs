@@ -84,6 +84,17 @@ impl Part {
         }
     }
 
+    /// The material of the next primitive as [`Part::material_index`] gives it, but
+    /// without marking the part as inheriting: for a primitive that may yet be dropped
+    /// (see [`Part::add_triangulated`]).
+    #[inline]
+    pub fn material_in_effect(&self) -> u32 {
+        match self.materials.len() {
+            0 => INHERITED,
+            n => n as u32 - 1,
+        }
+    }
+
     /// An `f` on line `line`.
     pub fn add_material(&mut self, material: Material, line: u32) {
         self.materials.push((material, line));
@@ -153,14 +164,11 @@ impl Part {
         line: u32,
         at: impl FnOnce() -> (usize, usize),
     ) -> Result<(), TooManySmooth> {
-        self.polygons += 1;
         if self.triangulator.triangulate(pts, &mut self.tris).is_err() {
-            self.degenerate_dropped += 1;
-            if self.first_degenerate.is_none() {
-                self.first_degenerate = Some(at());
-            }
+            self.add_degenerate(at);
             return Ok(());
         }
+        self.polygons += 1;
         let m = self.material_index();
         self.record(Kind::Triangle, self.tris.len(), line);
         let g = &mut self.geometry;
@@ -181,6 +189,57 @@ impl Part {
                 None => u32::MAX,
             };
             g.triangle_normals.push(k);
+        }
+        Ok(())
+    }
+
+    /// A degenerate polygon, dropped and counted as [`Part::add_polygon`] drops it; its
+    /// position, `at()`, is kept if it is the first.
+    pub fn add_degenerate(&mut self, at: impl FnOnce() -> (usize, usize)) {
+        self.polygons += 1;
+        self.degenerate_dropped += 1;
+        if self.first_degenerate.is_none() {
+            self.first_degenerate = Some(at());
+        }
+    }
+
+    /// A polygon on line `line` already triangulated into `tris`, with their vertex
+    /// normals (one triple per triangle) for a `pp`: what [`Part::add_polygon`] adds
+    /// for it, with material `material`, the [`Part::material_index`] of its line, or
+    /// [`INHERITED`] before the part's first `f` (the part then inherits).
+    ///
+    /// # Errors
+    /// [`TooManySmooth`] past `u32::MAX` smooth triangles.
+    pub fn add_triangulated(
+        &mut self,
+        tris: &[Triangle],
+        normals: Option<&[[Vec3; 3]]>,
+        line: u32,
+        material: u32,
+    ) -> Result<(), TooManySmooth> {
+        self.polygons += 1;
+        self.inherits |= material == INHERITED;
+        self.record(Kind::Triangle, tris.len(), line);
+        let g = &mut self.geometry;
+        let first = g.triangles.items.len();
+        g.triangles.items.extend_from_slice(tris);
+        g.triangles.material.resize(first + tris.len(), material);
+        match normals {
+            Some(n) => {
+                debug_assert_eq!(n.len(), tris.len());
+                let k = g.vertex_normals.len();
+                let last = k + n.len();
+                // The last index, `last − 1`, below `u32::MAX` (the flat marker).
+                if u32::try_from(last).is_err() {
+                    return Err(TooManySmooth);
+                }
+                g.triangle_normals.extend(k as u32..last as u32);
+                g.vertex_normals.extend_from_slice(n);
+            }
+            None => {
+                let flat = std::iter::repeat_n(u32::MAX, tris.len());
+                g.triangle_normals.extend(flat);
+            }
         }
         Ok(())
     }
