@@ -42,7 +42,7 @@ impl<A: Accel> Tracer<'_, A> {
         let (surf, d, s) = (at.surf, at.d, at.state);
         // Textured inputs and the bumped shading normal (scene/texture.rs).
         let (m, ns) = self.scene.shading(surf);
-        let m = &*m;
+        let m = &m;
         let p = surf.point.p;
         let ng_out = surf.point.ng;
         // Both sides are surfaces: face the normals towards the incoming ray.

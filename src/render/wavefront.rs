@@ -16,7 +16,6 @@ use super::whitted::Tracer;
 use crate::accel::{Accel, Hit};
 use crate::geometry::Kind;
 use crate::math::{Ray, Vec3, offset_ray_origin};
-use crate::scene::{Surface, Surfaces};
 use std::cell::Cell;
 
 /// An eye ray of a batch.
@@ -73,20 +72,11 @@ struct Buffers {
     hits: Vec<Option<Hit>>,
     /// The order the hits are shaded in.
     order: Vec<u32>,
-    /// The surfaces of the hits, in `order` (the misses left out).
-    surfaces: Surfaces,
     lights: LightQueue,
 }
 
 thread_local! {
     static BUFFERS: Cell<Buffers> = Cell::new(Buffers::default());
-}
-
-/// The group of a hit in [`by_kind`]'s order: 0 for a miss, else its kind's
-/// geometry id plus one (an unknown id in the last group).
-#[inline]
-fn group(h: &Option<Hit>) -> usize {
-    h.map_or(0, |h| (h.geom_id as usize + 1).min(Kind::ALL.len()))
 }
 
 /// The indices of `hits` grouped by what was hit (the misses first, then kind by
@@ -95,6 +85,7 @@ fn group(h: &Option<Hit>) -> usize {
 /// are shaded changes no value: each writes its own node.
 fn by_kind(hits: &[Option<Hit>], order: &mut Vec<u32>) {
     const GROUPS: usize = Kind::ALL.len() + 1;
+    let group = |h: &Option<Hit>| h.map_or(0, |h| (h.geom_id as usize + 1).min(GROUPS - 1));
     let mut start = [0u32; GROUPS + 1];
     for h in hits {
         start[group(h) + 1] += 1;
@@ -109,13 +100,6 @@ fn by_kind(hits: &[Option<Hit>], order: &mut Vec<u32>) {
         order[*at as usize] = i as u32;
         *at += 1;
     }
-}
-
-/// `order`'s runs of hits on one kind ([`by_kind`]'s groups, the misses left out).
-fn kind_runs<'o>(hits: &'o [Option<Hit>], order: &'o [u32]) -> impl Iterator<Item = &'o [u32]> {
-    order
-        .chunk_by(move |&a, &b| group(&hits[a as usize]) == group(&hits[b as usize]))
-        .filter(move |run| hits[run[0] as usize].is_some())
 }
 
 impl<A: Accel> Tracer<'_, A> {
@@ -204,17 +188,9 @@ impl<A: Accel> Tracer<'_, A> {
             self.cast(round, coherent, b, rec);
             b.again.clear();
             by_kind(&b.hits, &mut b.order);
-            self.surfaces(b);
-            let mut surfaces = 0;
             for &i in &b.order {
                 let i = i as usize;
-                let Some(hit) = &b.hits[i] else {
-                    self.escape(&round[i], depth, rec);
-                    continue;
-                };
-                let surf = b.surfaces.get(surfaces);
-                surfaces += 1;
-                self.arrive(&round[i], hit, &surf, depth, &mut b.again, rec);
+                self.arrive(&round[i], b.hits[i], depth, &mut b.again, rec);
             }
             std::mem::swap(round, &mut b.again);
             coherent = false;
@@ -241,44 +217,32 @@ impl<A: Accel> Tracer<'_, A> {
         rec.cast(false, &nodes);
     }
 
-    /// The surfaces of `b.hits` into `b.surfaces`, in `b.order`, a run of one kind
-    /// at a time.
-    fn surfaces(&self, b: &mut Buffers) {
-        let exact = self.accel.exact_triangle_hits();
-        b.surfaces.clear(b.hits.len());
-        for run in kind_runs(&b.hits, &b.order) {
-            self.scene
-                .surfaces(run, &b.hits, &b.rays, exact, &mut b.surfaces);
-        }
-    }
-
-    /// Ray `s` left the scene: its node takes the background.
-    fn escape<R: Recorder>(&self, s: &PathState, depth: &mut Depth, rec: &mut R) {
-        let sky = self.scene.escape(s.ray.dir);
-        rec.miss(s.node, sky);
-        let node = depth.tree.node(s.node);
-        node.local = sky;
-        node.missed = true;
-    }
-
-    /// Ray `s` met `hit` on `surf`: a surface it goes on through (queued `again`), or
-    /// a surface it is shaded at.
+    /// Ray `s` met `first`: the background, a surface it goes on through (queued
+    /// `again`), or a surface it is shaded at.
     fn arrive<R: Recorder>(
         &self,
         s: &PathState,
-        hit: &Hit,
-        surf: &Surface,
+        first: Option<Hit>,
         depth: &mut Depth,
         again: &mut Vec<PathState>,
         rec: &mut R,
     ) {
         let scene = self.scene;
+        let Some(hit) = first else {
+            let sky = scene.escape(s.ray.dir);
+            rec.miss(s.node, sky);
+            let node = depth.tree.node(s.node);
+            node.local = sky;
+            node.missed = true;
+            return;
+        };
+        let surf = scene.surface_of(&hit, &s.ray, self.accel.exact_triangle_hits());
         let m = &scene.materials[surf.material as usize];
         let d = s.ray.dir.normalize();
         let entering = surf.point.ng.dot(d) < 0.0;
         let met = Met {
-            hit,
-            surf,
+            hit: &hit,
+            surf: &surf,
             entering,
             media: &s.media,
         };
@@ -310,10 +274,10 @@ impl<A: Accel> Tracer<'_, A> {
         if s.depth == 1 {
             rec.counts().eye_hit += 1;
         }
-        let gi = self.gi.and_then(|g| g.radiosity_at(hit, surf.point.p, d));
+        let gi = self.gi.and_then(|g| g.radiosity_at(&hit, surf.point.p, d));
         let at = Arrival {
             state: s,
-            surf,
+            surf: &surf,
             d,
             entering,
             gi,
@@ -347,16 +311,5 @@ mod tests {
         assert_eq!(order, [1, 5, 2, 4, 0, 3, 6]);
         by_kind(&[], &mut order);
         assert!(order.is_empty());
-    }
-
-    #[test]
-    fn kind_runs_are_the_groups_of_hits_without_the_misses() {
-        let (s, t) = (hit(Kind::Sphere), hit(Kind::Triangle));
-        let hits = [s, None, t, s, t, None, s];
-        let mut order = Vec::new();
-        by_kind(&hits, &mut order);
-        let runs: Vec<&[u32]> = kind_runs(&hits, &order).collect();
-        assert_eq!(runs, [&[2u32, 4][..], &[0, 3, 6][..]]);
-        assert_eq!(kind_runs(&[None, None], &[0, 1]).count(), 0);
     }
 }

@@ -4,19 +4,16 @@
 use crate::geometry::{Kind, Param, SurfacePoint};
 use crate::math::{DVec3, Ray, Vec3, Xform};
 use glam::Vec2;
-use std::borrow::Cow;
 
 mod hit;
 pub mod range;
 mod sources;
 mod store;
-mod surfaces;
 pub mod texture;
 
 pub use hit::{Hit, NO_INSTANCE};
 pub use sources::{Origin, PrimSources, Sources};
 pub use store::{Geometry, GeometryMark, KindVisitor, Prims, ShapeEntry};
-pub use surfaces::Surfaces;
 
 pub use texture::{Environment, Maps, NO_TEXTURE, Texture};
 
@@ -378,17 +375,15 @@ impl Scene {
     /// The material at `surf` with its textured inputs resolved (colour, highlight
     /// and mirror weights) and the shading normal after its normal and bump maps
     /// (not yet faced towards the ray). See [`texture`].
-    /// A material without texture maps is lent, not copied.
     #[inline]
-    pub fn shading(&self, surf: &Surface) -> (Cow<'_, Material>, Vec3) {
-        let m = &self.materials[surf.material as usize];
+    pub fn shading(&self, surf: &Surface) -> (Material, Vec3) {
+        let mut m = self.materials[surf.material as usize];
         match surf.param {
             Some(prm) => {
-                let mut m = *m;
                 let ns = self.apply_maps(&mut m, &prm, surf);
-                (Cow::Owned(m), ns)
+                (m, ns)
             }
-            None => (Cow::Borrowed(m), surf.ns),
+            None => (m, surf.ns),
         }
     }
 

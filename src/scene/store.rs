@@ -412,9 +412,7 @@ impl Geometry {
         }
     }
 
-    /// The surface at `hit` on triangle `i`, `hit` as exact as the caller made it.
-    #[inline]
-    pub(super) fn triangle_surface(&self, i: usize, hit: &Hit) -> Surface {
+    fn triangle_surface(&self, i: usize, hit: &Hit) -> Surface {
         let tri = &self.triangles.items[i];
         let point = tri.surface(hit.u, hit.v);
         let ns = match self.triangle_normals[i] {
@@ -507,30 +505,20 @@ impl KindVisitor<'_> for SurfaceAt<'_> {
     type Output = Surface;
     #[inline]
     fn visit<P: Analytic>(&mut self, prims: &Prims<P>) -> Surface {
-        analytic_surface(prims, self.i, self.hit, self.ray)
-    }
-}
-
-/// The surface at `hit` on primitive `i` of `prims`, for `ray`.
-#[inline(always)]
-pub(super) fn analytic_surface<P: Analytic>(
-    prims: &Prims<P>,
-    i: usize,
-    hit: &Hit,
-    ray: &Ray,
-) -> Surface {
-    let shape = &prims.items[i];
-    let shape_hit = ShapeHit {
-        t: hit.t,
-        u: hit.u,
-        v: hit.v,
-        ng: hit.ng,
-    };
-    let point = shape.surface(ray, &shape_hit);
-    Surface {
-        point,
-        ns: point.ng,
-        material: shape.material(&shape_hit, prims.material[i]),
-        param: None,
+        let hit = self.hit;
+        let shape = &prims.items[self.i];
+        let shape_hit = ShapeHit {
+            t: hit.t,
+            u: hit.u,
+            v: hit.v,
+            ng: hit.ng,
+        };
+        let point = shape.surface(self.ray, &shape_hit);
+        Surface {
+            point,
+            ns: point.ng,
+            material: shape.material(&shape_hit, prims.material[self.i]),
+            param: None,
+        }
     }
 }
