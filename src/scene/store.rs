@@ -160,7 +160,7 @@ macro_rules! define_store {
                     triangle_quads, quads, sources, $($field,)*
                 } = other;
                 let mark = self.mark();
-                self.sources.append(&sources, &|k| mark.count(k));
+                self.sources.append_owned(sources, &|k| mark.count(k));
                 let first_triangle = self.triangles.len();
                 self.triangles.append(triangles, &material);
                 append_indices(&mut self.triangle_normals, triangle_normals, first_triangle,
