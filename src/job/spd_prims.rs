@@ -14,6 +14,7 @@
 //! the next batch meanwhile instead of waiting, and the last batch is added when the
 //! builder drains it ([`PrimBatch::drain`]).
 
+use super::spd_points::PointCache;
 use crate::geometry::polygon::Triangulator;
 use crate::geometry::{Cone, Intersect, Kind, Sphere, Triangle};
 use crate::load::nff::{Part, unit_normal, world_bounds};
@@ -134,6 +135,8 @@ struct Piece {
     nrm: Vec<Vec3>,
     corners: Vec<[usize; 3]>,
     triangulator: Triangulator,
+    /// The points of the last polygons made.
+    points: PointCache,
 }
 
 impl Piece {
@@ -174,7 +177,7 @@ impl Piece {
         self.pts.clear();
         self.nrm.clear();
         for (k, &v) in verts.iter().enumerate() {
-            self.pts.push(scene_point(origin, v)?);
+            self.pts.push(self.points.point(origin, v)?);
             if let Some(n) = normals {
                 let n = n[k];
                 let n = Vec3::new(finite_f32(n.x)?, finite_f32(n.y)?, finite_f32(n.z)?);
