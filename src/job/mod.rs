@@ -19,6 +19,7 @@ mod pipeline;
 mod report;
 pub mod resolve;
 mod source;
+mod spd_points;
 mod spd_prims;
 mod spd_scene;
 pub mod template;

@@ -9,8 +9,12 @@
 //! own), so the batch's results, added in order with the lines and materials they were
 //! queued with, are what making them one at a time would add. A batch is cut into
 //! pieces of about equal work, a polygon counting as many as its triangles, made one
-//! piece per task.
+//! piece per task. A full batch is made while the batch before it is added to the
+//! scene's lists (which grow, page by page, on the builder's thread): the pool makes
+//! the next batch meanwhile instead of waiting, and the last batch is added when the
+//! builder drains it ([`PrimBatch::drain`]).
 
+use super::spd_points::PointCache;
 use crate::geometry::polygon::Triangulator;
 use crate::geometry::{Cone, Intersect, Kind, Sphere, Triangle};
 use crate::load::nff::{Part, unit_normal, world_bounds};
@@ -131,6 +135,8 @@ struct Piece {
     nrm: Vec<Vec3>,
     corners: Vec<[usize; 3]>,
     triangulator: Triangulator,
+    /// The points of the last polygons made.
+    points: PointCache,
 }
 
 impl Piece {
@@ -171,7 +177,7 @@ impl Piece {
         self.pts.clear();
         self.nrm.clear();
         for (k, &v) in verts.iter().enumerate() {
-            self.pts.push(scene_point(origin, v)?);
+            self.pts.push(self.points.point(origin, v)?);
             if let Some(n) = normals {
                 let n = n[k];
                 let n = Vec3::new(finite_f32(n.x)?, finite_f32(n.y)?, finite_f32(n.z)?);
@@ -237,10 +243,64 @@ impl Piece {
     }
 }
 
-/// Primitives waiting to be made, in entity order.
+/// Queued primitives cut into pieces, and what the pieces made of them.
+#[derive(Debug, Default)]
+struct Stage {
+    pending: Vec<Queued>,
+    /// Where the pieces made one after the other on one thread end in `pending`.
+    cuts: Vec<usize>,
+    /// Scratch: what each piece made.
+    pieces: Vec<Piece>,
+}
+
+impl Stage {
+    /// Make every piece (whose polygons' numbers are in `verts` and `normals`) in the
+    /// frame of `origin`, on the current rayon pool.
+    fn make(&mut self, verts: &[D], normals: &[D], origin: Option<DVec3>) {
+        if self.cuts.last() != Some(&self.pending.len()) {
+            self.cuts.push(self.pending.len());
+        }
+        let n = self.cuts.len();
+        if self.pieces.len() < n {
+            self.pieces.resize_with(n, Piece::default);
+        }
+        let (pending, cuts) = (&self.pending[..], &self.cuts[..]);
+        self.pieces[..n]
+            .par_iter_mut()
+            .enumerate()
+            .for_each(|(k, piece)| {
+                piece.make(&pending[piece_range(cuts, k)], verts, normals, origin)
+            });
+    }
+
+    /// Add what the pieces made to `part` in order, then empty the stage; whether the
+    /// loader would have made all of it (true for an empty stage).
+    fn add(&mut self, part: &mut Part) -> bool {
+        let (pending, cuts) = (&self.pending[..], &self.cuts[..]);
+        let all_made = (self.pieces.iter().enumerate().take(cuts.len()))
+            .all(|(k, piece)| piece.add(&pending[piece_range(cuts, k)], part));
+        self.pending.clear();
+        self.cuts.clear();
+        all_made
+    }
+}
+
+/// The queued primitives of piece `k` of a stage whose pieces end at `cuts`.
+fn piece_range(cuts: &[usize], k: usize) -> std::ops::Range<usize> {
+    let start = if k == 0 { 0 } else { cuts[k - 1] };
+    start..cuts[k]
+}
+
+/// Primitives waiting to be made, in entity order, and the batch made last, waiting to
+/// be added: a full batch is made on the pool while the one before it is added on the
+/// builder's thread ([`PrimBatch::flush`]), so that the pool does not wait for the
+/// scene's lists to grow.
 #[derive(Debug)]
 pub(crate) struct PrimBatch {
-    pending: Vec<Queued>,
+    /// The primitives queued since the last flush.
+    queued_stage: Stage,
+    /// The batch made at the last flush, not yet added.
+    made: Stage,
     /// The queued polygons' vertices and the queued `pp`s' normals.
     verts: Vec<D>,
     normals: Vec<D>,
@@ -249,12 +309,8 @@ pub(crate) struct PrimBatch {
     capacity: usize,
     /// The work queued.
     queued: usize,
-    /// Where the pieces made one after the other on one thread end in `pending`, and
-    /// the work queued since the last one.
-    cuts: Vec<usize>,
+    /// The work queued since the last cut of `queued_stage`.
     piece_work: usize,
-    /// Scratch: what each piece made.
-    pieces: Vec<Piece>,
     /// Scratch: the spheres made of a batch of them.
     spheres: Vec<Option<Sphere>>,
 }
@@ -263,14 +319,13 @@ impl PrimBatch {
     /// An empty batch that is full at `capacity` primitives (at least one).
     pub fn new(capacity: usize) -> Self {
         PrimBatch {
-            pending: Vec::new(),
+            queued_stage: Stage::default(),
+            made: Stage::default(),
             verts: Vec::new(),
             normals: Vec::new(),
             capacity: capacity.max(1),
             queued: 0,
-            cuts: Vec::new(),
             piece_work: 0,
-            pieces: Vec::new(),
             spheres: Vec::new(),
         }
     }
@@ -315,50 +370,46 @@ impl PrimBatch {
     }
 
     fn queue(&mut self, prim: Prim, line: u32, material: u32, work: usize) -> bool {
-        self.pending.push(Queued {
+        let piece_len = self.piece_len();
+        let stage = &mut self.queued_stage;
+        stage.pending.push(Queued {
             prim,
             line,
             material,
         });
         self.queued += work;
         self.piece_work += work;
-        if self.piece_work >= self.piece_len() {
-            self.cuts.push(self.pending.len());
+        if self.piece_work >= piece_len {
+            stage.cuts.push(stage.pending.len());
             self.piece_work = 0;
         }
         self.queued >= self.capacity
     }
 
-    /// Make the queued primitives in the frame of `origin`, in parallel, and add them
-    /// to `part` in order. Returns false if the loader would have refused one of them
-    /// (see [`sphere_of`], [`Piece::polygon`]): the build has failed, and what was added
-    /// is of no use.
+    /// Make the queued primitives in the frame of `origin`, in parallel, while the
+    /// batch made at the last flush is added to `part` in order; the batch made now is
+    /// added at the next flush or [`PrimBatch::drain`]. Returns false if the loader
+    /// would have refused one of the primitives added (see [`sphere_of`],
+    /// [`Piece::polygon`]): the build has failed, and what was added is of no use.
     pub fn flush(&mut self, origin: Option<DVec3>, part: &mut Part) -> bool {
-        if self.pending.is_empty() {
-            return true;
+        if self.queued_stage.pending.is_empty() {
+            return self.drain(part);
         }
-        if self.cuts.last() != Some(&self.pending.len()) {
-            self.cuts.push(self.pending.len());
-        }
-        let n = self.cuts.len();
-        if self.pieces.len() < n {
-            self.pieces.resize_with(n, Piece::default);
-        }
-        let (pending, cuts) = (&self.pending[..], &self.cuts[..]);
         let (verts, normals) = (&self.verts[..], &self.normals[..]);
-        let range = |k: usize| if k == 0 { 0 } else { cuts[k - 1] }..cuts[k];
-        self.pieces[..n]
-            .par_iter_mut()
-            .enumerate()
-            .for_each(|(k, piece)| piece.make(&pending[range(k)], verts, normals, origin));
-        let all_made = (self.pieces[..n].iter().enumerate())
-            .all(|(k, piece)| piece.add(&pending[range(k)], part));
-        self.pending.clear();
+        let (made, queued) = (&mut self.made, &mut self.queued_stage);
+        let (all_added, ()) =
+            rayon::join(|| made.add(part), || queued.make(verts, normals, origin));
+        std::mem::swap(&mut self.made, &mut self.queued_stage);
         self.verts.clear();
         self.normals.clear();
-        self.cuts.clear();
         (self.queued, self.piece_work) = (0, 0);
-        all_made
+        all_added
+    }
+
+    /// Add the batch made at the last flush to `part`, if it is not yet; false as
+    /// [`PrimBatch::flush`] returns it.
+    pub fn drain(&mut self, part: &mut Part) -> bool {
+        self.made.add(part)
     }
 
     /// The queued primitives, then `spheres` (`(centre, radius)`, on one line each from
@@ -370,7 +421,8 @@ impl PrimBatch {
         origin: Option<DVec3>,
         part: &mut Part,
     ) -> bool {
-        let queued_made = self.flush(origin, part);
+        let flushed = self.flush(origin, part);
+        let queued_made = self.drain(part) && flushed;
         let make = |&(center, radius): &(D, f64)| sphere_of(origin, center, radius);
         let piece = self.piece_len();
         make_all(spheres, piece, make, &mut self.spheres);
@@ -396,4 +448,101 @@ fn make_all<T: Sync, U: Send>(
         .with_min_len(piece)
         .map(make)
         .collect_into_vec(out);
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+    use std::sync::Arc;
+
+    const ORIGIN: Option<DVec3> = Some(DVec3::ZERO);
+
+    /// The `k`-th of some quadrilaterals, each two triangles.
+    fn quad(k: usize) -> [D; 4] {
+        let x = k as f64;
+        [
+            D::new(x, 0.0, 0.0),
+            D::new(x + 1.0, 0.0, 0.0),
+            D::new(x + 1.0, 1.0, 0.0),
+            D::new(x, 1.0, 0.0),
+        ]
+    }
+
+    /// Queue `n` quadrilaterals, one every five lines, flushing whenever the batch is
+    /// full; the part they went to and whether every flush succeeded.
+    fn queue_quads(batch: &mut PrimBatch, n: usize, part: &mut Part) -> bool {
+        let mut ok = true;
+        for k in 0..n {
+            let line = 1 + 5 * k as u32;
+            if batch.push_polygon(&quad(k), None, line, 0) {
+                ok &= batch.flush(ORIGIN, part);
+            }
+        }
+        ok
+    }
+
+    /// A flushed batch is made at once and added at the next flush or drain, after
+    /// the batches before it.
+    #[test]
+    fn a_made_batch_is_added_at_the_next_flush_or_drain() {
+        let mut part = Part::new(Arc::from("x"));
+        let mut batch = PrimBatch::new(4);
+        assert!(queue_quads(&mut batch, 2, &mut part));
+        assert_eq!(part.geometry.triangles.len(), 0, "the first batch waits");
+        assert!(queue_quads(&mut batch, 2, &mut part));
+        assert_eq!(
+            part.geometry.triangles.len(),
+            4,
+            "added at the second flush"
+        );
+        assert!(batch.flush(ORIGIN, &mut part));
+        assert_eq!(part.geometry.triangles.len(), 8);
+        assert!(batch.drain(&mut part));
+        assert!(batch.drain(&mut part), "nothing left to add");
+        assert_eq!(part.geometry.triangles.len(), 8);
+        assert_eq!(part.polygons, 4);
+    }
+
+    /// Batches of any size on one and on three threads add the same triangles in the
+    /// same order as one batch holding them all.
+    #[test]
+    fn overlapped_batches_add_what_one_batch_adds_on_any_pool() {
+        let build = |capacity: usize| {
+            let mut part = Part::new(Arc::from("x"));
+            let mut batch = PrimBatch::new(capacity);
+            assert!(queue_quads(&mut batch, 50, &mut part));
+            assert!(batch.flush(ORIGIN, &mut part) && batch.drain(&mut part));
+            part
+        };
+        let whole = build(1 << 20);
+        assert_eq!(whole.geometry.triangles.len(), 100);
+        for threads in [1, 3] {
+            let pool = rayon::ThreadPoolBuilder::new()
+                .num_threads(threads)
+                .build()
+                .unwrap();
+            for capacity in [1, 2, 3, 7, 64] {
+                let part = pool.install(|| build(capacity));
+                let what = format!("{threads} threads, batches of {capacity}");
+                assert_eq!(part.geometry, whole.geometry, "{what}");
+                let (got, want) = (&part.geometry.sources, &whole.geometry.sources);
+                assert!(got.same_origins(want), "{what}");
+            }
+        }
+    }
+
+    /// A primitive the loader would refuse in the last batch made is reported when
+    /// that batch is drained.
+    #[test]
+    fn a_refusal_in_the_last_batch_is_reported_when_it_is_drained() {
+        let mut part = Part::new(Arc::from("x"));
+        let mut batch = PrimBatch::new(2);
+        assert!(queue_quads(&mut batch, 3, &mut part));
+        batch.push(Prim::Sphere(D::ZERO, 0.0), 20, 0);
+        assert!(
+            batch.flush(ORIGIN, &mut part),
+            "the batch before it is made"
+        );
+        assert!(!batch.drain(&mut part), "a sphere of radius zero");
+    }
 }

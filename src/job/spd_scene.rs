@@ -11,8 +11,8 @@
 //! as failed: the caller then writes the text and reads it.
 //!
 //! Spheres, cones and polygons wait in a batch (`super::spd_prims`), made in parallel
-//! (polygons rounded and triangulated) when it is full and at the end, each with the
-//! material in effect on its line; one before the first viewpoint fails the build at
+//! (polygons rounded and triangulated) when it is full and at the end, and added while
+//! the next batch is made, each with the material in effect on its line; one before the first viewpoint fails the build at
 //! once (the frame it would be made in, the eye's, is not known yet). Nothing else
 //! changes how they are made: later viewpoints keep the first's frame, and lights go
 //! to a list of their own. A fill with the numbers of one of the last few made (and
@@ -115,6 +115,8 @@ impl<'p, 'w> SceneBuilder<'p, 'w> {
     /// The scene, or `None` when the build failed (the text then decides).
     fn finish(mut self) -> Option<Result<Scene, LoadError>> {
         self.make_prims();
+        let drained = self.prims.drain(&mut self.part);
+        self.check(drained);
         if self.failed {
             return None;
         }

@@ -299,6 +299,19 @@ impl PrimSources {
         }
     }
 
+    /// [`PrimSources::append`] for a table that is not needed after: taken as it is
+    /// (its storage kept, not copied) when `self` records nothing and no primitive
+    /// comes before `other`'s.
+    pub fn append_owned(&mut self, other: PrimSources, offset: &dyn Fn(Kind) -> usize) {
+        let nothing_before = Kind::ALL.into_iter().all(|kind| offset(kind) == 0);
+        let empty = |s: &Sources| s.runs.is_empty() && s.files.is_empty();
+        if nothing_before && self.kinds.iter().all(empty) {
+            *self = other;
+            return;
+        }
+        self.append(&other, offset);
+    }
+
     /// Whether `other` records the same origins as `self` (see
     /// [`Sources::same_origins`]).
     pub fn same_origins(&self, other: &PrimSources) -> bool {
@@ -384,6 +397,35 @@ mod tests {
         s.add_lines(1000, 1000, &f, 1010);
         assert_eq!(s.runs(), 1);
         assert_eq!(s.get(1999).unwrap().line, 2009);
+    }
+
+    /// A table appended whole to an empty one is taken with its storage; appended
+    /// after primitives it is added as [`PrimSources::append`] adds it.
+    #[test]
+    fn an_owned_table_appended_to_an_empty_one_is_taken_as_it_is() {
+        let f: Arc<str> = Arc::from("a.nff");
+        let mut table = PrimSources::default();
+        table.add_lines(Kind::Sphere, 0, 10, &f, 1);
+        table.add(Kind::Triangle, 0, 2, &f, 11);
+        table.add(Kind::Triangle, 2, 2, &f, 16);
+        let copy = table.clone();
+        let runs = table.kinds[Kind::Triangle as usize].runs.as_ptr();
+        let mut taken = PrimSources::default();
+        taken.append_owned(table, &|_| 0);
+        assert!(taken.same_origins(&copy));
+        let triangles = &taken.kinds[Kind::Triangle as usize];
+        assert_eq!(triangles.runs.as_ptr(), runs, "the storage taken");
+        assert_eq!(taken.get(Kind::Triangle, 3).unwrap().line, 16);
+        for offset in [0, 5] {
+            let mut before = PrimSources::default();
+            before.add(Kind::Triangle, 0, 1, &f, 1);
+            let (mut owned, mut copied) = (before.clone(), before);
+            owned.append_owned(copy.clone(), &|_| offset + 1);
+            copied.append(&copy, &|_| offset + 1);
+            assert!(owned.same_origins(&copied), "offset {offset}");
+            let last = owned.get(Kind::Sphere, offset as u32 + 10).unwrap();
+            assert_eq!(last.line, 10, "offset {offset}");
+        }
     }
 
     /// Appended to an empty table, a table's runs are copied: the table that adding

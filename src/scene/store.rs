@@ -160,7 +160,7 @@ macro_rules! define_store {
                     triangle_quads, quads, sources, $($field,)*
                 } = other;
                 let mark = self.mark();
-                self.sources.append(&sources, &|k| mark.count(k));
+                self.sources.append_owned(sources, &|k| mark.count(k));
                 let first_triangle = self.triangles.len();
                 self.triangles.append(triangles, &material);
                 append_indices(&mut self.triangle_normals, triangle_normals, first_triangle,
@@ -213,6 +213,11 @@ for_each_kind!(define_store);
 /// triangles but may be shorter (the rest have none).
 fn append_indices(list: &mut Vec<u32>, other: Vec<u32>, first: usize, base: usize) {
     if other.is_empty() {
+        return;
+    }
+    if first == 0 && base == 0 {
+        // The indices stay as they are: `other`'s storage is the list.
+        *list = other;
         return;
     }
     list.resize(first, u32::MAX);
@@ -520,5 +525,54 @@ impl KindVisitor<'_> for SurfaceAt<'_> {
             material: shape.material(&shape_hit, prims.material[self.i]),
             param: None,
         }
+    }
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+
+    fn tri(x: f32) -> Triangle {
+        Triangle {
+            p: [Vec3::new(x, 0.0, 0.0), Vec3::Y, Vec3::Z],
+        }
+    }
+
+    /// A store of a flat, a smooth and a flat triangle.
+    fn mixed() -> Geometry {
+        let mut g = Geometry::default();
+        g.add_triangle(tri(1.0), 0);
+        g.add_smooth_triangle(tri(2.0), [Vec3::X, Vec3::Y, Vec3::Z], 1);
+        g.add_triangle(tri(3.0), 0);
+        g
+    }
+
+    /// Appended to an empty store, a store's normal indices are its own storage, kept
+    /// as they are; appended after triangles with normals, they are numbered on.
+    #[test]
+    fn normal_indices_appended_to_an_empty_store_are_taken_as_they_are() {
+        let other = mixed();
+        let indices = other.triangle_normals.as_ptr();
+        let mut g = Geometry::default();
+        g.append(other, |m| m);
+        assert_eq!(g.triangle_normals, [u32::MAX, 0, u32::MAX]);
+        assert_eq!(g.triangle_normals.as_ptr(), indices, "the storage taken");
+        g.append(mixed(), |m| m + 5);
+        assert_eq!(
+            g.triangle_normals,
+            [u32::MAX, 0, u32::MAX, u32::MAX, 1, u32::MAX]
+        );
+        assert_eq!(g.vertex_normals.len(), 2);
+        assert_eq!(g.triangles.material, [0, 1, 0, 5, 6, 5]);
+    }
+
+    /// An empty store after triangles without normals: the indices start at the
+    /// appended triangles, padded with "none" before them.
+    #[test]
+    fn normal_indices_appended_after_flat_triangles_are_padded() {
+        let mut g = Geometry::default();
+        g.triangles.push(tri(0.0), 0);
+        g.append(mixed(), |m| m);
+        assert_eq!(g.triangle_normals, [u32::MAX, u32::MAX, 0, u32::MAX]);
     }
 }

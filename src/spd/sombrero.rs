@@ -65,27 +65,28 @@ fn samples(n: usize) -> Vec<Vec<f32>> {
     rows
 }
 
-/// The triangles of the height field `data` (`SPD lib_output_polygon_height`).
-fn triangles(data: &[Vec<f32>]) -> Vec<[DVec3; 3]> {
+/// The triangles of the height field `data` (`SPD lib_output_polygon_height`), made
+/// as they are taken (the largest fields have millions).
+fn triangles(data: &[Vec<f32>]) -> impl Iterator<Item = [DVec3; 3]> + '_ {
     let rows = data.len();
     let cols = data[0].len();
     let dx = (OUT_X.1 - OUT_X.0) / (cols - 1) as f64;
     let dz = (OUT_Z.1 - OUT_Z.0) / (rows - 1) as f64;
-    let vert = |i: usize, j: usize| {
+    let vert = move |i: usize, j: usize| {
         DVec3::new(
             OUT_X.0 + j as f64 * dx,
             OUT_Y0 + f64::from(data[i][j]),
             OUT_Z.0 + i as f64 * dz,
         )
     };
-    let mut out = Vec::with_capacity(2 * (rows - 1) * (cols - 1));
-    for i in 0..rows - 1 {
-        for j in 0..cols - 1 {
-            out.push([vert(i, j), vert(i + 1, j + 1), vert(i, j + 1)]);
-            out.push([vert(i, j), vert(i + 1, j), vert(i + 1, j + 1)]);
-        }
-    }
-    out
+    (0..rows - 1).flat_map(move |i| {
+        (0..cols - 1).flat_map(move |j| {
+            [
+                [vert(i, j), vert(i + 1, j + 1), vert(i, j + 1)],
+                [vert(i, j), vert(i + 1, j), vert(i + 1, j + 1)],
+            ]
+        })
+    })
 }
 
 /// Write the database at size factor `size`.
@@ -126,15 +127,15 @@ mod tests {
         for n in 1..=3 {
             let w = side(n);
             assert_eq!(w, 32 << (n - 1));
-            assert_eq!(triangles(&samples(w)).len(), 2 * (w - 1) * (w - 1));
+            assert_eq!(triangles(&samples(w)).count(), 2 * (w - 1) * (w - 1));
         }
-        assert_eq!(triangles(&samples(side(1))).len(), 1922);
+        assert_eq!(triangles(&samples(side(1))).count(), 1922);
     }
 
     #[test]
     fn triangles_form_a_grid_whose_heights_follow_the_function() {
         let n = side(1);
-        let tris = triangles(&samples(n));
+        let tris: Vec<_> = triangles(&samples(n)).collect();
         // Distinct vertices, keyed by grid position.
         let step = 8.0 / (n - 1) as f64;
         let mut grid: BTreeMap<(i64, i64), f64> = BTreeMap::new();

@@ -29,18 +29,17 @@ fn corner_signs() -> impl Iterator<Item = DVec3> {
 }
 
 /// The triangles of the pyramid at size factor `depth` inscribed in the cube of
-/// centre `center` and half-side `half`, in the SPD's order.
-fn triangles(depth: u32, center: DVec3, half: f64, out: &mut Vec<[DVec3; 3]>) {
+/// centre `center` and half-side `half`, to `out` in the SPD's order as they are made.
+fn triangles(depth: u32, center: DVec3, half: f64, out: &mut impl FnMut(&[DVec3; 3])) {
     if depth <= 1 {
-        let p: Vec<DVec3> = corner_signs()
-            .map(|s| {
-                DVec3::new(
-                    center.x + s.x * half,
-                    center.y + s.y * half,
-                    center.z + s.z * half,
-                )
-            })
-            .collect();
+        let mut p = [DVec3::ZERO; 4];
+        for (p, s) in p.iter_mut().zip(corner_signs()) {
+            *p = DVec3::new(
+                center.x + s.x * half,
+                center.y + s.y * half,
+                center.z + s.z * half,
+            );
+        }
         // Face k uses corners k, k+1, k+2 (mod 4), reversed for odd k so that every
         // face winds the same way seen from outside.
         for face in 0..4 {
@@ -48,7 +47,7 @@ fn triangles(depth: u32, center: DVec3, half: f64, out: &mut Vec<[DVec3; 3]>) {
             if face % 2 == 1 {
                 ord.swap(0, 2);
             }
-            out.push(ord.map(|i| p[i]));
+            out(&ord.map(|i| p[i]));
         }
     } else {
         for s in corner_signs() {
@@ -84,11 +83,7 @@ pub fn generate(size: u32, w: &mut impl NffSink) {
         0.0,
         0.0,
     );
-    let mut tris = Vec::new();
-    triangles(size, DVec3::ZERO, 1.0, &mut tris);
-    for t in &tris {
-        w.polygon(t);
-    }
+    triangles(size, DVec3::ZERO, 1.0, &mut |t| w.polygon(t));
 }
 
 #[cfg(test)]
@@ -100,7 +95,7 @@ mod tests {
 
     fn tris(n: u32) -> Vec<[DVec3; 3]> {
         let mut v = Vec::new();
-        triangles(n, DVec3::ZERO, 1.0, &mut v);
+        triangles(n, DVec3::ZERO, 1.0, &mut |t| v.push(*t));
         v
     }
 
